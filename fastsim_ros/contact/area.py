@@ -1,0 +1,248 @@
+"""Contact areas discretised on a regular grid of rectangular cells.
+
+A :class:`GridArea` is the common currency of the exact solver, FastSim and
+MAE: cell centres ``x[i]`` (rolling direction, leading edge at larger ``x``)
+and ``y[j]`` (lateral), arrays indexed ``[j, i]`` so that each row is one
+lateral strip marched along ``x`` (the layout of the node's organised point
+clouds), and the normal pressure on each cell.  A cell is in contact where
+its pressure is positive (METHOD.md section 2).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fastsim_ros.contact.errors import EmptyContactError, InvalidInputError, IrregularGridError
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class GridArea:
+    """A contact area on a regular grid.
+
+    ``x0``, ``y0``: centre of cell ``[0, 0]`` (m); ``dx``, ``dy``: cell size
+    (m); ``pressure``: normal pressure (Pa), shape ``(ny, nx)``, zero outside
+    the contact.  Areas made for coefficients only carry a unit pressure.
+    """
+
+    x0: float
+    y0: float
+    dx: float
+    dy: float
+    pressure: FloatArray
+
+    def __post_init__(self) -> None:
+        p = np.asarray(self.pressure, dtype=float)
+        if p.ndim != 2:
+            raise InvalidInputError("pressure must be a 2-D array (rows = lateral strips)")
+        values = (self.x0, self.y0, self.dx, self.dy)
+        if not all(math.isfinite(v) for v in values) or not np.all(np.isfinite(p)):
+            raise InvalidInputError("grid or pressure has NaN or infinite values")
+        if self.dx <= 0.0 or self.dy <= 0.0:
+            raise InvalidInputError("cell sizes must be positive")
+        if np.any(p < 0.0):
+            raise InvalidInputError("negative pressure")
+        if not np.any(p > 0.0):
+            raise EmptyContactError("no cell in contact (no positive pressure)")
+        p = p.copy()
+        p.setflags(write=False)
+        object.__setattr__(self, "pressure", p)
+
+    @property
+    def ny(self) -> int:
+        """Number of lateral strips (rows)."""
+        return int(self.pressure.shape[0])
+
+    @property
+    def nx(self) -> int:
+        """Number of cells along the rolling direction (columns)."""
+        return int(self.pressure.shape[1])
+
+    @property
+    def x(self) -> FloatArray:
+        """Cell-centre coordinates along ``x`` (m), shape ``(nx,)``."""
+        return self.x0 + self.dx * np.arange(self.nx, dtype=np.float64)
+
+    @property
+    def y(self) -> FloatArray:
+        """Cell-centre coordinates along ``y`` (m), shape ``(ny,)``."""
+        return self.y0 + self.dy * np.arange(self.ny, dtype=np.float64)
+
+    @property
+    def mask(self) -> NDArray[np.bool_]:
+        """Cells in contact (positive pressure)."""
+        return self.pressure > 0.0
+
+    @property
+    def cell_area(self) -> float:
+        """Area of one cell (m^2)."""
+        return self.dx * self.dy
+
+    @property
+    def area(self) -> float:
+        """Discrete contact area (m^2): cells in contact times the cell area."""
+        return float(np.count_nonzero(self.mask)) * self.cell_area
+
+    @property
+    def load(self) -> float:
+        """Normal load ``N = sum p dA`` (N)."""
+        return float(self.pressure.sum()) * self.cell_area
+
+    def with_pressure(self, pressure: FloatArray) -> GridArea:
+        """Return the same grid with another pressure field."""
+        return GridArea(self.x0, self.y0, self.dx, self.dy, pressure)
+
+    def with_load(self, load: float) -> GridArea:
+        """Return the same pressure shape rescaled to total load ``load`` (N)."""
+        if not (math.isfinite(load) and load > 0.0):
+            raise InvalidInputError("load must be positive and finite")
+        return self.with_pressure(self.pressure * (load / self.load))
+
+    def mirrored_y(self) -> GridArea:
+        """Return the mirror image in ``y`` (``y -> -y``)."""
+        return GridArea(self.x0, -(self.y0 + self.dy * (self.ny - 1)), self.dx, self.dy,
+                        self.pressure[::-1, :])
+
+    def shifted(self, sx: float, sy: float) -> GridArea:
+        """Return the area translated by ``(sx, sy)`` (m)."""
+        return GridArea(self.x0 + sx, self.y0 + sy, self.dx, self.dy, self.pressure)
+
+    def scaled(self, k: float) -> GridArea:
+        """Return the area with all lengths scaled by ``k``; pressure unchanged."""
+        return GridArea(self.x0 * k, self.y0 * k, self.dx * k, self.dy * k, self.pressure)
+
+    def padded(self, left: int = 0, right: int = 0, bottom: int = 0, top: int = 0) -> GridArea:
+        """Return the same area on a grid with empty cells added (x: left/right, y: bottom/top)."""
+        p = np.pad(self.pressure, ((bottom, top), (left, right)))
+        return GridArea(self.x0 - left * self.dx, self.y0 - bottom * self.dy, self.dx, self.dy, p)
+
+    def cropped(self) -> GridArea:
+        """Return the area on the smallest grid that holds every cell in contact."""
+        rows = np.flatnonzero(self.mask.any(axis=1))
+        cols = np.flatnonzero(self.mask.any(axis=0))
+        j0, j1, i0, i1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+        return GridArea(self.x0 + i0 * self.dx, self.y0 + j0 * self.dy, self.dx, self.dy,
+                        self.pressure[j0:j1, i0:i1])
+
+
+def _cell_centres(lo: float, hi: float, n: int) -> FloatArray:
+    h = (hi - lo) / n
+    return lo + h * (np.arange(n, dtype=np.float64) + 0.5)
+
+
+def ellipse(a: float, b: float, *, nx: int, ny: int | None = None,
+            load: float | None = None, pressure: str = "hertz") -> GridArea:
+    """Make an ellipse with semi-axes ``a`` (along x) and ``b`` (m) on ``nx`` x ``ny`` cells.
+
+    The grid spans the bounding box ``[-a, a] x [-b, b]``.  Without ``load``
+    the pressure is 1 Pa on every cell inside (coefficients only).  With a
+    load (N), ``pressure="hertz"`` gives ``p0 sqrt(1 - x^2/a^2 - y^2/b^2)``
+    and ``"parabolic"`` Kalker's ``1 - x^2/a^2 - y^2/b^2`` profile, both
+    rescaled so that the discrete sum equals the load.
+    """
+    _check_positive(a=a, b=b)
+    ny = nx if ny is None else ny
+    _check_cells(nx, ny)
+    x = _cell_centres(-a, a, nx)
+    y = _cell_centres(-b, b, ny)
+    rho2 = (x[None, :] / a) ** 2 + (y[:, None] / b) ** 2
+    inside = rho2 < 1.0
+    if load is None:
+        p = inside.astype(float)
+    elif pressure == "hertz":
+        p = np.sqrt(np.clip(1.0 - rho2, 0.0, None)) * inside
+    elif pressure == "parabolic":
+        p = np.clip(1.0 - rho2, 0.0, None) * inside
+    else:
+        raise InvalidInputError(f"unknown pressure profile {pressure!r}")
+    area = GridArea(float(x[0]), float(y[0]), 2 * a / nx, 2 * b / ny, p)
+    return area if load is None else area.with_load(load)
+
+
+def semi_ellipse_axes(a_over_b: float) -> tuple[float, float]:
+    """Semi-axes ``(a, b)`` (m) of the ellipse with ratio ``a/b`` and ``a b = 1/pi`` (area 1)."""
+    _check_positive(a_over_b=a_over_b)
+    return math.sqrt(a_over_b / math.pi), 1.0 / math.sqrt(a_over_b * math.pi)
+
+
+def semi_ellipses(g1: float, g2: float, *, cells: int) -> GridArea:
+    """Make two semi-ellipses joined along ``y = 0`` (the paper's Table 5 family), unit pressure.
+
+    Zone 1 (``y < 0``) is the lower half of the ellipse ``a1/b1 = g1``, zone 2
+    (``y > 0``) the upper half of ``a2/b2 = g2``, with ``a_i b_i = 1/pi`` so the
+    total area is 1 m^2.  The grid has ``cells`` cells along ``x`` across the
+    wider half and about ``cells`` along ``y``, with a cell face on the join
+    line.
+    """
+    a1, b1 = semi_ellipse_axes(g1)
+    a2, b2 = semi_ellipse_axes(g2)
+    _check_cells(cells, cells)
+    amax = max(a1, a2)
+    x = _cell_centres(-amax, amax, cells)
+    dy = (b1 + b2) / cells
+    n1 = max(1, math.ceil(b1 / dy - 1e-9))
+    n2 = max(1, math.ceil(b2 / dy - 1e-9))
+    y = dy * (np.arange(n1 + n2) - n1 + 0.5)
+    xx, yy = x[None, :], y[:, None]
+    inside = np.where(yy < 0.0, (xx / a1) ** 2 + (yy / b1) ** 2 < 1.0,
+                      (xx / a2) ** 2 + (yy / b2) ** 2 < 1.0)
+    return GridArea(float(x[0]), float(y[0]), 2 * amax / cells, dy, inside.astype(float))
+
+
+def from_cells(x: FloatArray, y: FloatArray, pressure: FloatArray, *,
+               rtol: float = 1e-6) -> GridArea:
+    """Make a grid area from scattered cell centres ``(x, y)`` (m) and their pressure (Pa).
+
+    The centres must lie on one regular grid (any subset of it; absent cells
+    are outside the contact).  Raises :class:`IrregularGridError` otherwise.
+    """
+    x = np.asarray(x, dtype=float).ravel()
+    y = np.asarray(y, dtype=float).ravel()
+    p = np.asarray(pressure, dtype=float).ravel()
+    if not (x.size == y.size == p.size) or x.size == 0:
+        raise InvalidInputError("x, y and pressure must have the same, non-zero length")
+    if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y)) and np.all(np.isfinite(p))):
+        raise InvalidInputError("NaN or infinite value in the cells")
+    if np.any(p < 0.0):
+        raise InvalidInputError("negative pressure")
+    ix, dx, x0 = _grid_index(x, "x", rtol)
+    iy, dy, y0 = _grid_index(y, "y", rtol)
+    grid = np.zeros((iy.max() + 1, ix.max() + 1))
+    if np.unique(iy * grid.shape[1] + ix).size != ix.size:
+        raise IrregularGridError("two cells share one grid position")
+    grid[iy, ix] = p
+    return GridArea(x0, y0, dx, dy, grid)
+
+
+def _grid_index(v: FloatArray, name: str, rtol: float) -> tuple[NDArray[np.int_], float, float]:
+    """Integer grid indices of coordinates ``v``, with the spacing and the first centre."""
+    u = np.unique(v)
+    span = float(u[-1] - u[0])
+    if u.size == 1:
+        raise IrregularGridError(f"a single {name} coordinate: the cell size along {name} "
+                                 "cannot be inferred")
+    h = float(np.min(np.diff(u)))
+    tol = rtol * max(span, h) + 1e-15
+    k = (v - u[0]) / h
+    idx = np.rint(k).astype(int)
+    if np.max(np.abs(k - idx)) * h > tol * 10 + 1e-9 * h:
+        raise IrregularGridError(f"{name} coordinates are not on a regular grid "
+                                 f"(spacing {h:.6g} m)")
+    return idx, h, float(u[0])
+
+
+def _check_positive(**values: float) -> None:
+    for name, v in values.items():
+        if not (math.isfinite(v) and v > 0.0):
+            raise InvalidInputError(f"{name.replace('_over_', '/')} must be positive and "
+                                    f"finite, got {v}")
+
+
+def _check_cells(nx: int, ny: int) -> None:
+    if nx < 2 or ny < 2:
+        raise InvalidInputError("a grid needs at least 2 cells along each axis")

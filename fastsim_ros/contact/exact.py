@@ -1,0 +1,428 @@
+"""Kalker's exact theory of steady rolling, discretised by boundary elements.
+
+Assumptions (as in Kalker 1990 and CONTACT): two quasi-identical elastic
+half-spaces (combined ``G``, ``nu``), so the normal problem does not depend on
+the tangential one; steady state; uniform tractions on the rectangular cells
+of a regular grid; the displacement difference from the closed-form rectangle
+influence coefficients (:mod:`fastsim_ros.contact.influence`).
+
+The slip per unit rolling distance of the wheel relative to the rail is
+``s = w - du/dx`` (material flows from larger to smaller ``x``), with the rigid
+slip ``w = (xi - phi y, eta + phi x)``.  It is discretised at cell centres
+with the *upstream* difference ``du/dx ~ (u(x + dx) - u(x))/dx``; the upstream
+point may lie outside the area, where the displacement is still the elastic
+field of the tractions inside.  With that difference the coefficient of
+``eta`` in ``Mz`` equals ``C23`` on every grid (METHOD.md section 5).
+
+Tractions ``tau`` are those of the rail on the wheel.  Full adhesion
+(``s = 0`` everywhere) is one linear system ``B tau = w``; ``B`` is a
+convolution on the regular grid, so products go through FFTs and GMRES solves
+fine meshes in seconds.  A dense direct solve is kept as the reference.
+Coulomb friction (``|tau| <= mu p``; ``s = 0`` where ``|tau| < mu p``; ``s``
+opposite to ``tau`` where ``|tau| = mu p``) is solved by a Gauss-Seidel sweep
+over the grid's columns from the leading to the trailing edge (the order in
+which material flows through the contact, so the strong upstream coupling of
+the difference is always up to date), each cell solving its local problem
+exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+import scipy.fft
+import scipy.linalg
+import scipy.sparse.linalg
+from numpy.typing import NDArray
+
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.errors import ConvergenceError, InvalidInputError
+from fastsim_ros.contact.influence import influence_kernel
+
+FloatArray = NDArray[np.float64]
+SolverKind = Literal["fft", "dense"]
+
+
+def check_material(nu: float, shear_modulus: float = 1.0) -> None:
+    """Refuse a Poisson ratio outside [0, 0.5] or a non-positive shear modulus."""
+    if not (math.isfinite(nu) and 0.0 <= nu <= 0.5):
+        raise InvalidInputError(f"nu must lie in [0, 0.5], got {nu}")
+    if not (math.isfinite(shear_modulus) and shear_modulus > 0.0):
+        raise InvalidInputError(f"shear modulus must be positive, got {shear_modulus}")
+
+
+@dataclass(frozen=True, eq=False)
+class SteadyRollingOperator:
+    """The discrete operator ``tau -> du/dx`` (upstream difference) of a grid.
+
+    ``kernel_*[dj, di]`` hold ``(K(d + e_x) - K(d))/dx`` for offsets
+    ``di in [-(nx-1), nx-1]``, ``dj in [-(ny-1), ny-1]`` (field minus source),
+    ``K`` the rectangle influence coefficients.  Units 1/Pa.
+    """
+
+    area: GridArea
+    nu: float
+    shear_modulus: float
+    kernel_xx: FloatArray
+    kernel_yy: FloatArray
+    kernel_xy: FloatArray
+
+    @classmethod
+    def of(cls, area: GridArea, *, nu: float, shear_modulus: float = 1.0) -> SteadyRollingOperator:
+        """Build the operator of ``area``'s grid."""
+        check_material(nu, shear_modulus)
+        nx, ny = area.nx, area.ny
+        k = influence_kernel(area.dx, area.dy, nx, ny - 1, shear_modulus=shear_modulus, nu=nu)
+
+        def diff(c: FloatArray) -> FloatArray:
+            # columns are di = -nx..nx; d + e_x for di in [-(nx-1), nx-1] is columns 2..2nx
+            return (c[:, 2:] - c[:, 1:-1]) / area.dx
+
+        return cls(area, nu, shear_modulus, diff(k.xx), diff(k.yy), diff(k.xy))
+
+    @property
+    def diagonal(self) -> tuple[float, float]:
+        """``(D_x, D_y)``: minus the self-coefficients, ``> 0`` (1/Pa)."""
+        cy, cx = self.area.ny - 1, self.area.nx - 1
+        return -float(self.kernel_xx[cy, cx]), -float(self.kernel_yy[cy, cx])
+
+    def dense(self) -> FloatArray:
+        """Return the operator restricted to the contact cells, ``[[Bxx, Bxy], [Bxy, Byy]]``."""
+        jj, ii = np.nonzero(self.area.mask)
+        dj = jj[:, None] - jj[None, :] + self.area.ny - 1
+        di = ii[:, None] - ii[None, :] + self.area.nx - 1
+        bxx = self.kernel_xx[dj, di]
+        byy = self.kernel_yy[dj, di]
+        bxy = self.kernel_xy[dj, di]
+        return np.block([[bxx, bxy], [bxy, byy]])
+
+    def fft_product(self) -> _FFTProduct:
+        """FFT-based product with tractions on the whole grid."""
+        return _FFTProduct(self)
+
+
+class _FFTProduct:
+    """Circular embedding of the Toeplitz operator on a ``2ny`` x ``2nx`` grid."""
+
+    def __init__(self, op: SteadyRollingOperator) -> None:
+        ny, nx = op.area.ny, op.area.nx
+        self.shape = (2 * ny, 2 * nx)
+        self.ny, self.nx = ny, nx
+        self.fxx = self._spectrum(op.kernel_xx)
+        self.fyy = self._spectrum(op.kernel_yy)
+        self.fxy = self._spectrum(op.kernel_xy)
+
+    def _spectrum(self, kernel: FloatArray) -> NDArray[np.complex128]:
+        c = np.zeros(self.shape)
+        ny, nx = self.ny, self.nx
+        # offset d lives at index d mod (2n): the product of the padded arrays is a
+        # linear (not circular) convolution on the first ny x nx entries.
+        rows = np.r_[np.arange(ny), np.arange(ny + 1, 2 * ny)]
+        cols = np.r_[np.arange(nx), np.arange(nx + 1, 2 * nx)]
+        c[np.ix_(rows, cols)] = np.roll(np.roll(kernel, -(ny - 1), axis=0), -(nx - 1), axis=1)
+        return scipy.fft.rfft2(c, workers=-1)
+
+    def __call__(self, tx: FloatArray, ty: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """``(du_x/dx, du_y/dx)`` on the grid for tractions ``tx``, ``ty`` (ny, nx)."""
+        fx = scipy.fft.rfft2(tx, s=self.shape, workers=-1)
+        fy = scipy.fft.rfft2(ty, s=self.shape, workers=-1)
+        gx = scipy.fft.irfft2(self.fxx * fx + self.fxy * fy, s=self.shape, workers=-1)
+        gy = scipy.fft.irfft2(self.fxy * fx + self.fyy * fy, s=self.shape, workers=-1)
+        return gx[: self.ny, : self.nx], gy[: self.ny, : self.nx]
+
+
+class _StripPreconditioner:
+    """Exact inverse of each lateral strip's own block of the operator.
+
+    Within a strip (``dj = 0``) the operator holds the upstream difference,
+    the strongest coupling of steady rolling, and no ``x``-``y`` coupling
+    (``K_xy`` vanishes on ``dj = 0``); the strips' mutual influence is left to
+    GMRES.  This cuts the iterations several-fold on fine grids.
+    """
+
+    def __init__(self, op: SteadyRollingOperator) -> None:
+        mask = op.area.mask
+        self.n = int(np.count_nonzero(mask))
+        flat = np.cumsum(mask.ravel()).reshape(mask.shape) - 1
+        row_x = op.kernel_xx[op.area.ny - 1]
+        row_y = op.kernel_yy[op.area.ny - 1]
+        self.blocks = []
+        cache: dict[bytes, tuple[object, object]] = {}
+        for j in range(op.area.ny):
+            cols = np.flatnonzero(mask[j])
+            if cols.size == 0:
+                continue
+            key = (cols - cols[0]).tobytes()
+            if key not in cache:
+                d = cols[:, None] - cols[None, :] + op.area.nx - 1
+                cache[key] = (scipy.linalg.lu_factor(row_x[d]), scipy.linalg.lu_factor(row_y[d]))
+            self.blocks.append((flat[j, cols], *cache[key]))
+
+    def solve(self, v: FloatArray) -> FloatArray:
+        out = np.empty_like(v)
+        n = self.n
+        for idx, lux, luy in self.blocks:
+            out[idx] = scipy.linalg.lu_solve(lux, v[idx], check_finite=False)
+            out[n + idx] = scipy.linalg.lu_solve(luy, v[n + idx], check_finite=False)
+        return out
+
+    def as_operator(self) -> scipy.sparse.linalg.LinearOperator:
+        return scipy.sparse.linalg.LinearOperator((2 * self.n, 2 * self.n), matvec=self.solve,
+                                                  dtype=float)
+
+
+@dataclass(frozen=True, eq=False)
+class TractionSolution:
+    """Tangential tractions of one solve and their resultants.
+
+    ``tau_x``, ``tau_y``: tractions of the rail on the wheel (Pa), shape
+    ``(ny, nx)``, zero outside the contact; ``slip``: cells in slip (all
+    false in full adhesion); ``fx``, ``fy`` (N) and ``mz`` (N m) about the
+    reference point; ``iterations`` of the iterative solver.
+    """
+
+    area: GridArea
+    tau_x: FloatArray
+    tau_y: FloatArray
+    slip: NDArray[np.bool_]
+    fx: float
+    fy: float
+    mz: float
+    iterations: int
+
+
+def rigid_slip(area: GridArea, xi: float, eta: float, phi: float,
+               reference: tuple[float, float] = (0.0, 0.0)) -> tuple[FloatArray, FloatArray]:
+    """Rigid slip ``(w_x, w_y)`` at the cell centres, creepages about ``reference`` (m)."""
+    x = area.x[None, :] - reference[0]
+    y = area.y[:, None] - reference[1]
+    shape = area.pressure.shape
+    return (np.broadcast_to(xi - phi * y, shape).astype(float),
+            np.broadcast_to(eta + phi * x, shape).astype(float))
+
+
+def resultants(area: GridArea, tau_x: FloatArray, tau_y: FloatArray,
+               reference: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float]:
+    """``(Fx, Fy, Mz)`` of a traction field, ``Mz`` about ``reference``."""
+    x = area.x[None, :] - reference[0]
+    y = area.y[:, None] - reference[1]
+    da = area.cell_area
+    return (float(tau_x.sum() * da), float(tau_y.sum() * da),
+            float((x * tau_y - y * tau_x).sum() * da))
+
+
+def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: float,
+                  shear_modulus: float = 1.0, reference: tuple[float, float] = (0.0, 0.0),
+                  solver: SolverKind = "fft", rtol: float = 1e-10,
+                  operator: SteadyRollingOperator | None = None) -> TractionSolution:
+    """Tractions in full adhesion (``mu`` infinite) for creepages about ``reference``.
+
+    ``xi``, ``eta`` dimensionless, ``phi`` in 1/m; ``shear_modulus`` combined
+    ``G`` (Pa).  ``solver="fft"``: GMRES with FFT products; ``"dense"``: LU of
+    the dense operator (the reference, for a few thousand cells at most).
+    """
+    op = operator or SteadyRollingOperator.of(area, nu=nu, shear_modulus=shear_modulus)
+    wx, wy = rigid_slip(area, xi, eta, phi, reference)
+    mask = area.mask
+    n = int(np.count_nonzero(mask))
+    rhs = np.concatenate([wx[mask], wy[mask]])
+    iterations = 0
+    if solver == "dense":
+        tau = scipy.linalg.solve(op.dense(), rhs)
+    elif solver == "fft":
+        product = op.fft_product()
+        tx = np.zeros(mask.shape)
+        ty = np.zeros(mask.shape)
+
+        def matvec(v: FloatArray) -> FloatArray:
+            tx[mask] = v[:n]
+            ty[mask] = v[n:]
+            gx, gy = product(tx, ty)
+            return np.concatenate([gx[mask], gy[mask]])
+
+        lin = scipy.sparse.linalg.LinearOperator((2 * n, 2 * n), matvec=matvec, dtype=float)
+        precond = _StripPreconditioner(op).as_operator()
+        counter = [0]
+
+        def count(_: object) -> None:
+            counter[0] += 1
+
+        if not np.any(rhs):
+            tau = np.zeros(2 * n)
+        else:
+            tau, info = scipy.sparse.linalg.gmres(lin, rhs, rtol=rtol, atol=0.0, restart=200,
+                                                  maxiter=50, M=precond, callback=count,
+                                                  callback_type="pr_norm")
+            if info != 0:
+                raise ConvergenceError(f"GMRES did not converge ({counter[0]} iterations)")
+        iterations = counter[0]
+    else:
+        raise InvalidInputError(f"unknown solver {solver!r}")
+    tau_x = np.zeros(mask.shape)
+    tau_y = np.zeros(mask.shape)
+    tau_x[mask] = tau[:n]
+    tau_y[mask] = tau[n:]
+    fx, fy, mz = resultants(area, tau_x, tau_y, reference)
+    return TractionSolution(area, tau_x, tau_y, np.zeros(mask.shape, dtype=bool), fx, fy, mz,
+                            iterations)
+
+
+def _local_coulomb(rx: FloatArray, ry: FloatArray, d_x: float, d_y: float,
+                   bound: FloatArray) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+    """Each cell's own problem: ``s = r + D tau``, ``|tau| <= g``, ``s`` opposite to ``tau``.
+
+    Adhesion ``tau = -r/D`` if it lies within the bound; otherwise
+    ``tau = -(D + k)^-1 r`` with the ``k > 0`` that puts it on the bound
+    (then ``s = -k tau``), found by Newton's method on the convex, decreasing
+    ``|(D + k)^-1 r|^2 - g^2``, which converges monotonically from ``k = 0``.
+    """
+    tx = -rx / d_x
+    ty = -ry / d_y
+    slip = tx**2 + ty**2 > bound**2
+    if np.any(slip):
+        r_x, r_y, g = rx[slip], ry[slip], bound[slip]
+        k = np.zeros_like(g)
+        for _ in range(60):
+            ax = r_x / (d_x + k)
+            ay = r_y / (d_y + k)
+            f = ax**2 + ay**2 - g**2
+            df = -2.0 * (ax**2 / (d_x + k) + ay**2 / (d_y + k))
+            step = f / df
+            k = k - step
+            if np.all(np.abs(step) <= 1e-14 * (d_x + k)):
+                break
+        tx[slip] = -r_x / (d_x + k)
+        ty[slip] = -r_y / (d_y + k)
+        zero = g <= 0.0
+        if np.any(zero):
+            idx = np.flatnonzero(slip)[zero]
+            tx[idx] = 0.0
+            ty[idx] = 0.0
+    return tx, ty, slip
+
+
+def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu: float,
+            shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
+            tol: float = 1e-9, max_sweeps: int = 2000,
+            operator: SteadyRollingOperator | None = None) -> TractionSolution:
+    """Tractions with Coulomb friction ``|tau| <= mu p``, ``p`` the area's pressure (Pa).
+
+    Creepages about ``reference`` (``phi`` in 1/m); ``shear_modulus`` the
+    combined ``G`` (Pa).  Iterates Gauss-Seidel sweeps until the largest
+    traction change of a sweep is below ``tol * mu * max(p)``.
+    """
+    if not (math.isfinite(mu) and mu > 0.0):
+        raise InvalidInputError(f"mu must be positive, got {mu}")
+    for name, v in (("xi", xi), ("eta", eta), ("phi", phi)):
+        if not math.isfinite(v):
+            raise InvalidInputError(f"{name} must be finite")
+    op = operator or SteadyRollingOperator.of(area, nu=nu, shear_modulus=shear_modulus)
+    mask = area.mask
+    jj, ii = np.nonzero(mask)
+    n = jj.size
+    b = op.dense()
+    # rows of B's transpose are contiguous: the update of all slips by one
+    # column's traction change reads them.
+    bt = np.ascontiguousarray(b.T)
+    del b
+    wx, wy = rigid_slip(area, xi, eta, phi, reference)
+    bound = mu * area.pressure[mask]
+    d_x, d_y = op.diagonal
+    tau = np.zeros(2 * n)
+    s = np.concatenate([wx[mask], wy[mask]])
+    columns = [np.flatnonzero(ii == c) for c in range(area.nx - 1, -1, -1)]
+    columns = [c for c in columns if c.size]
+    scale = mu * float(area.pressure.max())
+    slip = np.zeros(n, dtype=bool)
+    for sweep in range(1, max_sweeps + 1):
+        change = 0.0
+        for idx in columns:
+            ox, oy = tau[idx], tau[n + idx]
+            rx = s[idx] - d_x * ox
+            ry = s[n + idx] - d_y * oy
+            tx, ty, slip[idx] = _local_coulomb(rx, ry, d_x, d_y, bound[idx])
+            dtx, dty = tx - ox, ty - oy
+            change = max(change, float(np.max(np.abs(dtx))), float(np.max(np.abs(dty))))
+            s -= dtx @ bt[idx] + dty @ bt[n + idx]
+            tau[idx] = tx
+            tau[n + idx] = ty
+        if change <= tol * scale:
+            break
+    else:
+        raise ConvergenceError(f"Coulomb solver did not converge in {max_sweeps} sweeps")
+    tau_x = np.zeros(mask.shape)
+    tau_y = np.zeros(mask.shape)
+    slip_map = np.zeros(mask.shape, dtype=bool)
+    tau_x[mask] = tau[:n]
+    tau_y[mask] = tau[n:]
+    slip_map[mask] = slip
+    fx, fy, mz = resultants(area, tau_x, tau_y, reference)
+    return TractionSolution(area, tau_x, tau_y, slip_map, fx, fy, mz, sweep)
+
+
+@dataclass(frozen=True)
+class CreepCoefficients:
+    """Generalised creepage coefficients of an area (METHOD.md section 1, paper eq. 3).
+
+    ``Fx = -G (A/pi) C11 xi - G (A/pi) C12 eta - G (A/pi)^1.5 C13 phi``,
+    ``Fy = -G (A/pi) C21 xi - G (A/pi) C22 eta - G (A/pi)^1.5 C23 phi``,
+    ``Mz = G (A/pi)^1.5 C31 xi + G (A/pi)^1.5 C32 eta - G (A/pi)^2 C33 phi``
+    (Kalker's signs: ``C32 = C23`` on an ellipse), about ``reference`` (m).
+    ``area`` is ``A`` (m^2), the discrete area of the cells in contact.
+    """
+
+    C11: float
+    C12: float
+    C13: float
+    C21: float
+    C22: float
+    C23: float
+    C31: float
+    C32: float
+    C33: float
+    area: float
+    reference: tuple[float, float] = (0.0, 0.0)
+
+    def as_dict(self) -> dict[str, float]:
+        """Return the coefficients and the area by name."""
+        names = ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33", "area")
+        return {k: getattr(self, k) for k in names}
+
+
+def coefficients_from_unit_solutions(
+    area: float, unit: tuple[tuple[float, float, float], ...], *, shear_modulus: float = 1.0,
+    reference: tuple[float, float] = (0.0, 0.0)
+) -> CreepCoefficients:
+    """Coefficients from ``(Fx, Fy, Mz)`` at unit ``xi``, unit ``eta`` and unit ``phi``."""
+    c = math.sqrt(area / math.pi)
+    g = shear_modulus
+    (fx1, fy1, mz1), (fx2, fy2, mz2), (fx3, fy3, mz3) = unit
+    return CreepCoefficients(
+        C11=-fx1 / (g * c**2), C12=-fx2 / (g * c**2), C13=-fx3 / (g * c**3),
+        C21=-fy1 / (g * c**2), C22=-fy2 / (g * c**2), C23=-fy3 / (g * c**3),
+        C31=mz1 / (g * c**3), C32=mz2 / (g * c**3), C33=-mz3 / (g * c**4),
+        area=area, reference=reference)
+
+
+def unit_solutions(area: GridArea, *, nu: float, reference: tuple[float, float] = (0.0, 0.0),
+                   solver: SolverKind = "fft") -> tuple[TractionSolution, ...]:
+    """Full-adhesion solutions for unit ``xi``, unit ``eta`` and unit ``phi`` (G = 1 Pa)."""
+    op = SteadyRollingOperator.of(area, nu=nu)
+    return tuple(full_adhesion(area, *cr, nu=nu, reference=reference, solver=solver, operator=op)
+                 for cr in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
+
+
+def creep_coefficients(area: GridArea, *, nu: float,
+                       reference: tuple[float, float] = (0.0, 0.0),
+                       solver: SolverKind = "fft") -> CreepCoefficients:
+    """Generalised coefficients ``C~ij`` of an area from the exact theory on its grid.
+
+    Normalised with the discrete area (cells times cell area), which removes
+    most of the staircase noise of the boundary (METHOD.md section 5).
+    """
+    sols = unit_solutions(area, nu=nu, reference=reference, solver=solver)
+    return coefficients_from_unit_solutions(
+        area.area, tuple((s.fx, s.fy, s.mz) for s in sols), reference=reference)

@@ -1,0 +1,1 @@
+"""Pure message <-> domain conversions, no node state."""

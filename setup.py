@@ -1,0 +1,35 @@
+"""Setup for the fastsim_ros ament_python package."""
+
+from glob import glob
+import os
+
+from setuptools import setup
+
+package_name = 'fastsim_ros'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=[package_name, package_name + '.contact', 'msg_adapters'],
+    package_data={package_name: ['data/*.csv']},
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        (os.path.join('share', package_name, 'config'), glob('config/*.yaml')),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='fastsim_ros team',
+    maintainer_email='fastsim@example.com',
+    description=(
+        'Wheel-rail creep forces with FastSim, extended to non-elliptical '
+        'contact areas by MAE'
+    ),
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'fastsim_contact = fastsim_ros.cli:main',
+        ],
+    },
+)
