@@ -220,17 +220,24 @@ def from_cells(x: FloatArray, y: FloatArray, pressure: FloatArray, *,
 
 
 def _grid_index(v: FloatArray, name: str, rtol: float) -> tuple[NDArray[np.int_], float, float]:
-    """Integer grid indices of coordinates ``v``, with the spacing and the first centre."""
+    """Integer grid indices of coordinates ``v``, with the spacing and the first centre.
+
+    The spacing is the most common gap between neighbouring coordinates (a
+    stray point must not make a fine phantom grid); every coordinate must
+    then lie on a multiple of it.
+    """
     u = np.unique(v)
-    span = float(u[-1] - u[0])
     if u.size == 1:
         raise IrregularGridError(f"a single {name} coordinate: the cell size along {name} "
                                  "cannot be inferred")
-    h = float(np.min(np.diff(u)))
-    tol = rtol * max(span, h) + 1e-15
+    gaps = np.diff(u)
+    tol = rtol * float(u[-1] - u[0])
+    candidates = np.unique(np.round(gaps / max(tol, 1e-300)))
+    counts = [np.count_nonzero(np.abs(gaps - c * tol) <= tol) for c in candidates]
+    h = float(np.median(gaps[np.abs(gaps - candidates[int(np.argmax(counts))] * tol) <= tol]))
     k = (v - u[0]) / h
     idx = np.rint(k).astype(int)
-    if np.max(np.abs(k - idx)) * h > tol * 10 + 1e-9 * h:
+    if np.max(np.abs(k - idx)) * h > 10 * tol + 1e-12 * h:
         raise IrregularGridError(f"{name} coordinates are not on a regular grid "
                                  f"(spacing {h:.6g} m)")
     return idx, h, float(u[0])

@@ -1,0 +1,236 @@
+"""``fastsim_contact``: one-off contact computations from the command line.
+
+Two commands (INTERFACE.md): ``coefficients`` prints an area's generalised
+creepage coefficients, ``forces`` the creep forces at given creepages.  SI
+units throughout.  ``--json`` prints exactly one JSON object on stdout.  Bad
+input gives one line on stderr and exit status 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+import numpy as np
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import exact
+from fastsim_ros.contact.errors import ContactError, InvalidInputError
+
+EXACT_GRIDS = (0.4, 0.6, 0.8, 1.0)
+DEFAULT_CELLS = {"exact": 100, "exact_forces": 60}
+
+
+class UsageError(Exception):
+    """A command line that cannot be run: reported in one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+def _finite(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(v):
+        raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
+    return v
+
+
+def _cells(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
+    if n < 4 or n > 400:
+        raise argparse.ArgumentTypeError(f"--cells must lie in [4, 400], got {n}")
+    return n
+
+
+def _add_area(p: argparse.ArgumentParser, *, forces: bool) -> None:
+    g = p.add_argument_group("area (one of --shape or --patch)")
+    g.add_argument("--shape", choices=("ellipse", "semi-ellipses"))
+    g.add_argument("--a-over-b", type=_finite, nargs="+", metavar="G",
+                   help="a/b of the ellipse, or G1 G2 of the two semi-ellipses")
+    if forces:
+        g.add_argument("--a", type=_finite, help="semi-axis along x (m)")
+        g.add_argument("--b", type=_finite, help="semi-axis along y (m)")
+    g.add_argument("--patch", type=Path, help="CSV with header x,y,pressure (m, m, Pa)")
+    p.add_argument("--cells", type=_cells, help="cells along each axis of the bounding box")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Return the parser of the two commands and their fixed flags."""
+    parser = _Parser(prog="fastsim_contact",
+                     description="Creepage coefficients and creep forces of a contact area.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    co = sub.add_parser("coefficients", help="generalised creepage coefficients C~ij")
+    _add_area(co, forces=False)
+    co.add_argument("--method", choices=("exact",), default="exact")
+    co.add_argument("--nu", type=_finite, default=0.25, help="Poisson ratio (default 0.25)")
+    fo = sub.add_parser("forces", help="creep forces at given creepages")
+    _add_area(fo, forces=True)
+    fo.add_argument("--xi", type=_finite, required=True, help="longitudinal creepage")
+    fo.add_argument("--eta", type=_finite, required=True, help="lateral creepage")
+    fo.add_argument("--phi", type=_finite, required=True, help="spin creepage (1/m)")
+    fo.add_argument("--mu", type=_finite, required=True, help="friction coefficient")
+    fo.add_argument("--load", type=_finite, help="normal load N (N)")
+    fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
+    fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
+    fo.add_argument("--method", choices=("exact",), default="exact")
+    fo.add_argument("--bound", choices=("given", "parabolic"), default="given",
+                    help="traction bound: the pressure as given, or Kalker's parabolic one")
+    return parser
+
+
+def read_patch(path: Path) -> areas.GridArea:
+    """Read a patch CSV (header ``x,y,pressure``; m, m, Pa) into a grid area."""
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.reader(line for line in f if not line.lstrip().startswith("#")))
+    except OSError as e:
+        raise InvalidInputError(f"cannot read patch file {path}: {e.strerror}") from None
+    if not rows or [c.strip() for c in rows[0]] != ["x", "y", "pressure"]:
+        raise InvalidInputError(f"{path}: the header must be x,y,pressure")
+    body = [r for r in rows[1:] if any(c.strip() for c in r)]
+    if not body:
+        raise InvalidInputError(f"{path}: no cells")
+    try:
+        data = np.array([[float(c) for c in r] for r in body], dtype=float)
+    except ValueError:
+        raise InvalidInputError(f"{path}: a value that is not a number") from None
+    if data.ndim != 2 or data.shape[1] != 3:
+        raise InvalidInputError(f"{path}: every row needs three values x,y,pressure")
+    return areas.from_cells(data[:, 0], data[:, 1], data[:, 2])
+
+
+def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridArea], str]:
+    """A function of the cell count giving the area, and the area's description."""
+    if args.patch is not None:
+        if args.shape is not None:
+            raise UsageError("give either --shape or --patch, not both")
+        patch = read_patch(args.patch)
+        return (lambda n: patch), f"patch {args.patch}"
+    if args.shape is None:
+        raise UsageError("an area is needed: --shape ellipse|semi-ellipses or --patch FILE")
+    g = args.a_over_b
+    if args.shape == "ellipse":
+        if g is None or len(g) != 1:
+            raise UsageError("--shape ellipse takes one --a-over-b value")
+        a, b = areas.semi_ellipse_axes(g[0])
+        return (lambda n: areas.ellipse(a, b, nx=n, ny=n)), f"ellipse a/b={g[0]:g}"
+    if g is None or len(g) != 2:
+        raise UsageError("--shape semi-ellipses takes two --a-over-b values G1 G2")
+    for v in g:
+        areas.semi_ellipse_axes(v)
+    return ((lambda n: areas.semi_ellipses(g[0], g[1], cells=n)),
+            f"semi-ellipses a1/b1={g[0]:g}, a2/b2={g[1]:g}")
+
+
+def _grid_sequence(finest: int) -> list[int]:
+    return sorted({max(4, 2 * round(f * finest / 2)) for f in EXACT_GRIDS})
+
+
+def coefficients(args: argparse.Namespace) -> dict[str, Any]:
+    """Run ``coefficients``: a dict of the results."""
+    exact.check_material(args.nu)
+    make, what = _shape_maker(args)
+    result: dict[str, Any]
+    if args.patch is not None:
+        patch = make(0)
+        c = exact.creep_coefficients(patch, nu=args.nu)
+        result = c.as_dict()
+        result.update(cells=[patch.nx, patch.ny], extrapolated=False)
+    else:
+        finest = args.cells or DEFAULT_CELLS["exact"]
+        grids = _grid_sequence(finest)
+        per = [exact.creep_coefficients(make(n), nu=args.nu) for n in grids]
+        h = np.array([1.0 / n for n in grids])
+        result = {}
+        for key in ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33"):
+            # first-order convergence in the cell size (METHOD.md 5)
+            result[key] = float(np.polyfit(h, [getattr(c, key) for c in per], 1)[1])
+        result.update(area=1.0, cells=grids, extrapolated=True)
+    result.update(method=args.method, nu=args.nu, area_description=what)
+    return result
+
+
+def forces(args: argparse.Namespace) -> dict[str, Any]:
+    """Run ``forces``: a dict of the results."""
+    exact.check_material(args.nu, args.shear_modulus)
+    if not args.mu > 0.0:
+        raise InvalidInputError(f"mu must be positive, got {args.mu}")
+    if args.load is not None and not args.load > 0.0:
+        raise InvalidInputError(f"--load must be positive, got {args.load}")
+    patch = _force_area(args)
+    sol = exact.coulomb(patch, args.xi, args.eta, args.phi, mu=args.mu, nu=args.nu,
+                        shear_modulus=args.shear_modulus)
+    return {"Fx": sol.fx, "Fy": sol.fy, "Mz": sol.mz, "N": patch.load, "method": args.method,
+            "slip_fraction": float(np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask),
+            "cells": [patch.nx, patch.ny]}
+
+
+def _force_area(args: argparse.Namespace) -> areas.GridArea:
+    if args.patch is not None:
+        if args.shape is not None:
+            raise UsageError("give either --shape or --patch, not both")
+        patch = read_patch(args.patch)
+        if args.load is not None:
+            patch = patch.with_load(args.load)
+        if args.bound == "parabolic":
+            raise UsageError("--bound parabolic needs an ellipse (--shape ellipse --a A --b B)")
+        return patch
+    if args.shape != "ellipse" or args.a is None or args.b is None:
+        raise UsageError("forces need --shape ellipse --a A --b B (with --load) or --patch FILE")
+    if args.load is None:
+        raise UsageError("--load is required with --shape ellipse --a A --b B")
+    n = args.cells or DEFAULT_CELLS["exact_forces"]
+    profile = "parabolic" if args.bound == "parabolic" else "hertz"
+    return areas.ellipse(args.a, args.b, nx=n, ny=n, load=args.load, pressure=profile)
+
+
+def _print_table(command: str, result: dict[str, Any]) -> None:
+    if command == "coefficients":
+        print(f"{result['area_description']}, nu = {result['nu']:g}, method {result['method']}"
+              + (f", extrapolated from grids {result['cells']}" if result.get("extrapolated")
+                 else f", grid {result['cells'][0]} x {result['cells'][1]}"))
+        print(f"area A = {result['area']:.6g} m^2; about the area's origin")
+        for row in ("1", "2", "3"):
+            print("  " + "  ".join(f"C{row}{col} = {result[f'C{row}{col}']:9.4f}"
+                                   for col in "123"))
+    else:
+        print(f"method {result['method']}, N = {result['N']:.6g} N")
+        print(f"  Fx = {result['Fx']:.6g} N\n  Fy = {result['Fy']:.6g} N\n"
+              f"  Mz = {result['Mz']:.6g} N m")
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``fastsim_contact``: 0 on success, 2 on bad input."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        result = coefficients(args) if args.command == "coefficients" else forces(args)
+    except (UsageError, ContactError) as e:
+        print(f"fastsim_contact: error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    if args.json:
+        print(json.dumps(result))
+    else:
+        _print_table(args.command, result)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

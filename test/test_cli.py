@@ -1,0 +1,129 @@
+"""The ``fastsim_contact`` command line: fixed flags, JSON output, bad input."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from fastsim_ros import cli
+from fastsim_ros.contact import area as areas
+
+
+def run(capsys, *argv):
+    rc = cli.main(list(argv))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def write_patch(path, area, *, extra_rows=()):
+    jj, ii = np.nonzero(area.mask)
+    lines = ["x,y,pressure"]
+    lines += [f"{float(area.x[i])!r},{float(area.y[j])!r},{float(area.pressure[j, i])!r}"
+              for j, i in zip(jj, ii)]
+    lines += list(extra_rows)
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_circle_exact_coefficients_match_kalker(capsys):
+    # The issue's acceptance command.
+    rc, out, err = run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "1",
+                       "--nu", "0.25", "--method", "exact", "--json")
+    assert rc == 0 and err == ""
+    c = json.loads(out)
+    assert {"C11", "C12", "C13", "C21", "C22", "C23", "area"} <= c.keys()
+    assert c["C11"] == pytest.approx(4.12, rel=0.01)
+    assert c["C22"] == pytest.approx(3.67, rel=0.01)
+    assert c["C23"] == pytest.approx(1.47, rel=0.01)
+    assert abs(c["C13"]) < 0.02
+    assert c["area"] == 1.0
+
+
+def test_patch_coefficients_refer_to_the_file_origin(tmp_path, capsys):
+    ar = areas.semi_ellipses(0.5, 2.0, cells=16)
+    base = write_patch(tmp_path / "a.csv", ar)
+    moved = write_patch(tmp_path / "b.csv", ar.shifted(0.0, 0.1))
+    c0 = json.loads(run(capsys, "coefficients", "--patch", str(base), "--json")[1])
+    c1 = json.loads(run(capsys, "coefficients", "--patch", str(moved), "--json")[1])
+    assert c1["C11"] == pytest.approx(c0["C11"], rel=1e-9)
+    # the area moved by +0.1 in y: the origin lies 0.1 below it (METHOD.md 3.5)
+    shift = (c0["C11"] * -0.1) / math.sqrt(c0["area"] / math.pi)
+    assert c1["C13"] == pytest.approx(c0["C13"] + shift, rel=1e-8)
+
+
+def test_readable_table_without_json(capsys):
+    rc, out, _ = run(capsys, "coefficients", "--shape", "semi-ellipses", "--a-over-b", "0.5",
+                     "2", "--cells", "30")
+    assert rc == 0
+    assert "C13" in out and "extrapolated" in out
+    with pytest.raises(json.JSONDecodeError):
+        json.loads(out)
+
+
+def test_exact_forces_saturate_at_mu_n(capsys):
+    rc, out, _ = run(capsys, "forces", "--shape", "ellipse", "--a", "6e-3", "--b", "4e-3",
+                     "--load", "1e4", "--xi", "0.05", "--eta", "0", "--phi", "0", "--mu", "0.3",
+                     "--method", "exact", "--cells", "24", "--json")
+    f = json.loads(out)
+    assert rc == 0
+    assert f["N"] == pytest.approx(1e4, rel=1e-12)
+    assert f["Fx"] == pytest.approx(-0.3e4, rel=1e-6)
+    assert {"Fx", "Fy", "Mz", "N", "method"} <= f.keys()
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["coefficients", "--shape", "ellipse", "--a-over-b", "0"], "a/b must be positive"),
+    (["coefficients", "--shape", "ellipse", "--a-over-b", "-1"], "a/b must be positive"),
+    (["coefficients", "--shape", "ellipse", "--a-over-b", "nan"], "not a finite number"),
+    (["coefficients", "--shape", "ellipse", "--a-over-b", "1", "--nu", "0.6"], "nu must lie"),
+    (["coefficients", "--shape", "ellipse", "--a-over-b", "1", "--nu", "-0.1"], "nu must lie"),
+    (["coefficients", "--shape", "ellipse", "--a-over-b", "1", "--frobnicate"],
+     "unrecognized arguments"),
+    (["coefficients"], "an area is needed"),
+    (["forces", "--shape", "ellipse", "--a", "1e-3", "--b", "1e-3", "--load", "1e3",
+      "--xi", "0", "--eta", "0", "--phi", "0", "--mu", "0"], "mu must be positive"),
+    (["forces", "--shape", "ellipse", "--a", "1e-3", "--b", "1e-3",
+      "--xi", "0", "--eta", "0", "--phi", "0", "--mu", "0.3"], "--load is required"),
+])
+def test_bad_input_one_line_exit_2(capsys, argv, match):
+    rc, out, err = run(capsys, *argv)
+    assert rc == 2
+    assert out == ""
+    assert len(err.strip().splitlines()) == 1
+    assert match in err
+
+
+@pytest.mark.parametrize("rows, match", [
+    (["0.5,0.5,nan"], "NaN or infinite"),
+    (["0.5,0.5,-1"], "negative pressure"),
+    (["0.123,0.5,1"], "not on a regular grid"),
+    (["0.5,0.5,abc"], "not a number"),
+])
+def test_bad_patch_files(tmp_path, capsys, rows, match):
+    ar = areas.ellipse(1.0, 1.0, nx=8)
+    path = write_patch(tmp_path / "p.csv", ar, extra_rows=rows)
+    rc, out, err = run(capsys, "coefficients", "--patch", str(path))
+    assert rc == 2 and out == ""
+    assert match in err and len(err.strip().splitlines()) == 1
+
+
+def test_empty_patch_is_refused(tmp_path, capsys):
+    path = tmp_path / "p.csv"
+    path.write_text("x,y,pressure\n0,0,0\n1,0,0\n0,1,0\n1,1,0\n")
+    rc, _, err = run(capsys, "coefficients", "--patch", str(path))
+    assert rc == 2 and "no cell in contact" in err
+
+
+def test_missing_patch_file(tmp_path, capsys):
+    rc, _, err = run(capsys, "coefficients", "--patch", str(tmp_path / "none.csv"))
+    assert rc == 2 and "cannot read patch file" in err
+
+
+def test_runs_as_a_program_without_traceback():
+    done = subprocess.run([sys.executable, "-m", "fastsim_ros.cli", "coefficients", "--shape",
+                           "ellipse", "--a-over-b", "0"], capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "Traceback" not in done.stderr and done.stdout == ""
