@@ -115,7 +115,7 @@ def read_patch(path: Path) -> areas.GridArea:
 
 
 def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridArea], str]:
-    """A function of the cell count giving the area, and the area's description."""
+    """Return a function of the cell count that makes the area, and its description."""
     if args.patch is not None:
         if args.shape is not None:
             raise UsageError("give either --shape or --patch, not both")
@@ -149,7 +149,7 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     if args.patch is not None:
         patch = make(0)
         c = exact.creep_coefficients(patch, nu=args.nu)
-        result = c.as_dict()
+        result = {**c.as_dict()}
         result.update(cells=[patch.nx, patch.ny], extrapolated=False)
     else:
         finest = args.cells or DEFAULT_CELLS["exact"]
