@@ -48,10 +48,16 @@ FULL_KEYS = ("C11", "C22", "C23", "C33", "C12", "C13", "C32")
 HALF_KEYS = ("c11", "c12", "c13", "c21", "c22", "c23")
 
 
-def solve_grid(g: float, nu: float, n: int) -> dict[str, float]:
-    """Full-ellipse and upper-half coefficients of one grid."""
+def solve_grid(g: float, nu: float, n: int, shape: float = 1.0) -> dict[str, float]:
+    """Full-ellipse and upper-half coefficients of one grid.
+
+    ``shape`` stretches the cell counts: ``n * shape`` cells along x and
+    ``n / shape`` along y (even), for the check on a second cell shape.
+    """
     a, b = areas.semi_ellipse_axes(g)
-    ar = areas.ellipse(a, b, nx=n, ny=n)
+    nx = 2 * round(n * shape / 2)
+    ny = 2 * round(n / shape / 2)
+    ar = areas.ellipse(a, b, nx=nx, ny=ny)
     sols = exact.unit_solutions(ar, nu=nu)
     full = exact.coefficients_from_unit_solutions(
         ar.area, tuple((s.fx, s.fy, s.mz) for s in sols))
@@ -88,7 +94,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
                         help="three ratios and one nu only (a smoke run, writes under /tmp)")
+    parser.add_argument("--cell-shape-check", type=float, nargs="+", metavar="A_OVER_B",
+                        help="instead of the tables: extrapolate C11, C22, C23 at these a/b on "
+                        "square-box cells and on cells with 4x the cell count along x per y "
+                        "(writes docs/data/cell_shape_check.csv)")
     args = parser.parse_args()
+    if args.cell_shape_check:
+        return cell_shape_check(args.cell_shape_check)
     ratios = (0.5, 1.0, 2.0) if args.quick else A_OVER_B
     nus = (0.25,) if args.quick else NUS
     out_dir = Path("/tmp/fastsim_tables") if args.quick else ROOT / "fastsim_ros" / "data"
@@ -145,6 +157,29 @@ def main() -> int:
         w.writeheader()
         w.writerows(raw_rows)
     print(f"done in {time.time() - t_start:.0f} s", flush=True)
+    return 0
+
+
+def cell_shape_check(ratios: list[float]) -> int:
+    """Converge C11, C22, C23 on two cell shapes (METHOD.md section 6, long end)."""
+    path = ROOT / "docs" / "data" / "cell_shape_check.csv"
+    rows = []
+    for g in ratios:
+        for nu in NUS:
+            for shape in (1.0, 2.0):
+                per = {n: solve_grid(g, nu, n, shape) for n in GRIDS}
+                row = {"a_over_b": g, "nu": nu, "cells_x_per_y": shape**2}
+                for k in FULL_KEYS[:3]:
+                    row[k], row[k + "_err"] = extrapolate({n: per[n][k] for n in GRIDS})
+                rows.append(row)
+                print(row, flush=True)
+    with open(path, "w", newline="") as f:
+        f.write("# Made by: python scripts/make_coefficient_tables.py --cell-shape-check "
+                + " ".join(f"{g:g}" for g in ratios) + "\n")
+        f.write("# cells_x_per_y = 1: n x n cells over the bounding box; 4: 2n x n/2 cells.\n")
+        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
+        w.writeheader()
+        w.writerows(rows)
     return 0
 
 
