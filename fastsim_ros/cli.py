@@ -21,10 +21,18 @@ import numpy as np
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import exact
+from fastsim_ros.contact.equivalent import equivalent_ellipse, equivalent_fastsim
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
+from fastsim_ros.contact.fastsim import traction_bound
+from fastsim_ros.contact.mae import mae_coefficients, mae_fastsim, mae_geometry
+from fastsim_ros.contact.tables import coefficient_table
 
 EXACT_GRIDS = (0.4, 0.6, 0.8, 1.0)
-DEFAULT_CELLS = {"exact": 100, "exact_forces": 60}
+#: cells across the bounding box of a shape, per method: exact coefficients are
+#: extrapolated from grids up to this; FastSim's discretisation error at 60
+#: cells is 0.1% on ellipses (docs/validation.md).
+DEFAULT_CELLS = {"exact": 100, "mae": 100, "fastsim": 60, "exact_forces": 60,
+                 "mae_forces": 60, "fastsim_ellipse_forces": 60}
 
 
 class UsageError(Exception):
@@ -76,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     co = sub.add_parser("coefficients", help="generalised creepage coefficients C~ij")
     _add_area(co, forces=False)
-    co.add_argument("--method", choices=("exact",), default="exact")
+    co.add_argument("--method", choices=("exact", "mae", "fastsim"), default="exact",
+                    help="exact solver, MAE's coefficients, or MAE + FastSim in adhesion")
     co.add_argument("--nu", type=_finite, default=0.25, help="Poisson ratio (default 0.25)")
     fo = sub.add_parser("forces", help="creep forces at given creepages")
     _add_area(fo, forces=True)
@@ -87,7 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
     fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
-    fo.add_argument("--method", choices=("exact",), default="exact")
+    fo.add_argument("--method", choices=("mae", "fastsim_ellipse", "exact"), default="mae")
     fo.add_argument("--bound", choices=("given", "parabolic"), default="given",
                     help="traction bound: the pressure as given, or Kalker's parabolic one")
     return parser
@@ -146,12 +155,7 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     exact.check_material(args.nu)
     make, what = _shape_maker(args)
     result: dict[str, Any]
-    if args.patch is not None:
-        patch = make(0)
-        c = exact.creep_coefficients(patch, nu=args.nu)
-        result = {**c.as_dict()}
-        result.update(cells=[patch.nx, patch.ny], extrapolated=False)
-    else:
+    if args.method == "exact" and args.patch is None:
         finest = args.cells or DEFAULT_CELLS["exact"]
         grids = _grid_sequence(finest)
         per = [exact.creep_coefficients(make(n), nu=args.nu) for n in grids]
@@ -161,8 +165,28 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
             # first-order convergence in the cell size (METHOD.md 5)
             result[key] = float(np.polyfit(h, [getattr(c, key) for c in per], 1)[1])
         result.update(area=1.0, cells=grids, extrapolated=True)
+    else:
+        ar = make(args.cells or DEFAULT_CELLS[args.method])
+        if args.method == "exact":
+            c = exact.creep_coefficients(ar, nu=args.nu)
+        elif args.method == "mae":
+            c = mae_coefficients(mae_geometry(ar), coefficient_table(args.nu))
+        else:
+            c = _fastsim_coefficients(ar, args.nu)
+        result = {k: (None if math.isnan(v) else v) for k, v in c.as_dict().items()}
+        result.update(cells=[ar.nx, ar.ny], extrapolated=False)
     result.update(method=args.method, nu=args.nu, area_description=what)
     return result
+
+
+def _fastsim_coefficients(ar: areas.GridArea, nu: float) -> exact.CreepCoefficients:
+    """MAE + FastSim in full adhesion (no bound), unit creepages, G = 1 Pa."""
+    table = coefficient_table(nu)
+    unbounded = np.where(ar.mask, np.inf, 0.0)
+    unit = tuple(mae_fastsim(ar, *cr, bound=unbounded, table=table, shear_modulus=1.0)
+                 for cr in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
+    return exact.coefficients_from_unit_solutions(ar.area, tuple((r.fx, r.fy, r.mz)
+                                                                 for r in unit))
 
 
 def forces(args: argparse.Namespace) -> dict[str, Any]:
@@ -172,31 +196,55 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         raise InvalidInputError(f"mu must be positive, got {args.mu}")
     if args.load is not None and not args.load > 0.0:
         raise InvalidInputError(f"--load must be positive, got {args.load}")
-    patch = _force_area(args)
-    sol = exact.coulomb(patch, args.xi, args.eta, args.phi, mu=args.mu, nu=args.nu,
-                        shear_modulus=args.shear_modulus)
-    return {"Fx": sol.fx, "Fy": sol.fy, "Mz": sol.mz, "N": patch.load, "method": args.method,
-            "slip_fraction": float(np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask),
-            "cells": [patch.nx, patch.ny]}
+    patch, ellipse = _force_area(args)
+    result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound}
+    if args.method == "exact":
+        if args.bound == "parabolic":
+            raise UsageError("--method exact takes the pressure as given (--bound given)")
+        sol = exact.coulomb(patch, args.xi, args.eta, args.phi, mu=args.mu, nu=args.nu,
+                            shear_modulus=args.shear_modulus)
+        result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
+            np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
+    elif args.method == "mae":
+        bound = traction_bound(patch, args.mu, bound=args.bound, ellipse=ellipse)
+        res = mae_fastsim(patch, args.xi, args.eta, args.phi, bound=bound,
+                          table=coefficient_table(args.nu), shear_modulus=args.shear_modulus)
+        g = res.geometry
+        result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=float(
+            np.count_nonzero(res.traction.slip)) / np.count_nonzero(patch.mask),
+            split_y=g.y_s, zones=[{"area": z.area, "a": z.a_eq, "b": z.b_eq}
+                                  for z in (g.zone1, g.zone2)])
+    else:
+        eq = equivalent_fastsim(patch, args.xi, args.eta, args.phi, mu=args.mu,
+                                table=coefficient_table(args.nu),
+                                shear_modulus=args.shear_modulus, bound=args.bound)
+        result.update(Fx=eq.fx, Fy=eq.fy, Mz=eq.mz, ellipse={
+            "x_c": eq.ellipse.x_c, "y_c": eq.ellipse.y_c, "a": eq.ellipse.a, "b": eq.ellipse.b})
+    result["cells"] = [patch.nx, patch.ny]
+    return result
 
 
-def _force_area(args: argparse.Namespace) -> areas.GridArea:
+Ellipse = tuple[float, float, float, float]
+
+
+def _force_area(args: argparse.Namespace) -> tuple[areas.GridArea, Ellipse]:
+    """Return the loaded area and the ellipse ``(x_c, y_c, a, b)`` of its parabolic bound."""
     if args.patch is not None:
         if args.shape is not None:
             raise UsageError("give either --shape or --patch, not both")
         patch = read_patch(args.patch)
         if args.load is not None:
             patch = patch.with_load(args.load)
-        if args.bound == "parabolic":
-            raise UsageError("--bound parabolic needs an ellipse (--shape ellipse --a A --b B)")
-        return patch
+        e = equivalent_ellipse(patch)
+        return patch, (e.x_c, e.y_c, e.a, e.b)
     if args.shape != "ellipse" or args.a is None or args.b is None:
         raise UsageError("forces need --shape ellipse --a A --b B (with --load) or --patch FILE")
     if args.load is None:
         raise UsageError("--load is required with --shape ellipse --a A --b B")
-    n = args.cells or DEFAULT_CELLS["exact_forces"]
+    n = args.cells or DEFAULT_CELLS[args.method + "_forces"]
     profile = "parabolic" if args.bound == "parabolic" else "hertz"
-    return areas.ellipse(args.a, args.b, nx=n, ny=n, load=args.load, pressure=profile)
+    ar = areas.ellipse(args.a, args.b, nx=n, ny=n, load=args.load, pressure=profile)
+    return ar, (0.0, 0.0, args.a, args.b)
 
 
 def _print_table(command: str, result: dict[str, Any]) -> None:
@@ -206,8 +254,9 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
                  else f", grid {result['cells'][0]} x {result['cells'][1]}"))
         print(f"area A = {result['area']:.6g} m^2; about the area's origin")
         for row in ("1", "2", "3"):
-            print("  " + "  ".join(f"C{row}{col} = {result[f'C{row}{col}']:9.4f}"
-                                   for col in "123"))
+            values = [(f"C{row}{col}", result[f"C{row}{col}"]) for col in "123"]
+            if all(v is not None for _, v in values):
+                print("  " + "  ".join(f"{k} = {v:9.4f}" for k, v in values))
     else:
         print(f"method {result['method']}, N = {result['N']:.6g} N")
         print(f"  Fx = {result['Fx']:.6g} N\n  Fy = {result['Fy']:.6g} N\n"

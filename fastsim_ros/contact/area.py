@@ -85,7 +85,7 @@ class GridArea:
 
     @property
     def area(self) -> float:
-        """Return the discrete contact area (m^2): cells in contact times the cell area."""
+        """Return the discrete contact area in m^2, cells in contact times the cell area."""
         return float(np.count_nonzero(self.mask)) * self.cell_area
 
     @property

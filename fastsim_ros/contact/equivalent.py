@@ -1,0 +1,83 @@
+"""The equivalent-ellipse baseline: plain FastSim on an ellipse standing in for the patch.
+
+What a user without MAE would do: replace the patch by the ellipse with its
+area and with ``a/b`` from its second moments about the centroid
+(``a/b = sqrt(Ixx/Iyy)``, exact for an ellipse), centred on the centroid,
+and run Kalker's FastSim on that ellipse with Kalker's flexibilities and a
+bound for the same load: Hertzian (``bound="given"``, the ellipse's own
+pressure, since the patch's cannot be carried over to another area) or
+Kalker's parabolic one.  The patch's shape beyond its second moments is lost:
+that is what MAE is measured against.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fastsim_ros.contact.area import GridArea, ellipse
+from fastsim_ros.contact.fastsim import (FastSimResult, StripFlexibility, fastsim,
+                                         kalker_flexibility, traction_bound)
+from fastsim_ros.contact.tables import CoefficientTable
+
+
+@dataclass(frozen=True)
+class EquivalentEllipse:
+    """Centre ``(x_c, y_c)`` and semi-axes ``a`` (along x), ``b`` (m)."""
+
+    x_c: float
+    y_c: float
+    a: float
+    b: float
+
+
+def equivalent_ellipse(area: GridArea) -> EquivalentEllipse:
+    """Return the ellipse of the area's size, centroid and second-moment ratio."""
+    mask = area.mask
+    jj, ii = np.nonzero(mask)
+    x = area.x[ii]
+    y = area.y[jj]
+    x_c, y_c = float(x.mean()), float(y.mean())
+    # second moments of the cells, each cell's own dx^2/12 included
+    ixx = float(np.mean((x - x_c) ** 2)) + area.dx**2 / 12.0
+    iyy = float(np.mean((y - y_c) ** 2)) + area.dy**2 / 12.0
+    g = math.sqrt(ixx / iyy)
+    a = math.sqrt(area.area * g / math.pi)
+    return EquivalentEllipse(x_c, y_c, a, a / g)
+
+
+@dataclass(frozen=True, eq=False)
+class EquivalentResult:
+    """Forces (N), ``Mz`` (N m) about the reference point, the ellipse and its solve."""
+
+    fx: float
+    fy: float
+    mz: float
+    ellipse: EquivalentEllipse
+    grid: GridArea
+    traction: FastSimResult
+
+
+def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
+                       table: CoefficientTable, shear_modulus: float,
+                       reference: tuple[float, float] = (0.0, 0.0), bound: str = "given",
+                       cells: int | None = None) -> EquivalentResult:
+    """Plain FastSim on the area's equivalent ellipse, load ``N`` of the area.
+
+    The ellipse is discretised on ``cells`` x ``cells`` cells over its bounding
+    box (default: the larger cell count of the area's grid).
+    """
+    e = equivalent_ellipse(area)
+    n = cells or max(area.nx, area.ny)
+    profile = "parabolic" if bound == "parabolic" else "hertz"
+    grid = ellipse(e.a, e.b, nx=n, ny=n, load=area.load, pressure=profile).shifted(e.x_c, e.y_c)
+    g = traction_bound(grid, mu)
+    c11, c22, c23 = table.kalker(e.a / e.b)
+    l1, l2, l3 = kalker_flexibility(e.a, e.b, c11, c22, c23, shear_modulus)
+    ones = np.ones(grid.ny)
+    flex = StripFlexibility(l1 * ones, l2 * ones, l3 * ones, l3 * ones)
+    res = fastsim(grid, xi, eta, phi, bound=g, flexibility=flex, sweep_point=(e.x_c, e.y_c),
+                  reference=reference)
+    return EquivalentResult(res.fx, res.fy, res.mz, e, grid, res)

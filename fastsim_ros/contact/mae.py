@@ -1,0 +1,275 @@
+"""MAE: assimilation of a non-elliptical contact area to two semi-ellipses.
+
+Alonso & Giménez, Vehicle System Dynamics 45(4):341-357, 2007, as fixed by
+METHOD.md section 3.  Assumptions: the area's principal axes are ``x`` and
+``y`` (wheel-rail contact); each of the two zones on either side of a
+lateral split line behaves, in the tangential problem, like the semi-ellipse
+with the same mean-square edge coordinates and the same area; the coupling
+coefficients ``c12``, ``c21`` are left out of the FastSim pass (a few percent
+of ``c11``; the coefficients report them).
+
+Steps: centroid; split line ``y = y_s``; mean-square semi-axes of each zone
+(eq. 6); half-ellipse coefficients from the package's tables; generalised
+coefficients about the split point ``S = (x_c, y_s)`` (eq. 7, weighted by the
+zones' areas) and about the reference point; per-zone flexibilities ``L1 ..
+L4`` (section 3.2.2); FastSim zone by zone with the creepages at ``S``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.exact import CreepCoefficients
+from fastsim_ros.contact.fastsim import FastSimResult, StripFlexibility, fastsim
+from fastsim_ros.contact.tables import CoefficientTable
+
+FloatArray = NDArray[np.float64]
+SplitRule = Literal["widest_strip", "centroid"]
+DEFAULT_SPLIT: SplitRule = "widest_strip"
+
+
+@dataclass(frozen=True)
+class Zone:
+    """One zone of the split and its semi-ellipse.
+
+    ``area`` (m^2); ``a``, ``b``: mean-square semi-axes (m, eq. 6);
+    ``a_over_b``; ``a_eq``, ``b_eq``: the semi-ellipse of ratio ``a_over_b``
+    and the zone's area, ``pi a_eq b_eq / 2 = area`` (m).  An empty zone has
+    zero area and ``nan`` axes.
+    """
+
+    area: float
+    a: float
+    b: float
+    a_over_b: float
+    a_eq: float
+    b_eq: float
+
+    @property
+    def empty(self) -> bool:
+        """Whether the zone holds no cell."""
+        return self.area <= 0.0
+
+
+@dataclass(frozen=True)
+class MaeGeometry:
+    """Centroid ``(x_c, y_c)``, split line ``y_s`` (m), and the two zones (1: ``y < y_s``)."""
+
+    x_c: float
+    y_c: float
+    y_s: float
+    rule: SplitRule
+    zone1: Zone
+    zone2: Zone
+    area: float
+
+    @property
+    def weights(self) -> tuple[float, float]:
+        """``w_i = 2 A_i / A``."""
+        return 2.0 * self.zone1.area / self.area, 2.0 * self.zone2.area / self.area
+
+
+def _row_extents(mask: NDArray[np.bool_]) -> tuple[NDArray[np.int_], NDArray[np.int_],
+                                                   NDArray[np.int_]]:
+    """Per row: cells in contact, index of the first and of the last contact cell."""
+    count = mask.sum(axis=1)
+    nx = mask.shape[1]
+    first = np.where(count > 0, np.argmax(mask, axis=1), 0)
+    last = np.where(count > 0, nx - 1 - np.argmax(mask[:, ::-1], axis=1), -1)
+    return count, first, last
+
+
+def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
+    """Index ``f`` of the cell face ``y = y0 + (f - 1/2) dy`` the split runs along.
+
+    ``centroid``: the face nearest the centroid (the paper's text).
+    ``widest_strip``: through the band of strips with the longest chord: its
+    middle face (on an ellipse with an even number of strips, the centre
+    line), unless the chord drops by over a cell at each end more on one side
+    of the band than on the other (a jump: the join line of two
+    semi-ellipses), where the split takes the band's face on that side.
+    """
+    mask = area.mask
+    count, _, _ = _row_extents(mask)
+    if rule == "centroid":
+        rows = np.flatnonzero(count)
+        yc = float((count * np.arange(area.ny)).sum() / count.sum())
+        return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1))
+    if rule != "widest_strip":
+        raise ValueError(f"unknown split rule {rule!r}")
+    # the band of strips sharing the longest chord (a staircase ellipse has several)
+    j0 = int(np.argmax(count))
+    j1 = j0
+    while j1 + 1 < area.ny and count[j1 + 1] == count[j0]:
+        j1 += 1
+    below = int(count[j0 - 1]) if j0 > 0 else 0
+    above = int(count[j1 + 1]) if j1 + 1 < area.ny else 0
+    # chords of centred shapes change by two cells at a time (one at each end)
+    drop_below, drop_above = count[j0] - below, count[j0] - above
+    if drop_below > drop_above + 2:
+        return j0
+    if drop_above > drop_below + 2:
+        return j1 + 1
+    width = j1 - j0 + 1
+    if width % 2 == 0:
+        return j0 + width // 2
+    middle = j0 + width // 2
+    # an odd band: the face of its middle strip nearer the centroid
+    yc = float((count * np.arange(area.ny)).sum() / count.sum())
+    return middle + 1 if yc > middle else middle
+
+
+def _zone(area: GridArea, rows: NDArray[np.bool_], x_c: float, y_s: float,
+          lower: bool) -> Zone:
+    mask = area.mask & rows[:, None]
+    n = int(np.count_nonzero(mask))
+    if n == 0:
+        return Zone(0.0, math.nan, math.nan, math.nan, math.nan, math.nan)
+    count, first, last = _row_extents(mask)
+    used = count > 0
+    x = area.x
+    lead = x[last[used]] + 0.5 * area.dx - x_c
+    trail = x[first[used]] - 0.5 * area.dx - x_c
+    ve_x = float(np.mean(0.5 * (lead**2 + trail**2)))
+    cols = mask.any(axis=0)
+    y = area.y
+    if lower:
+        j_out = np.argmax(mask, axis=0)[cols]
+        edge = y_s - (y[j_out] - 0.5 * area.dy)
+    else:
+        j_out = area.ny - 1 - np.argmax(mask[::-1, :], axis=0)[cols]
+        edge = y[j_out] + 0.5 * area.dy - y_s
+    ve_y = float(np.mean(edge**2))
+    # a semi-ellipse's mean-square edge coordinates are 2/3 of its squared semi-axes
+    a, b = math.sqrt(1.5 * ve_x), math.sqrt(1.5 * ve_y)
+    zone_area = n * area.cell_area
+    g = a / b
+    a_eq = math.sqrt(2.0 * zone_area * g / math.pi)
+    return Zone(zone_area, a, b, g, a_eq, a_eq / g)
+
+
+def mae_geometry(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> MaeGeometry:
+    """MAE steps 1-3: centroid, split line and the two zones' semi-ellipses."""
+    mask = area.mask
+    n = np.count_nonzero(mask)
+    jj, ii = np.nonzero(mask)
+    x_c = float(area.x[ii].sum() / n)
+    y_c = float(area.y[jj].sum() / n)
+    f = split_face(area, rule)
+    y_s = float(area.y0 + (f - 0.5) * area.dy)
+    rows = np.arange(area.ny) < f
+    return MaeGeometry(x_c, y_c, y_s, rule, _zone(area, rows, x_c, y_s, True),
+                       _zone(area, ~rows, x_c, y_s, False), area.area)
+
+
+def mae_coefficients(geometry: MaeGeometry, table: CoefficientTable,
+                     reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
+    """MAE steps 4-5: generalised coefficients ``C~ij`` about ``reference`` (m).
+
+    About ``S``: ``C~11 = sum w_i c11(g_i)``, ``C~22`` likewise,
+    ``C~23 = sum w_i^1.5 c23(g_i)``, ``C~13 = w1^1.5 c13(g1) - w2^1.5 c13(g2)``,
+    ``C~12 = w2 c12(g2) - w1 c12(g1)`` (and ``C~21``), from the mirror signs
+    of METHOD.md 3.4; then moved to ``reference`` by the rigid-slip identity.
+    ``C~3j`` are not given by MAE: reported as ``nan``.
+    """
+    w = geometry.weights
+    c = {k: 0.0 for k in ("11", "12", "13", "21", "22", "23")}
+    for zone, wi, sign in ((geometry.zone1, w[0], -1.0), (geometry.zone2, w[1], 1.0)):
+        if zone.empty:
+            continue
+        h = table.half(zone.a_over_b)
+        c["11"] += wi * h["c11"]
+        c["22"] += wi * h["c22"]
+        c["23"] += wi**1.5 * h["c23"]
+        c["12"] += sign * wi * h["c12"]
+        c["21"] += sign * wi * h["c21"]
+        c["13"] -= sign * wi**1.5 * h["c13"]
+    root = math.sqrt(geometry.area / math.pi)
+    dxp = reference[0] - geometry.x_c
+    dyp = reference[1] - geometry.y_s
+    c13 = c["13"] + (c["11"] * dyp - c["12"] * dxp) / root
+    c23 = c["23"] + (c["21"] * dyp - c["22"] * dxp) / root
+    return CreepCoefficients(C11=c["11"], C12=c["12"], C13=c13, C21=c["21"], C22=c["22"],
+                             C23=c23, C31=math.nan, C32=math.nan, C33=math.nan,
+                             area=geometry.area, reference=reference)
+
+
+@dataclass(frozen=True)
+class ZoneFlexibility:
+    """Flexibilities ``L1 .. L4`` (m/Pa) of one zone (METHOD.md 3.6); ``L4`` may be ``inf``."""
+
+    l1: float
+    l2: float
+    l3: float
+    l4: float
+
+
+def zone_flexibility(zone: Zone, table: CoefficientTable,
+                     shear_modulus: float) -> ZoneFlexibility:
+    """Return flexibilities with which FastSim reproduces the zone's half-ellipse in adhesion.
+
+    ``L1 = 4a/(3 G c11)``, ``L2 = 4a/(3 G c22)``,
+    ``L3 = pi a^1.5/(8 G sqrt(b) c23)``, ``L4 = sqrt(a b)/(2 G c13)``, with the
+    area-matched semi-axes ``a``, ``b``.
+    """
+    h = table.half(zone.a_over_b)
+    a, b, g = zone.a_eq, zone.b_eq, shear_modulus
+    l4 = math.sqrt(a * b) / (2.0 * g * h["c13"]) if h["c13"] > 0.0 else math.inf
+    return ZoneFlexibility(4.0 * a / (3.0 * g * h["c11"]), 4.0 * a / (3.0 * g * h["c22"]),
+                           math.pi * a**1.5 / (8.0 * g * math.sqrt(b) * h["c23"]), l4)
+
+
+def strip_flexibility(area: GridArea, geometry: MaeGeometry, table: CoefficientTable,
+                      shear_modulus: float) -> StripFlexibility:
+    """Each strip's ``L1, L2, L3, L4`` from its zone."""
+    lower = area.y < geometry.y_s
+    out = {}
+    for name in ("l1", "l2", "l3", "l4"):
+        out[name] = np.full(area.ny, math.nan)
+    for zone, rows in ((geometry.zone1, lower), (geometry.zone2, ~lower)):
+        if zone.empty:
+            continue
+        f = zone_flexibility(zone, table, shear_modulus)
+        for name in out:
+            out[name][rows] = getattr(f, name)
+    return StripFlexibility(out["l1"], out["l2"], out["l3"], out["l4"])
+
+
+@dataclass(frozen=True, eq=False)
+class MaeResult:
+    """MAE + FastSim: forces (N), ``Mz`` (N m) about the reference point, and what made them."""
+
+    fx: float
+    fy: float
+    mz: float
+    traction: FastSimResult
+    geometry: MaeGeometry
+    flexibility: tuple[ZoneFlexibility | None, ZoneFlexibility | None]
+
+
+def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
+                table: CoefficientTable, shear_modulus: float,
+                reference: tuple[float, float] = (0.0, 0.0),
+                rule: SplitRule = DEFAULT_SPLIT) -> MaeResult:
+    """MAE step 7: FastSim zone by zone, creepages about ``reference`` (``phi`` in 1/m).
+
+    ``bound``: traction bound ``g`` (Pa) on the area's cells
+    (:func:`fastsim_ros.contact.fastsim.traction_bound`); ``shear_modulus``:
+    combined ``G`` (Pa); ``table``: coefficients at the material's ``nu``.
+    """
+    geometry = mae_geometry(area, rule)
+    flex = strip_flexibility(area, geometry, table, shear_modulus)
+    # strips outside both zones carry no contact: any finite flexibility will do
+    safe = StripFlexibility(*(np.nan_to_num(v, nan=1.0) for v in
+                              (flex.l1, flex.l2, flex.l3, flex.spin)))
+    res = fastsim(area, xi, eta, phi, bound=bound, flexibility=safe,
+                  sweep_point=(geometry.x_c, geometry.y_s), reference=reference)
+    zones = tuple(None if z.empty else zone_flexibility(z, table, shear_modulus)
+                  for z in (geometry.zone1, geometry.zone2))
+    return MaeResult(res.fx, res.fy, res.mz, res, geometry, (zones[0], zones[1]))
