@@ -1,0 +1,179 @@
+"""MAE (numpy reference): the exactness checks of METHOD.md section 6."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, kalker_flexibility
+from fastsim_ros.contact.mae import (mae_coefficients, mae_fastsim, mae_geometry,
+                                     split_face, zone_flexibility)
+from fastsim_ros.contact.tables import coefficient_table
+
+RATIOS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0)
+NUS = (0.0, 0.25, 0.5)
+
+
+def unbounded(ar):
+    return np.where(ar.mask, np.inf, 0.0)
+
+
+def hertz_like(ar, halves):
+    """A Hertz-like pressure on two semi-ellipses ``[(a1, b1), (a2, b2)]``, unit load."""
+    y = ar.y[:, None]
+    a = np.where(y < 0, halves[0][0], halves[1][0])
+    b = np.where(y < 0, halves[0][1], halves[1][1])
+    p = np.sqrt(np.clip(1 - (ar.x[None, :] / a) ** 2 - (y / b) ** 2, 0, None)) * ar.mask
+    return ar.with_pressure(p).with_load(1.0)
+
+
+@pytest.mark.parametrize("nu", NUS)
+@pytest.mark.parametrize("g", RATIOS)
+def test_ellipse_gives_back_its_axes_and_kalker(g, nu):
+    a, b = areas.semi_ellipse_axes(g)
+    ar = areas.ellipse(a, b, nx=40, ny=40)
+    geo = mae_geometry(ar)
+    assert geo.y_s == pytest.approx(0.0, abs=1e-12)
+    for z in (geo.zone1, geo.zone2):
+        # mean-square edges on cell faces: within a small fraction of a cell
+        assert abs(z.a - a) < 0.2 * ar.dx and abs(z.b - b) < 0.2 * ar.dy
+        assert z.a_over_b == pytest.approx(g, rel=1e-9)
+    t = coefficient_table(nu)
+    c = mae_coefficients(geo, t)
+    for mine, ref in zip((c.C11, c.C22, c.C23), t.kalker(g)):
+        assert mine == pytest.approx(ref, rel=1e-9)
+    assert abs(c.C13) < 1e-12 and abs(c.C12) < 1e-12 and abs(c.C21) < 1e-12
+
+
+@pytest.mark.parametrize("g", [0.2, 1.0, 5.0])
+def test_mae_flexibilities_of_an_ellipse_are_kalkers(g):
+    a, b = areas.semi_ellipse_axes(g)
+    ar = areas.ellipse(a, b, nx=40, ny=40)
+    t = coefficient_table(0.25)
+    z = mae_geometry(ar).zone2
+    f = zone_flexibility(z, t, 1.0)
+    k = kalker_flexibility(z.a_eq, z.b_eq, *t.kalker(g), 1.0)
+    assert (f.l1, f.l2, f.l3) == pytest.approx(k, rel=1e-12)
+
+
+@pytest.mark.parametrize("creepage", [(1e-3, 0.0, 0.0), (0.0, 2e-3, 0.0), (4e-3, -3e-3, 0.0),
+                                      (0.05, 0.02, 0.0)])
+def test_mae_fastsim_equals_plain_fastsim_on_an_ellipse(creepage):
+    # one table source: the same flexibilities, so the same tractions to round-off
+    a, b = 6e-3, 4e-3
+    ar = areas.ellipse(a, b, nx=40, ny=40, load=2e4)
+    t = coefficient_table(0.28)
+    g = 0.3 * np.asarray(ar.pressure)
+    m = mae_fastsim(ar, *creepage, bound=g, table=t, shear_modulus=8e10)
+    z = m.geometry.zone1
+    l1, l2, l3 = kalker_flexibility(z.a_eq, z.b_eq, *t.kalker(z.a_over_b), 8e10)
+    one = np.ones(ar.ny)
+    plain = fastsim(ar, *creepage, bound=g, flexibility=StripFlexibility(
+        l1 * one, l2 * one, l3 * one, l3 * one))
+    np.testing.assert_allclose(m.traction.tau_x, plain.tau_x, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(m.traction.tau_y, plain.tau_y, rtol=1e-12, atol=1e-9)
+
+
+def test_mae_fastsim_at_vanishing_spin_equals_plain_fastsim():
+    a, b = areas.semi_ellipse_axes(0.5)
+    ar = areas.ellipse(a, b, nx=40, ny=40)
+    t = coefficient_table(0.25)
+    m = mae_fastsim(ar, 0.0, 0.0, 1.0, bound=unbounded(ar), table=t, shear_modulus=1.0)
+    l1, l2, l3 = kalker_flexibility(a, b, *t.kalker(0.5), 1.0)
+    z = m.geometry.zone1
+    l1, l2, l3 = kalker_flexibility(z.a_eq, z.b_eq, *t.kalker(0.5), 1.0)
+    one = np.ones(ar.ny)
+    plain = fastsim(ar, 0.0, 0.0, 1.0, bound=unbounded(ar),
+                    flexibility=StripFlexibility(l1 * one, l2 * one, l3 * one, l3 * one))
+    assert m.fy == pytest.approx(plain.fy, rel=1e-12)
+    assert abs(m.fx) < 1e-12 * abs(m.fy) and abs(plain.fx) < 1e-12 * abs(plain.fy)
+
+
+@pytest.mark.parametrize("g1", [0.1, 0.5, 2.0, 5.0])
+def test_semi_ellipses_widest_strip_recovers_the_halves(g1):
+    ar = areas.semi_ellipses(g1, 1.0, cells=100)
+    geo = mae_geometry(ar, "widest_strip")
+    assert geo.y_s == pytest.approx(0.0, abs=1e-12)  # the join line
+    for z, g in ((geo.zone1, g1), (geo.zone2, 1.0)):
+        a, b = areas.semi_ellipse_axes(g)
+        assert abs(z.a - a) < ar.dx and abs(z.b - b) < ar.dy
+        assert z.area == pytest.approx(0.5, rel=0.02)
+    t = coefficient_table(0.25)
+    c = mae_coefficients(geo, t)
+    h1, h2 = t.half(g1), t.half(1.0)
+    # METHOD.md 3.5 with equal halves: C~ij = c_ij(g1) + c_ij(g2), C~13 = c13(g1) - c13(g2)
+    assert c.C11 == pytest.approx(h1["c11"] + h2["c11"], rel=0.01)
+    assert c.C22 == pytest.approx(h1["c22"] + h2["c22"], rel=0.01)
+    assert c.C23 == pytest.approx(h1["c23"] + h2["c23"], rel=0.01)
+    assert c.C13 == pytest.approx(h1["c13"] - h2["c13"], rel=0.01, abs=0.01)
+
+
+def test_centroid_rule_splits_at_the_centroid():
+    ar = areas.semi_ellipses(0.2, 1.0, cells=60)
+    geo = mae_geometry(ar, "centroid")
+    assert abs(geo.y_s - geo.y_c) <= ar.dy / 2 + 1e-12
+    assert split_face(ar, "widest_strip") != split_face(ar, "centroid")
+
+
+def test_mirror_flips_c13_and_fx_under_spin():
+    ar = hertz_like(areas.semi_ellipses(0.5, 2.0, cells=60),
+                    [areas.semi_ellipse_axes(0.5), areas.semi_ellipse_axes(2.0)])
+    t = coefficient_table(0.25)
+    m = ar.mirrored_y()
+    c, cm = mae_coefficients(mae_geometry(ar), t), mae_coefficients(mae_geometry(m), t)
+    assert cm.C13 == pytest.approx(-c.C13, rel=1e-9) and abs(c.C13) > 0.05
+    for k in ("C11", "C22", "C23"):
+        assert getattr(cm, k) == pytest.approx(getattr(c, k), rel=1e-9)
+    kw = dict(table=t, shear_modulus=1e6)
+    r = mae_fastsim(ar, 0.0, 0.0, 2.0, bound=0.3 * np.asarray(ar.pressure), **kw)
+    rm = mae_fastsim(m, 0.0, 0.0, 2.0, bound=0.3 * np.asarray(m.pressure), **kw)
+    assert rm.fx == pytest.approx(-r.fx, rel=1e-9) and abs(r.fx) > 1e-3 * abs(r.fy)
+    assert rm.fy == pytest.approx(r.fy, rel=1e-9)
+
+
+def test_reference_point_moves_coefficients_and_forces_by_rigid_slip():
+    ar = hertz_like(areas.semi_ellipses(0.5, 2.0, cells=50),
+                    [areas.semi_ellipse_axes(0.5), areas.semi_ellipse_axes(2.0)])
+    t = coefficient_table(0.25)
+    geo = mae_geometry(ar)
+    p = (0.07, -0.11)
+    o, q = mae_coefficients(geo, t), mae_coefficients(geo, t, reference=p)
+    root = math.sqrt(geo.area / math.pi)
+    assert q.C13 == pytest.approx(o.C13 + (o.C11 * p[1] - o.C12 * p[0]) / root, rel=1e-12)
+    assert q.C23 == pytest.approx(o.C23 + (o.C21 * p[1] - o.C22 * p[0]) / root, rel=1e-12)
+    g = 0.3 * np.asarray(ar.pressure)
+    kw = dict(bound=g, table=t, shear_modulus=1e5)
+    xi, eta, phi = 1e-3, -2e-3, 0.5
+    at_p = mae_fastsim(ar, xi, eta, phi, reference=p, **kw)
+    at_o = mae_fastsim(ar, xi + phi * p[1], eta - phi * p[0], phi, **kw)
+    assert (at_p.fx, at_p.fy) == pytest.approx((at_o.fx, at_o.fy), rel=1e-12)
+    assert at_p.mz == pytest.approx(at_o.mz - (p[0] * at_o.fy - p[1] * at_o.fx), rel=1e-9)
+
+
+def test_large_creepage_gives_mu_n():
+    ar = hertz_like(areas.semi_ellipses(0.2, 1.0, cells=40),
+                    [areas.semi_ellipse_axes(0.2), areas.semi_ellipse_axes(1.0)])
+    t = coefficient_table(0.28)
+    r = mae_fastsim(ar, 0.0, 0.5, 0.0, bound=0.3 * np.asarray(ar.pressure), table=t,
+                    shear_modulus=1e4)
+    assert math.hypot(r.fx, r.fy) == pytest.approx(0.3 * ar.load, rel=1e-9)
+
+
+def test_independent_of_grid_origin_and_scale():
+    ar = hertz_like(areas.semi_ellipses(0.5, 2.0, cells=40),
+                    [areas.semi_ellipse_axes(0.5), areas.semi_ellipse_axes(2.0)])
+    t = coefficient_table(0.25)
+    kw = dict(table=t, shear_modulus=1e5)
+    g = 0.3 * np.asarray(ar.pressure)
+    base = mae_fastsim(ar, 1e-3, 1e-3, 0.2, bound=g, **kw)
+    moved = mae_fastsim(ar.shifted(0.3, 0.4), 1e-3, 1e-3, 0.2, bound=g, reference=(0.3, 0.4),
+                        **kw)
+    assert (moved.fx, moved.fy, moved.mz) == pytest.approx((base.fx, base.fy, base.mz),
+                                                           rel=1e-9)
+    k = 1e-2
+    lin = mae_fastsim(ar, 1e-3, 1e-3, 0.2, bound=unbounded(ar), **kw)
+    small = ar.scaled(k)
+    lin_k = mae_fastsim(small, 1e-3, 1e-3, 0.2 / k, bound=unbounded(small), **kw)
+    assert (lin_k.fx, lin_k.fy, lin_k.mz) == pytest.approx(
+        (lin.fx * k**2, lin.fy * k**2, lin.mz * k**3), rel=1e-9)
