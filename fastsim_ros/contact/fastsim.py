@@ -151,7 +151,7 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
 def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
             flexibility: StripFlexibility, sweep_point: tuple[float, float] = (0.0, 0.0),
             reference: tuple[float, float] = (0.0, 0.0)) -> FastSimResult:
-    """Solve with FastSim on ``area``, creepages ``xi``, ``eta``, ``phi`` (1/m) about ``reference``.
+    """Solve with FastSim on ``area``; creepages ``xi``, ``eta``, ``phi`` (1/m) about ``reference``.
 
     ``sweep_point`` ``(x_c, y_s)`` is the point the strips' rates refer to
     (the reference point itself in plain FastSim, MAE's ``S``); creepages are
