@@ -127,3 +127,56 @@ def test_runs_as_a_program_without_traceback():
                            "ellipse", "--a-over-b", "0"], capture_output=True, text=True)
     assert done.returncode == 2
     assert "Traceback" not in done.stderr and done.stdout == ""
+
+
+def _published_ratios():
+    from fastsim_ros.contact.tables import table_data
+    g = table_data().a_over_b
+    return [float(v) for v in g if 0.1 - 1e-9 <= v <= 10 + 1e-9]
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.25, 0.5])
+def test_mae_coefficients_of_ellipses_equal_the_tables(capsys, nu):
+    from fastsim_ros.contact.tables import coefficient_table
+    t = coefficient_table(nu)
+    for g in _published_ratios():
+        rc, out, _ = run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", repr(g),
+                         "--nu", str(nu), "--method", "mae", "--json")
+        c = json.loads(out)
+        assert rc == 0
+        for key, ref in zip(("C11", "C22", "C23"), t.kalker(g)):
+            assert c[key] == pytest.approx(ref, rel=0.005), (g, key)
+        assert abs(c["C13"]) < 1e-12 and abs(c["C12"]) < 1e-12
+
+
+@pytest.mark.parametrize("nu", [0.0, 0.25, 0.5])
+def test_fastsim_coefficients_of_ellipses_within_discretisation_error(capsys, nu):
+    # default grid 60 x 60: the pinned discretisation is within 0.15% of Kalker there
+    from fastsim_ros.contact.tables import coefficient_table
+    t = coefficient_table(nu)
+    for g in _published_ratios()[::3]:
+        rc, out, _ = run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", repr(g),
+                         "--nu", str(nu), "--method", "fastsim", "--json")
+        c = json.loads(out)
+        assert rc == 0 and c["cells"] == [60, 60]
+        for key, ref in zip(("C11", "C22", "C23"), t.kalker(g)):
+            assert c[key] == pytest.approx(ref, rel=0.0015), (g, key)
+        assert abs(c["C13"]) < 1e-9
+
+
+def test_forces_methods_agree_on_the_example_patch(capsys):
+    from pathlib import Path
+    patch = Path(__file__).resolve().parents[1] / "fastsim_ros" / "data" / "example_patch.csv"
+    forces = {}
+    for method in ("mae", "fastsim_ellipse", "exact"):
+        rc, out, _ = run(capsys, "forces", "--patch", str(patch), "--xi", "1e-3", "--eta", "0",
+                         "--phi", "0.5", "--mu", "0.3", "--method", method, "--json")
+        assert rc == 0
+        forces[method] = json.loads(out)
+    mu_n = 0.3 * forces["exact"]["N"]
+    assert forces["exact"]["N"] == pytest.approx(5e4, rel=1e-9)
+    for key in ("Fx", "Fy"):
+        assert abs(forces["mae"][key] - forces["exact"][key]) < 0.05 * mu_n
+    # MAE is the closer one on this asymmetric patch
+    assert (abs(forces["mae"]["Fx"] - forces["exact"]["Fx"])
+            < abs(forces["fastsim_ellipse"]["Fx"] - forces["exact"]["Fx"]))
