@@ -1,0 +1,238 @@
+"""Time the compiled MAE + FastSim and equivalent-ellipse paths; print medians and p99.
+
+Run from the package root (``benchmarks/README.md``)::
+
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_fastsim.py [--calls 2000] [--batch 2000]
+
+For each grid (10x10 ... 60x60 cells) and each patch (two semi-ellipses with
+a Hertz-like pressure, a wheel-rail sized non-elliptical patch; and a Hertzian
+ellipse), one call at a time from Python (``time.perf_counter_ns`` around
+each call, after a warm-up; the three compiled calls interleaved in blocks):
+
+- ``MaeSolver.solve`` (the full API: a ``GridArea`` in, ``ContactForces`` out),
+- ``MaeSolver.solve_arrays`` (the node's hot path: arrays in),
+- the MAE geometry and table look-ups alone (kernel ``mae_prepare`` called
+  in a compiled loop, so without the call overhead) and their share of the
+  whole compiled solve (``mae_solve`` in the same loop),
+- the numpy reference ``mae_fastsim`` (with its traction bound; fewer calls),
+- ``EquivalentEllipseSolver.solve`` (the baseline, same patch),
+
+then the batched throughput (patch solves per second, one core) of
+``solve_batch`` on distinct patches and on one patch under many creepages.
+The machine (platform, CPU, cores, load average) is printed with the figures:
+quote it with them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import platform
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numba
+import numpy as np
+from numba import njit
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import kernels
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver, warm_up
+from fastsim_ros.contact.fastsim import traction_bound
+from fastsim_ros.contact.mae import mae_fastsim
+from fastsim_ros.contact.tables import coefficient_table
+
+NU, G, MU, LOAD = 0.28, 8.0e10, 0.3, 5.0e4
+# wheel-rail creepages in partial slip with spin (saturation near 5e-3 here)
+CREEP = (1.0e-3, 5.0e-4, 1.0)
+GRIDS = (10, 20, 30, 45, 60)
+
+
+def machine() -> str:
+    """Describe the machine: platform, CPU model, cores, load (a busy machine slows runs)."""
+    model = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    model = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    cores = os.cpu_count()
+    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else cores
+    load = ", load average %.2f %.2f %.2f" % os.getloadavg() if hasattr(os, "getloadavg") \
+        else ""
+    return (f"{platform.platform()}; {model}; {cores} cores ({usable} usable){load}; "
+            f"Python {platform.python_version()}, numpy {np.__version__}, "
+            f"numba {numba.__version__}")
+
+
+def semi_ellipses(cells: int) -> GridArea:
+    """Make two semi-ellipses (a/b = 0.5 and 2) of 1 cm^2, Hertz-like pressure, ``LOAD`` (N)."""
+    base = areas.semi_ellipses(0.5, 2.0, cells=cells)
+    a1, b1 = areas.semi_ellipse_axes(0.5)
+    a2, b2 = areas.semi_ellipse_axes(2.0)
+    x, y = base.x[None, :], base.y[:, None]
+    rho2 = np.where(y < 0.0, (x / a1) ** 2 + (y / b1) ** 2, (x / a2) ** 2 + (y / b2) ** 2)
+    p = np.where(base.mask, np.sqrt(np.clip(1.0 - rho2, 0.0, None) + 1e-3), 0.0)
+    return base.with_pressure(p).scaled(0.01).with_load(LOAD)
+
+
+def ellipse(cells: int) -> GridArea:
+    """Make a Hertzian ellipse of 6 mm x 4 mm under ``LOAD`` (N)."""
+    return areas.ellipse(6e-3, 4e-3, nx=cells, load=LOAD)
+
+
+def per_call(fns: dict[str, Callable[[], Any]], calls: int,
+             rounds: int = 20) -> dict[str, tuple[float, float]]:
+    """Return the median and p99 (us) of ``calls`` timed calls of each function.
+
+    The calls go in ``rounds`` interleaved blocks (a block of each function,
+    then the next round), so that a machine whose speed drifts during the
+    run (a shared VM) affects every function alike.
+    """
+    clock = time.perf_counter_ns
+    times = {name: np.empty(calls) for name in fns}
+    block = max(1, calls // rounds)
+    for fn in fns.values():
+        for _ in range(min(200, calls)):
+            fn()
+    for start in range(0, calls, block):
+        stop = min(calls, start + block)
+        for name, fn in fns.items():
+            t = times[name]
+            for n in range(start, stop):
+                t0 = clock()
+                fn()
+                t[n] = clock() - t0
+    return {name: (float(np.median(t)) / 1e3, float(np.percentile(t, 99)) / 1e3)
+            for name, t in times.items()}
+
+
+@njit
+def _loop_prepare(reps, p, x0, y0, dx, dy, shear_modulus, knots, polys):
+    geo = np.empty(kernels.GEO_SIZE)
+    env = np.empty((2, p.shape[1]), dtype=np.int64)
+    for _ in range(reps):
+        kernels.mae_prepare(p, x0, y0, dx, dy, kernels.RULE_WIDEST_STRIP, shear_modulus,
+                            knots, polys, geo, env)
+    return geo[0]
+
+
+@njit
+def _loop_solve(reps, p, x0, y0, dx, dy, shear_modulus, knots, polys, xi, eta, phi, mu):
+    none_f = np.empty((0, 0))
+    none_b = np.empty((0, 0), dtype=np.bool_)
+    fx = 0.0
+    for _ in range(reps):
+        fx += kernels.mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0,
+                                kernels.RULE_WIDEST_STRIP, False, shear_modulus, knots, polys,
+                                none_f, none_f, none_b, False)[2]
+    return fx
+
+
+def in_kernel(fn: Callable[..., Any], *args: Any, reps: int = 200) -> float:
+    """Return the best time (us) per iteration of a compiled loop: no call overhead."""
+    fn(1, *args)
+    best = math.inf
+    for _ in range(15):
+        t0 = time.perf_counter_ns()
+        fn(reps, *args)
+        best = min(best, (time.perf_counter_ns() - t0) / reps)
+    return best / 1e3
+
+
+def throughput(fn: Callable[[], Any], size: int) -> float:
+    """Return patch solves per second of a batch call of ``size`` items (median of 5)."""
+    fn()
+    runs = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        fn()
+        runs.append(time.perf_counter() - t0)
+    return size / float(np.median(runs))
+
+
+def main() -> None:
+    """Run the benchmark and print its tables."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--calls", type=int, default=2000, help="timed calls per figure")
+    parser.add_argument("--reference-calls", type=int, default=30,
+                        help="timed calls of the numpy reference")
+    parser.add_argument("--batch", type=int, default=2000, help="items per batch")
+    parser.add_argument("--grids", type=int, nargs="+", default=list(GRIDS))
+    args = parser.parse_args()
+
+    print(f"machine: {machine()}")
+    print(f"warm-up (compile or load the cached kernels): {warm_up():.2f} s")
+    print(f"creepages xi, eta, phi = {CREEP} (phi in 1/m), mu = {MU}, N = {LOAD:g} N, "
+          f"G = {G:g} Pa, nu = {NU}; times in us, median / p99 over {args.calls} calls\n")
+    mae = MaeSolver(NU, G)
+    baseline = EquivalentEllipseSolver(NU, G)
+    table = coefficient_table(NU)
+    knots, polys = mae._knots, mae._polys
+    rng = np.random.default_rng(0)
+    xi, eta, phi = CREEP
+
+    head = (f"{'patch':<14}{'grid':>6}{'cells':>6}{'slip':>6}  {'solve':>13}  "
+            f"{'solve_arrays':>13}  {'geometry':>8}{'share':>7}  {'numpy ref':>10}  "
+            f"{'equivalent':>13}{'eq/mae':>7}")
+    print(head)
+    print("-" * len(head))
+    rates = []
+    for name, make in (("semi-ellipses", semi_ellipses), ("ellipse", ellipse)):
+        for n in args.grids:
+            ar = make(n)
+            p = np.array(ar.pressure)
+            grid = (ar.x0, ar.y0, ar.dx, ar.dy)
+            res = mae.solve(ar, xi, eta, phi, mu=MU)
+            t = per_call({
+                "solve": lambda: mae.solve(ar, xi, eta, phi, mu=MU),
+                "arrays": lambda: mae.solve_arrays(p, *grid, xi, eta, phi, MU),
+                "equivalent": lambda: baseline.solve(ar, xi, eta, phi, mu=MU)}, args.calls)
+            t_solve, t_arrays, t_eq = t["solve"], t["arrays"], t["equivalent"]
+            kargs = (ar.pressure, *grid, G, knots, polys)
+            t_geo = in_kernel(_loop_prepare, *kargs)
+            t_whole = in_kernel(_loop_solve, *kargs, xi, eta, phi, MU)
+            bound = traction_bound(ar, MU)
+            t_ref = per_call({"ref": lambda: mae_fastsim(
+                ar, xi, eta, phi, bound=bound, table=table, shear_modulus=G)},
+                args.reference_calls, rounds=1)["ref"]
+            print(f"{name:<14}{f'{ar.nx}x{ar.ny}':>6}{np.count_nonzero(ar.mask):>6}"
+                  f"{100 * res.slip_fraction:>5.0f}%  {t_solve[0]:>6.1f} /{t_solve[1]:>5.1f}  "
+                  f"{t_arrays[0]:>6.1f} /{t_arrays[1]:>5.1f}  {t_geo:>8.2f}"
+                  f"{100 * t_geo / t_whole:>6.0f}%  {t_ref[0]:>10.0f}  "
+                  f"{t_eq[0]:>6.1f} /{t_eq[1]:>5.1f}{t_eq[0] / t_solve[0]:>7.2f}")
+            # batches: distinct patches (load and a fore-aft tilt of the pressure vary
+            # smoothly from patch to patch, as from a normal solver) and creepages
+            b = args.batch
+            tilt = np.linspace(-1.0, 1.0, ar.nx)[None, None, :]
+            ps = p[None] * ((0.8 + 0.4 * rng.random((b, 1, 1)))
+                            * (1.0 + 0.3 * (rng.random((b, 1, 1)) - 0.5) * tilt))
+            creep = np.column_stack([xi * (0.5 + rng.random(b)), eta * (0.5 + rng.random(b)),
+                                     phi * (0.5 + rng.random(b))])
+            rates.append((name, f"{ar.nx}x{ar.ny}", [
+                throughput(lambda: s.solve_batch(pp, *grid, creep, mu=MU), b)
+                for s in (mae, baseline) for pp in (ps, p)]))
+    print("\ngeometry: MAE geometry + table look-ups alone (kernel mae_prepare, in a compiled "
+          "loop);\nshare: of the whole compiled MAE solve (mae_solve, same loop); numpy ref: "
+          "mae_fastsim,\nmedian of fewer calls; eq/mae: median of EquivalentEllipseSolver.solve "
+          "over MaeSolver.solve.\n")
+    print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
+    head = (f"{'patch':<14}{'grid':>6}  {'MAE distinct':>13}{'MAE 1 patch':>13}"
+            f"{'eq distinct':>13}{'eq 1 patch':>13}")
+    print(head)
+    print("-" * len(head))
+    for name, size, r in rates:
+        print(f"{name:<14}{size:>6}  " + "".join(f"{v:>13,.0f}" for v in r))
+    print("\ndistinct: B different patches (load and pressure tilt vary) and creepages; "
+          "1 patch: one patch\nunder B creepages (its geometry, look-ups and bound are "
+          "computed once).")
+
+
+if __name__ == "__main__":
+    main()

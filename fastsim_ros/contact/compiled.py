@@ -1,0 +1,391 @@
+"""The fast path: MAE + FastSim and the equivalent-ellipse baseline, compiled.
+
+Python API over :mod:`fastsim_ros.contact.kernels` (numba, compiled on first
+use and cached on disk; :func:`warm_up` compiles, or loads, every kernel on
+a tiny patch).  Results equal the numpy reference
+(:func:`~fastsim_ros.contact.mae.mae_fastsim`,
+:func:`~fastsim_ros.contact.equivalent.equivalent_fastsim`) to rounding.
+
+- :class:`MaeSolver` ``(nu, shear_modulus, rule=...)``: ``solve(area, xi,
+  eta, phi, mu=...)`` on a :class:`~fastsim_ros.contact.area.GridArea`,
+  ``solve_arrays(pressure, x0, y0, dx, dy, ...)`` without building one (the
+  node's hot path), ``solve_batch(...)`` for many patches or creepages in one
+  compiled loop, and ``geometry`` / ``flexibility`` for inspection.
+- :class:`EquivalentEllipseSolver` ``(nu, shear_modulus)``: the same calls.
+
+Units: SI throughout (m, Pa, N, N m; ``phi`` in 1/m).  Bad input raises the
+errors of :mod:`fastsim_ros.contact.errors` (validation runs in the kernels:
+it costs one pass over the cells, not a dozen numpy calls).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Literal, NoReturn
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from fastsim_ros.contact import kernels as k
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.errors import EmptyContactError, InvalidInputError, OutOfTableError
+from fastsim_ros.contact.tables import coefficient_table
+
+if TYPE_CHECKING:  # the reference modules pull in the exact solver (scipy): not on the hot path
+    from fastsim_ros.contact.equivalent import EquivalentEllipse
+    from fastsim_ros.contact.mae import MaeGeometry, ZoneFlexibility
+
+FloatArray = NDArray[np.float64]
+BoolArray = NDArray[np.bool_]
+Bound = Literal["given", "parabolic"]
+Rule = Literal["widest_strip", "centroid"]
+
+_RULES = {"widest_strip": k.RULE_WIDEST_STRIP, "centroid": k.RULE_CENTROID}
+# placeholders for the kernels' traction outputs when none are wanted: one
+# argument type for both cases, so one compiled specialisation
+_NO_FLOAT = np.empty((0, 0))
+_NO_BOOL = np.empty((0, 0), dtype=np.bool_)
+
+
+@dataclass(frozen=True, eq=False, slots=True)
+class ContactForces:
+    """Creep forces of one solve.
+
+    ``fx``, ``fy`` (N) and ``mz`` (N m, about the reference point): forces
+    of the rail on the wheel; ``n``: normal load ``sum p dA`` of the patch
+    (N); ``slip_fraction``: share of the cells in contact on the traction
+    bound.  With ``tractions=True``: ``tau_x``, ``tau_y`` (Pa) and ``slip``
+    on the grid ``grid = (x0, y0, dx, dy)`` (m) (the patch's for MAE, the
+    equivalent ellipse's for the baseline), else ``None``.
+    """
+
+    fx: float
+    fy: float
+    mz: float
+    n: float
+    slip_fraction: float
+    tau_x: FloatArray | None = None
+    tau_y: FloatArray | None = None
+    slip: BoolArray | None = None
+    grid: tuple[float, float, float, float] | None = None
+
+
+def _table_range(knots: FloatArray) -> str:
+    return f"[{math.exp(knots[0]):.4g}, {math.exp(knots[-1]):.4g}]"
+
+
+def _raise(status: int, info: float, knots: FloatArray, where: str = "") -> NoReturn:
+    """Raise the exception of a kernel status code."""
+    span = _table_range(knots)
+    messages: dict[int, tuple[type[Exception], str]] = {
+        k.E_GRID_NONFINITE: (InvalidInputError, "grid origin or cell size is NaN or infinite"),
+        k.E_CELL_SIZE: (InvalidInputError, "cell sizes must be positive"),
+        k.E_PRESSURE_NONFINITE: (InvalidInputError, "pressure has NaN or infinite values"),
+        k.E_PRESSURE_NEGATIVE: (InvalidInputError, "negative pressure"),
+        k.E_EMPTY: (EmptyContactError, "no cell in contact (no positive pressure)"),
+        k.E_CREEPAGE: (InvalidInputError, "creepages xi, eta, phi must be finite"),
+        k.E_MU: (InvalidInputError, "mu must be positive and finite"),
+        k.E_REFERENCE: (InvalidInputError, "the reference point must be finite"),
+        k.E_TABLE_ZONE1: (OutOfTableError, f"MAE zone 1 (y < y_s): a/b = {info:.4g} lies "
+                          f"outside the tables' range {span}"),
+        k.E_TABLE_ZONE2: (OutOfTableError, f"MAE zone 2 (y > y_s): a/b = {info:.4g} lies "
+                          f"outside the tables' range {span}"),
+        k.E_TABLE_ELLIPSE: (OutOfTableError, f"equivalent ellipse: a/b = {info:.4g} lies "
+                            f"outside the tables' range {span}"),
+        k.E_PARABOLIC_MISS: (InvalidInputError,
+                             "the parabolic bound's ellipse misses every cell in contact"),
+        k.E_CELLS: (InvalidInputError,
+                    "the equivalent ellipse needs at least 2 cells along each axis"),
+    }
+    error, text = messages.get(status, (RuntimeError, f"unknown kernel status {status}"))
+    raise error(where + text)
+
+
+def _readonly(a: FloatArray) -> FloatArray:
+    """Return ``a`` as a read-only view (GridArea's pressure is read-only).
+
+    numba compiles one specialisation per mutability: passing every pressure
+    read-only keeps it to one (and one disk-cache entry) per kernel.  A view
+    and ``setflags`` cost less than reading ``a.flags`` first.
+    """
+    a = a.view()
+    a.setflags(write=False)
+    return a
+
+
+def _pressure(pressure: ArrayLike, ndim: int) -> FloatArray:
+    p = np.ascontiguousarray(pressure, dtype=np.float64)
+    if p.ndim != ndim:
+        what = "a 2-D array (rows = lateral strips)" if ndim == 2 else \
+            "a 3-D array (patch, strip, column) or one 2-D patch"
+        raise InvalidInputError(f"pressure must be {what}, got shape {p.shape}")
+    return _readonly(p)
+
+
+def _bound(bound: str) -> bool:
+    """Return whether the bound is the parabolic one."""
+    if bound == "given":
+        return False
+    if bound == "parabolic":
+        return True
+    raise InvalidInputError(f"unknown traction bound {bound!r}: given or parabolic")
+
+
+def _per_item(value: ArrayLike, size: int, name: str) -> FloatArray:
+    """Return a scalar or a ``(size,)`` array as a contiguous ``(size,)`` float array."""
+    a = np.asarray(value, dtype=np.float64)
+    if a.ndim == 0:
+        return np.full(size, float(a))
+    if a.shape != (size,):
+        raise InvalidInputError(f"{name} must be a scalar or have shape ({size},), "
+                                f"got {a.shape}")
+    return np.ascontiguousarray(a)
+
+
+def _batch_inputs(pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
+                  dy: ArrayLike, creepages: ArrayLike,
+                  mu: ArrayLike) -> tuple[FloatArray, list[FloatArray], FloatArray, FloatArray]:
+    ps = np.asarray(pressures, dtype=np.float64)
+    if ps.ndim == 2:
+        ps = ps[None]
+    ps = _pressure(ps, 3)
+    cr = np.ascontiguousarray(creepages, dtype=np.float64)
+    if cr.ndim != 2 or cr.shape[1] != 3:
+        raise InvalidInputError(f"creepages must have shape (B, 3) (xi, eta, phi), "
+                                f"got {cr.shape}")
+    size = cr.shape[0]
+    if ps.shape[0] not in (1, size):
+        raise InvalidInputError(f"{ps.shape[0]} patches for {size} creepages: give one "
+                                "patch or one per creepage")
+    named = ((x0, "x0"), (y0, "y0"), (dx, "dx"), (dy, "dy"))
+    grid = [_per_item(v, size, name) for v, name in named]
+    return ps, grid, cr, _per_item(mu, size, "mu")
+
+
+class _Solver:
+    """What both solvers share: the material and the packed coefficient tables."""
+
+    def __init__(self, nu: float, shear_modulus: float) -> None:
+        if not (math.isfinite(shear_modulus) and shear_modulus > 0.0):
+            raise InvalidInputError(f"shear modulus must be positive, got {shear_modulus}")
+        table = coefficient_table(float(nu))  # refuses nu outside the tables
+        self.nu = float(nu)
+        self.shear_modulus = float(shear_modulus)
+        self._knots = np.ascontiguousarray(table.knots, dtype=np.float64)
+        self._polys = np.ascontiguousarray(np.stack([table.poly[name]
+                                                     for name in k.TABLE_NAMES]))
+
+    def _outputs(self, shape: tuple[int, int],
+                 tractions: bool) -> tuple[FloatArray, FloatArray, BoolArray]:
+        if not tractions:
+            return _NO_FLOAT, _NO_FLOAT, _NO_BOOL
+        return np.empty(shape), np.empty(shape), np.empty(shape, dtype=np.bool_)
+
+    def solve(self, area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
+              reference: tuple[float, float] = (0.0, 0.0), bound: Bound = "given",
+              tractions: bool = False) -> ContactForces:
+        """Solve at creepages ``xi``, ``eta`` (1) and spin ``phi`` (1/m) about ``reference`` (m).
+
+        ``mu``: friction coefficient; ``bound``: ``"given"`` (``g = mu p``)
+        or ``"parabolic"`` (Kalker's, on the patch's equivalent ellipse);
+        ``tractions``: also return the traction field.
+        """
+        return self._solve(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,
+                           mu, reference, bound, tractions)
+
+    def solve_arrays(self, pressure: ArrayLike, x0: float, y0: float, dx: float, dy: float,
+                     xi: float, eta: float, phi: float, mu: float, *,
+                     reference: tuple[float, float] = (0.0, 0.0), bound: Bound = "given",
+                     tractions: bool = False) -> ContactForces:
+        """Solve on the pressure ``p[j, i]`` (Pa) of the grid ``x0, y0, dx, dy`` (m).
+
+        The grid as in :class:`~fastsim_ros.contact.area.GridArea` (``(x0,
+        y0)`` the centre of cell ``[0, 0]``); the rest as :meth:`solve`.
+        """
+        return self._solve(_pressure(pressure, 2), x0, y0, dx, dy, xi, eta, phi, mu,
+                           reference, bound, tractions)
+
+    def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+               eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
+               tractions: bool) -> ContactForces:
+        raise NotImplementedError
+
+    def _forces(self, result: tuple[Any, ...], grid: tuple[float, float, float, float],
+                out: tuple[FloatArray, FloatArray, BoolArray], tractions: bool) -> ContactForces:
+        status, info, fx, fy, mz, load, nslip, ncontact = result
+        if status:
+            _raise(status, info, self._knots)
+        if tractions:
+            return ContactForces(fx, fy, mz, load, nslip / ncontact, out[0], out[1], out[2],
+                                 grid)
+        return ContactForces(fx, fy, mz, load, nslip / ncontact)
+
+
+class MaeSolver(_Solver):
+    """MAE + FastSim (:func:`fastsim_ros.contact.mae.mae_fastsim`), compiled.
+
+    ``nu``: combined Poisson ratio (the tables' range); ``shear_modulus``:
+    combined ``G`` (Pa); ``rule``: the split rule
+    (:func:`~fastsim_ros.contact.mae.split_face`).
+    """
+
+    def __init__(self, nu: float, shear_modulus: float, *,
+                 rule: Rule = "widest_strip") -> None:
+        super().__init__(nu, shear_modulus)
+        if rule not in _RULES:
+            raise InvalidInputError(f"unknown split rule {rule!r}: widest_strip or centroid")
+        self.rule: Rule = rule
+        self._rule = _RULES[rule]
+
+    def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+               eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
+               tractions: bool) -> ContactForces:
+        tractions = bool(tractions)
+        out = self._outputs(p.shape, tractions)  # type: ignore[arg-type]
+        grid = (float(x0), float(y0), float(dx), float(dy))
+        result = k.mae_solve(p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta),
+                             float(phi), float(mu), float(reference[0]), float(reference[1]),
+                             self._rule, _bound(bound), self.shear_modulus, self._knots,
+                             self._polys, out[0], out[1], out[2], tractions)
+        return self._forces(result, grid, out, tractions)
+
+    def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
+                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike,
+                    reference: tuple[float, float] = (0.0, 0.0),
+                    bound: Bound = "given") -> FloatArray:
+        """Solve a batch in one compiled loop; return ``(B, 3)``: ``Fx, Fy`` (N), ``Mz`` (N m).
+
+        ``pressures``: ``(B, ny, nx)`` (Pa), or one ``(ny, nx)`` patch for
+        every creepage; ``x0 .. dy`` (m) and ``mu``: scalars or ``(B,)``;
+        ``creepages``: ``(B, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about
+        ``reference`` (m).  Item ``b`` equals ``solve_arrays`` on it.
+        """
+        ps, grid, cr, mus = _batch_inputs(pressures, x0, y0, dx, dy, creepages, mu)
+        out = np.empty((cr.shape[0], 3))
+        status, index, info = k.mae_batch(ps, grid[0], grid[1], grid[2], grid[3], cr, mus,
+                                          float(reference[0]), float(reference[1]),
+                                          self._rule, _bound(bound), self.shear_modulus,
+                                          self._knots, self._polys, out)
+        if status:
+            _raise(status, info, self._knots, f"batch item {index}: ")
+        return out
+
+    def _prepare(self, area: GridArea) -> tuple[int, float, FloatArray]:
+        geo = np.empty(k.GEO_SIZE)
+        env = np.empty((2, area.nx), dtype=np.int64)
+        status, info = k.mae_prepare(_readonly(area.pressure), float(area.x0), float(area.y0),
+                                     float(area.dx), float(area.dy), self._rule,
+                                     self.shear_modulus, self._knots, self._polys, geo, env)
+        return status, info, geo
+
+    def geometry(self, area: GridArea) -> MaeGeometry:
+        """Return MAE steps 1-3 (centroid, split line, zones) as the reference's dataclass."""
+        from fastsim_ros.contact.mae import MaeGeometry, Zone
+        status, info, geo = self._prepare(area)
+        if status not in (k.OK, k.E_TABLE_ZONE1, k.E_TABLE_ZONE2):  # no table needed here
+            _raise(status, info, self._knots)
+        zones = [Zone(*(float(v) for v in geo[base:base + 6]))
+                 for base in (k.G_ZONE1, k.G_ZONE2)]
+        return MaeGeometry(float(geo[k.G_XC]), float(geo[k.G_YC]), float(geo[k.G_YS]),
+                           self.rule, zones[0], zones[1], float(geo[k.G_AREA]))
+
+    def flexibility(self, area: GridArea) -> tuple[ZoneFlexibility | None,
+                                                   ZoneFlexibility | None]:
+        """Return each zone's ``L1 .. L4`` (m/Pa), ``None`` for an empty zone."""
+        from fastsim_ros.contact.mae import ZoneFlexibility
+        status, info, geo = self._prepare(area)
+        if status:
+            _raise(status, info, self._knots)
+        return tuple(None if geo[zone] <= 0.0 else  # type: ignore[return-value]
+                     ZoneFlexibility(*(float(v) for v in geo[flex:flex + 4]))
+                     for zone, flex in ((k.G_ZONE1, k.G_FLEX1), (k.G_ZONE2, k.G_FLEX2)))
+
+
+class EquivalentEllipseSolver(_Solver):
+    """Plain FastSim on the patch's equivalent ellipse (the baseline), compiled.
+
+    :func:`fastsim_ros.contact.equivalent.equivalent_fastsim`: the ellipse
+    of the patch's area, centroid and second-moment ratio, discretised on
+    ``cells`` x ``cells`` cells (default ``max(nx, ny)`` of the patch), with
+    Kalker's flexibilities and a Hertzian (``bound="given"``) or parabolic
+    pressure of the patch's load.  ``nu``, ``shear_modulus`` (Pa) as
+    :class:`MaeSolver`.
+    """
+
+    def __init__(self, nu: float, shear_modulus: float, *, cells: int | None = None) -> None:
+        super().__init__(nu, shear_modulus)
+        if cells is not None and not cells >= 2:
+            raise InvalidInputError(f"cells must be at least 2, got {cells}")
+        self.cells = None if cells is None else int(cells)
+
+    def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+               eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
+               tractions: bool) -> ContactForces:
+        tractions = bool(tractions)
+        n = self.cells or max(p.shape)
+        out = self._outputs((n, n), tractions)
+        result = k.equivalent_solve(p, float(x0), float(y0), float(dx), float(dy), float(xi),
+                                    float(eta), float(phi), float(mu), float(reference[0]),
+                                    float(reference[1]), _bound(bound), n,
+                                    self.shear_modulus, self._knots, self._polys, out[0],
+                                    out[1], out[2], tractions)
+        grid = (math.nan,) * 4
+        if tractions and result[0] == k.OK:
+            e = self._ellipse(p, x0, y0, dx, dy)
+            # exactly the grid of area.ellipse(a, b, nx=n, ny=n).shifted(x_c, y_c)
+            grid = (-e.a + (e.a - -e.a) / n * 0.5 + e.x_c, -e.b + (e.b - -e.b) / n * 0.5 + e.y_c,
+                    2 * e.a / n, 2 * e.b / n)
+        return self._forces(result, grid, out, tractions)  # type: ignore[arg-type]
+
+    def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
+                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike,
+                    reference: tuple[float, float] = (0.0, 0.0),
+                    bound: Bound = "given") -> FloatArray:
+        """Solve a batch in one compiled loop: as :meth:`MaeSolver.solve_batch`."""
+        ps, grid, cr, mus = _batch_inputs(pressures, x0, y0, dx, dy, creepages, mu)
+        out = np.empty((cr.shape[0], 3))
+        status, index, info = k.equivalent_batch(
+            ps, grid[0], grid[1], grid[2], grid[3], cr, mus, float(reference[0]),
+            float(reference[1]), _bound(bound), self.cells or 0, self.shear_modulus,
+            self._knots, self._polys, out)
+        if status:
+            _raise(status, info, self._knots, f"batch item {index}: ")
+        return out
+
+    def _ellipse(self, p: FloatArray, x0: float, y0: float, dx: float,
+                 dy: float) -> EquivalentEllipse:
+        from fastsim_ros.contact.equivalent import EquivalentEllipse
+        ell = np.empty(k.ELL_SIZE)
+        status, info = k.equivalent_prepare(p, float(x0), float(y0), float(dx), float(dy),
+                                            self.shear_modulus, self._knots, self._polys, ell)
+        if status not in (k.OK, k.E_TABLE_ELLIPSE):  # no table needed for the ellipse
+            _raise(status, info, self._knots)
+        return EquivalentEllipse(*(float(v) for v in ell[k.E_XC:k.E_B + 1]))
+
+    def ellipse(self, area: GridArea) -> EquivalentEllipse:
+        """Return the area's equivalent ellipse: centre and semi-axes (m)."""
+        return self._ellipse(_readonly(area.pressure), area.x0, area.y0, area.dx, area.dy)
+
+
+def warm_up() -> float:
+    """Compile (or load from the disk cache) every kernel on a tiny patch; return seconds.
+
+    Call it at start-up so that the first real solve does not pay for the
+    compilation.
+    """
+    start = time.perf_counter()
+    area = GridArea(-1.0, -1.0, 0.4, 0.4, np.array(
+        [[0.0, 1.0, 2.0, 1.0, 0.0], [1.0, 2.0, 3.0, 2.0, 1.0], [1.0, 3.0, 4.0, 3.0, 1.0],
+         [1.0, 2.0, 3.0, 2.0, 1.0], [0.0, 1.0, 2.0, 1.0, 0.0]]))
+    creep = np.array([[1e-3, 0.0, 0.1], [0.0, -1e-3, 0.0]])
+    for solver in (MaeSolver(0.28, 8e10), EquivalentEllipseSolver(0.28, 8e10)):
+        solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3)
+        solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3, tractions=True)
+        solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, creep, mu=0.3)
+        if isinstance(solver, MaeSolver):
+            solver.geometry(area)
+        else:
+            solver.ellipse(area)
+    return time.perf_counter() - start

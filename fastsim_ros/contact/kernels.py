@@ -1,0 +1,947 @@
+"""Compiled kernels (numba) of FastSim, MAE and the equivalent-ellipse baseline.
+
+The fast path of :mod:`fastsim_ros.contact.compiled`; the numpy modules
+(:mod:`~fastsim_ros.contact.fastsim`, :mod:`~fastsim_ros.contact.mae`,
+:mod:`~fastsim_ros.contact.equivalent`) stay the readable reference.  The
+kernels repeat the reference's formulas with its order of floating-point
+operations, except where noted (the order of sums; centroid and second
+moments from exact integer index sums; the ellipse's pressure computed on
+one quadrant and mirrored; ``sqrt(tau_x^2 + tau_y^2)`` for ``hypot`` away
+from the traction bound), so the two agree to a few ulps.  No ROS import.
+
+Conventions (METHOD.md 1-3): pressure ``p[j, i]`` (Pa) on a regular grid,
+row ``j`` = lateral strip at ``y0 + j dy``, column ``i`` at ``x0 + i dx``
+(m), leading edge at the larger ``x``; a cell is in contact where ``p > 0``.
+
+Errors are not raised here (a raise cannot carry the typed exceptions of
+:mod:`~fastsim_ros.contact.errors`): kernels return a status code (``OK``
+or one of the ``E_*`` constants below) and the Python layer raises the
+matching exception.  ``error_model="numpy"``: a division by zero gives
+``inf``/``nan`` as in the numpy reference instead of an exception, and the
+loops carry no zero-divisor checks.
+
+Coefficient tables are passed as ``knots`` (``log a/b``, shape ``(K,)``) and
+``polys`` (shape ``(len(TABLE_NAMES), 4, K - 1)``): the cubic-spline
+coefficients of :class:`~fastsim_ros.contact.tables.CoefficientTable`, in the
+order of :data:`TABLE_NAMES`.
+
+Column envelopes ``env`` (``int64``, shape ``(2, nx)``): the cells of column
+``i`` that can be in contact lie in rows ``env[0, i] <= j < env[1, i]``.
+The sweep visits only those, so the cells around a patch cost nothing.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+#: order of the coefficients in the ``polys`` array
+TABLE_NAMES = ("C11", "C22", "C23", "C33", "c11", "c12", "c13", "c21", "c22", "c23")
+I_C11, I_C22, I_C23 = 0, 1, 2
+I_H11, I_H13, I_H22, I_H23 = 4, 6, 8, 9
+
+#: split rules of :func:`fastsim_ros.contact.mae.split_face`
+RULE_WIDEST_STRIP, RULE_CENTROID = 0, 1
+
+#: status codes of the kernels
+OK = 0
+E_GRID_NONFINITE = 1      # x0, y0, dx or dy is NaN or infinite
+E_CELL_SIZE = 2           # dx or dy not positive
+E_PRESSURE_NONFINITE = 3  # a pressure value is NaN or infinite
+E_PRESSURE_NEGATIVE = 4   # a pressure value is negative
+E_EMPTY = 5               # no cell with positive pressure
+E_CREEPAGE = 6            # xi, eta or phi not finite
+E_MU = 7                  # mu not positive and finite
+E_REFERENCE = 8           # reference point not finite
+E_TABLE_ZONE1 = 9         # zone 1's a/b outside the table (info: a/b)
+E_TABLE_ZONE2 = 10        # zone 2's a/b outside the table (info: a/b)
+E_TABLE_ELLIPSE = 11      # the equivalent ellipse's a/b outside the table (info: a/b)
+E_PARABOLIC_MISS = 12     # the parabolic bound's ellipse misses every cell in contact
+E_CELLS = 13              # fewer than 2 cells for the equivalent ellipse's grid
+
+#: layout of the MAE geometry vector ``geo`` (see :func:`mae_prepare`)
+G_XC, G_YC, G_YS, G_FACE, G_NCONTACT, G_LOAD, G_AREA = 0, 1, 2, 3, 4, 5, 6
+G_ZONE1, G_ZONE2 = 7, 13    # each: area, a, b, a/b, a_eq, b_eq
+G_FLEX1, G_FLEX2 = 19, 23   # each: L1, L2, L3, L4
+G_ELLIPSE = 27              # the patch's equivalent ellipse x_c, y_c, a, b
+GEO_SIZE = 31
+
+#: layout of the equivalent-ellipse vector ``ell`` (see :func:`equivalent_prepare`)
+E_XC, E_YC, E_A, E_B, E_LOAD, E_L1, E_L2, E_L3 = 0, 1, 2, 3, 4, 5, 6, 7
+ELL_SIZE = 8
+
+# |tau|^2 <= (1 - 1e-12) g^2 proves |tau| < g without a square root: the
+# reference's slip test (hypot, exact to an ulp) gives the same answer there
+_NO_SLIP = 1.0 - 1e-12
+# within this relative distance of the bound the slip test uses hypot, as the
+# reference does, so that the slip flags agree even on the bound
+_ON_BOUND = 1e-12
+
+
+# ---------------------------------------------------------------- input checks
+
+
+@njit(cache=True, error_model="numpy")
+def check_grid(x0, y0, dx, dy):
+    """Return the status of a grid origin ``(x0, y0)`` and cell size ``(dx, dy)`` (m)."""
+    if not (math.isfinite(x0) and math.isfinite(y0) and math.isfinite(dx)
+            and math.isfinite(dy)):
+        return E_GRID_NONFINITE
+    if not (dx > 0.0 and dy > 0.0):
+        return E_CELL_SIZE
+    return OK
+
+
+@njit(cache=True, error_model="numpy")
+def check_solve_inputs(xi, eta, phi, mu, xp, yp):
+    """Return the status of the creepages (1, 1, 1/m), ``mu`` and the reference point (m)."""
+    if not (math.isfinite(xi) and math.isfinite(eta) and math.isfinite(phi)):
+        return E_CREEPAGE
+    if not (math.isfinite(mu) and mu > 0.0):
+        return E_MU
+    if not (math.isfinite(xp) and math.isfinite(yp)):
+        return E_REFERENCE
+    return OK
+
+
+@njit(cache=True, error_model="numpy")
+def scan_moments(p, count):
+    """Validate a pressure grid (Pa) and sum what the centroid and second moments need.
+
+    Fills ``count[j]``, the cells in contact of strip ``j``.  Return
+    ``(status, n, si, sj, sii, sjj, psum)``: cells in contact, the sums of
+    their column and row indices and of the squares (exact integers), and
+    the sum of ``p``.  Non-finite values are reported before negative ones,
+    as :class:`~fastsim_ros.contact.area.GridArea` does.  Branch-free, so
+    that the compiler vectorises it: counts per column, not sums per cell.
+    """
+    ny, nx = p.shape
+    # one running sum per column: additions that do not wait for each other
+    colsum = np.zeros(nx)
+    colcount = np.zeros(nx, dtype=np.int64)
+    negative = 0
+    n = 0
+    sj = 0
+    sjj = 0
+    for j in range(ny):
+        c = 0
+        for i in range(nx):
+            v = p[j, i]
+            colsum[i] += v
+            pos = v > 0.0
+            colcount[i] += pos
+            c += pos
+            negative += v < 0.0
+        count[j] = c
+        n += c
+        sj += c * j
+        sjj += c * j * j
+    psum = 0.0
+    si = 0
+    sii = 0
+    for i in range(nx):
+        psum += colsum[i]
+        si += i * colcount[i]
+        sii += i * i * colcount[i]
+    if not math.isfinite(psum):
+        # NaN and inf propagate into the sums: only then look for them cell by cell
+        for j in range(ny):
+            for i in range(nx):
+                if not math.isfinite(p[j, i]):
+                    return E_PRESSURE_NONFINITE, 0, 0, 0, 0, 0, 0.0
+    if negative:
+        return E_PRESSURE_NEGATIVE, 0, 0, 0, 0, 0, 0.0
+    if n == 0:
+        return E_EMPTY, 0, 0, 0, 0, 0, 0.0
+    return OK, n, si, sj, sii, sjj, psum
+
+
+@njit(cache=True, error_model="numpy")
+def scan_patch(p, count, first, last, env):
+    """Run :func:`scan_moments`, then find the strips' extents and the column envelopes.
+
+    Fills ``count``, ``first[j]`` and ``last[j]`` (first and last cell in
+    contact of strip ``j``, 0 if none) and ``env``; returns what
+    :func:`scan_moments` returns.  The extents are searched from the ends of
+    each strip and column, so they cost the cells outside the contact only.
+    """
+    ny, nx = p.shape
+    result = scan_moments(p, count)
+    if result[0] != OK:
+        return result
+    for j in range(ny):
+        f = 0
+        e = 0
+        if count[j] > 0:
+            while not p[j, f] > 0.0:
+                f += 1
+            e = nx - 1
+            while not p[j, e] > 0.0:
+                e -= 1
+        first[j] = f
+        last[j] = e
+    for i in range(nx):
+        lo = 0
+        while lo < ny and not p[lo, i] > 0.0:
+            lo += 1
+        hi = ny
+        if lo < ny:
+            while not p[hi - 1, i] > 0.0:
+                hi -= 1
+        else:
+            lo = ny
+            hi = 0
+        env[0, i] = lo
+        env[1, i] = hi
+    return result
+
+
+# ---------------------------------------------------------------- tables
+
+
+@njit(cache=True, error_model="numpy")
+def in_table(knots, a_over_b):
+    """Whether ``a/b`` lies in the tables' range (``tables._log_ratio``'s test)."""
+    if not (math.isfinite(a_over_b) and a_over_b > 0.0):
+        return False
+    t = math.log(a_over_b)
+    return knots[0] - 1e-12 <= t <= knots[knots.shape[0] - 1] + 1e-12
+
+
+@njit(cache=True, error_model="numpy")
+def spline(knots, poly, t):
+    """Evaluate one coefficient's cubic at ``t = log(a/b)``; ``poly`` has shape ``(4, K - 1)``.
+
+    The interval is ``searchsorted(knots, t) - 1`` clipped to the table, as
+    :meth:`~fastsim_ros.contact.tables.CoefficientTable.__call__` picks it.
+    """
+    lo = 0
+    hi = knots.shape[0]
+    while lo < hi:  # first knot >= t (numpy's searchsorted, side="left")
+        mid = (lo + hi) // 2
+        if knots[mid] < t:
+            lo = mid + 1
+        else:
+            hi = mid
+    k = min(max(lo - 1, 0), knots.shape[0] - 2)
+    u = t - knots[k]
+    return ((poly[0, k] * u + poly[1, k]) * u + poly[2, k]) * u + poly[3, k]
+
+
+@njit(cache=True, error_model="numpy")
+def table_value(knots, polys, index, a_over_b):
+    """Return coefficient ``TABLE_NAMES[index]`` at ``a/b`` (no range check)."""
+    return spline(knots, polys[index], math.log(a_over_b))
+
+
+# ---------------------------------------------------------------- flexibilities
+
+
+@njit(cache=True, error_model="numpy")
+def half_flexibility(a, b, c11, c13, c22, c23, shear_modulus):
+    """Return MAE's ``(L1, L2, L3, L4)`` (m/Pa) of a semi-ellipse ``a``, ``b`` (m).
+
+    ``L1 = 4a/(3 G c11)``, ``L2 = 4a/(3 G c22)``,
+    ``L3 = pi a^1.5/(8 G sqrt(b) c23)``, ``L4 = sqrt(a b)/(2 G c13)``
+    (``inf`` where ``c13 <= 0``); as :func:`fastsim_ros.contact.mae.zone_flexibility`.
+    """
+    g = shear_modulus
+    l4 = math.sqrt(a * b) / (2.0 * g * c13) if c13 > 0.0 else math.inf
+    return (4.0 * a / (3.0 * g * c11), 4.0 * a / (3.0 * g * c22),
+            math.pi * a**1.5 / (8.0 * g * math.sqrt(b) * c23), l4)
+
+
+@njit(cache=True, error_model="numpy")
+def kalker_flexibility(a, b, c11, c22, c23, shear_modulus):
+    """Return Kalker's ``(L1, L2, L3)`` (m/Pa) of an ellipse ``a``, ``b`` (m).
+
+    As :func:`fastsim_ros.contact.fastsim.kalker_flexibility`.
+    """
+    return (8.0 * a / (3.0 * shear_modulus * c11), 8.0 * a / (3.0 * shear_modulus * c22),
+            math.pi * a * math.sqrt(a / b) / (4.0 * shear_modulus * c23))
+
+
+# ---------------------------------------------------------------- the sweep
+
+
+@njit(cache=True, error_model="numpy")
+def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
+          out_x, out_y, slip, store):
+    """March every strip from its leading edge; return ``(Fx, Fy, Mz, slipping, in contact)``.
+
+    The kernel of :func:`fastsim_ros.contact.fastsim.sweep` and the
+    resultants of :func:`~fastsim_ros.contact.fastsim.fastsim`.  The
+    traction bound (Pa) of cell ``(j, i)`` is ``outer * (shape[j, i] *
+    inner)`` (``mu p`` is ``shape = p``, ``outer = mu``, ``inner = 1``; a
+    finished bound has ``outer = inner = 1``), zero outside the contact and
+    only read inside the column envelopes ``env``.  ``xi``, ``eta``, ``phi``
+    (1, 1, 1/m): the creepages at the sweep point ``(x_c, y_s)`` (m);
+    ``flex`` (m/Pa), ``(4, ny)``: each strip's ``L1, L2, L3`` and spin
+    flexibility (``L3``, or MAE's ``L4``; may be ``inf``).  ``Fx``, ``Fy``
+    (N), ``Mz`` (N m) about ``(xp, yp)`` (m), cells on the bound, cells in
+    contact.  With ``store`` the tractions (Pa) and slip flags are written
+    to ``out_x``, ``out_y``, ``slip`` (shape of ``shape``); without it
+    those are not touched (pass empty arrays).
+
+    Like the reference, the march goes column by column with the strips side
+    by side: the strips are independent, so the CPU overlaps their chains of
+    dependent operations (a strip alone is a chain of square root, division
+    and product per slipping cell, three times slower).
+    """
+    ny, nx = shape.shape
+    da = dx * dy
+    half = 0.5 * dx
+    # per-strip state, constants and partial sums in one block (one allocation)
+    w = np.empty((9, ny))
+    tx, ty, sx, sy, sm = w[0], w[1], w[2], w[3], w[4]
+    rate_x, rate_y0, rate_yx, yr = w[5], w[6], w[7], w[8]
+    # the column a strip's current segment continues into (else: a new segment)
+    cont = np.empty(ny, dtype=np.int64)
+    for j in range(ny):
+        y = y0 + dy * j
+        # constant part of the strip's rates (Pa/m), grouped as the reference does
+        rate_x[j] = xi / flex[0, j] - phi * (y - y_s) / flex[3, j]
+        rate_y0[j] = eta / flex[1, j]
+        rate_yx[j] = phi / flex[2, j]
+        yr[j] = y - yp
+        sx[j] = 0.0
+        sy[j] = 0.0
+        sm[j] = 0.0
+        cont[j] = -2
+    if store:
+        out_x[:, :] = 0.0
+        out_y[:, :] = 0.0
+        slip[:, :] = False
+    nslip = 0
+    ncontact = 0
+    for i in range(nx - 1, -1, -1):
+        x = x0 + dx * i
+        x_rel = x - x_c
+        xr = x - xp
+        for j in range(env[0, i], env[1, i]):
+            g = outer * (shape[j, i] * inner)
+            if not g > 0.0:
+                continue
+            if cont[j] == i:
+                s = dx
+                t_x = tx[j]
+                t_y = ty[j]
+            else:
+                # first cell of a segment: zero traction at its front face, half a step back
+                s = half
+                t_x = 0.0
+                t_y = 0.0
+            cont[j] = i - 1
+            x_mid = x_rel + 0.5 * s
+            t_x = t_x - rate_x[j] * s
+            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s
+            over = False
+            m2 = t_x * t_x + t_y * t_y
+            if not m2 <= _NO_SLIP * g * g:
+                mag = math.sqrt(m2)
+                if abs(mag - g) <= _ON_BOUND * g:
+                    mag = math.hypot(t_x, t_y)
+                if mag > g:
+                    scale = g / mag
+                    t_x = t_x * scale
+                    t_y = t_y * scale
+                    over = True
+                    nslip += 1
+            tx[j] = t_x
+            ty[j] = t_y
+            sx[j] += t_x
+            sy[j] += t_y
+            sm[j] += xr * t_y - yr[j] * t_x
+            ncontact += 1
+            if store:
+                out_x[j, i] = t_x
+                out_y[j, i] = t_y
+                slip[j, i] = over
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    for j in range(ny):
+        fx += sx[j]
+        fy += sy[j]
+        mz += sm[j]
+    return fx * da, fy * da, mz * da, nslip, ncontact
+
+
+# ---------------------------------------------------------------- MAE geometry
+
+
+@njit(cache=True, error_model="numpy")
+def _round_half_even(v):
+    """Python's ``round(v)`` of a float: halves go to the even neighbour."""
+    r = math.floor(v)
+    d = v - r
+    if d > 0.5 or (d == 0.5 and r % 2.0 != 0.0):
+        r += 1.0
+    return int(r)
+
+
+@njit(cache=True, error_model="numpy")
+def split_face(count, rule):
+    """Index ``f`` of the cell face the MAE split runs along, from the strips' counts.
+
+    ``count[j]``: cells in contact in strip ``j``.  The two rules of
+    :func:`fastsim_ros.contact.mae.split_face`, branch for branch.
+    """
+    ny = count.shape[0]
+    total = 0
+    moment = 0
+    for j in range(ny):
+        total += count[j]
+        moment += count[j] * j
+    yc = moment / total
+    if rule == RULE_CENTROID:
+        r0 = 0
+        while count[r0] == 0:
+            r0 += 1
+        r1 = ny - 1
+        while count[r1] == 0:
+            r1 -= 1
+        return min(max(_round_half_even(yc + 0.5), r0), r1 + 1)
+    # the band of strips sharing the longest chord (a staircase ellipse has several)
+    j0 = 0
+    for j in range(1, ny):
+        if count[j] > count[j0]:
+            j0 = j
+    j1 = j0
+    while j1 + 1 < ny and count[j1 + 1] == count[j0]:
+        j1 += 1
+    below = count[j0 - 1] if j0 > 0 else 0
+    above = count[j1 + 1] if j1 + 1 < ny else 0
+    # chords of centred shapes change by two cells at a time (one at each end)
+    drop_below = count[j0] - below
+    drop_above = count[j0] - above
+    if drop_below > drop_above + 2:
+        return j0
+    if drop_above > drop_below + 2:
+        return j1 + 1
+    width = j1 - j0 + 1
+    if width % 2 == 0:
+        return j0 + width // 2
+    middle = j0 + width // 2
+    # an odd band: the face of its middle strip nearer the centroid
+    return middle + 1 if yc > middle else middle
+
+
+@njit(cache=True, error_model="numpy")
+def zone_geometry(x0, y0, dx, dy, count, first, last, env, f, x_c, y_s, lower, out):
+    """Write one zone's ``area, a, b, a/b, a_eq, b_eq`` (m^2, m) to ``out[0:6]``.
+
+    Zone 1 (``lower``) is the strips ``j < f``, zone 2 the others;
+    ``count``, ``first``, ``last``: each strip's cells in contact, first and
+    last of them; ``env``: the column envelopes, whose ends are the zones'
+    outer edges.  Mean-square edge coordinates from cell faces, as
+    :func:`fastsim_ros.contact.mae._zone`; an empty zone gets zero area and
+    ``nan`` axes.
+    """
+    ny = count.shape[0]
+    nx = env.shape[1]
+    j_lo, j_hi = (0, f) if lower else (f, ny)
+    n = 0
+    rows = 0
+    ve_x = 0.0
+    for j in range(j_lo, j_hi):
+        if count[j] == 0:
+            continue
+        n += count[j]
+        lead = x0 + dx * last[j] + 0.5 * dx - x_c
+        trail = x0 + dx * first[j] - 0.5 * dx - x_c
+        ve_x += 0.5 * (lead**2 + trail**2)
+        rows += 1
+    if n == 0:
+        out[0] = 0.0
+        for k in range(1, 6):
+            out[k] = math.nan
+        return
+    ve_x /= rows
+    cols = 0
+    ve_y = 0.0
+    for i in range(nx):
+        # the zone's outer cell of this longitudinal line: its lowest or highest
+        if lower:
+            j = env[0, i]
+            if j < f:
+                ve_y += (y_s - (y0 + dy * j - 0.5 * dy)) ** 2
+                cols += 1
+        else:
+            j = env[1, i] - 1
+            if j >= f:
+                ve_y += (y0 + dy * j + 0.5 * dy - y_s) ** 2
+                cols += 1
+    ve_y /= cols
+    # a semi-ellipse's mean-square edge coordinates are 2/3 of its squared semi-axes
+    a = math.sqrt(1.5 * ve_x)
+    b = math.sqrt(1.5 * ve_y)
+    zone_area = n * (dx * dy)
+    g = a / b
+    a_eq = math.sqrt(2.0 * zone_area * g / math.pi)
+    out[0] = zone_area
+    out[1] = a
+    out[2] = b
+    out[3] = g
+    out[4] = a_eq
+    out[5] = a_eq / g
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy):
+    """Return ``(x_c, y_c, a, b)`` (m) of the equivalent ellipse from :func:`scan_patch`'s sums.
+
+    Centroid, area and ``a/b = sqrt(Ixx/Iyy)`` of the cells (each cell's own
+    ``dx^2/12`` included), as
+    :func:`fastsim_ros.contact.equivalent.equivalent_ellipse`.  The second
+    moments come from exact integer sums, ``(n sum i^2 - (sum i)^2)/n^2``
+    cells^2: no second pass and no cancellation (the products fit in 64 bits
+    up to about a million cells; beyond, a float formula takes over).
+    """
+    x_c = x0 + dx * (si / n)
+    y_c = y0 + dy * (sj / n)
+    if float(n) * float(max(sii, sjj)) < 4e18:
+        var_i = (n * sii - si * si) / (n * n)
+        var_j = (n * sjj - sj * sj) / (n * n)
+    else:
+        var_i = sii / n - (si / n) ** 2
+        var_j = sjj / n - (sj / n) ** 2
+    ixx = dx * dx * var_i + dx**2 / 12.0
+    iyy = dy * dy * var_j + dy**2 / 12.0
+    g = math.sqrt(ixx / iyy)
+    a = math.sqrt(n * (dx * dy) * g / math.pi)
+    return x_c, y_c, a, a / g
+
+
+@njit(cache=True, error_model="numpy")
+def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
+    """MAE steps 1-3 and 6: validate, split, size the zones, look up, give ``L1 .. L4``.
+
+    Writes ``geo`` (length :data:`GEO_SIZE`): centroid ``x_c, y_c``, split
+    line ``y_s`` (m), split face index, cells in contact, load ``N = sum p
+    dA`` (N), contact area (m^2), then each zone's ``area, a, b, a/b, a_eq,
+    b_eq``, each zone's ``L1, L2, L3, L4`` (m/Pa; ``nan`` for an empty
+    zone) and the patch's equivalent ellipse ``x_c, y_c, a, b`` (m); and the
+    column envelopes ``env`` ``(2, nx)``.  Return ``(status, info)``;
+    ``info`` is the offending ``a/b`` of a zone outside the table (the
+    geometry is complete then, the flexibilities are not).
+    """
+    status = check_grid(x0, y0, dx, dy)
+    if status != OK:
+        return status, 0.0
+    ny = p.shape[0]
+    count = np.empty(ny, dtype=np.int64)
+    first = np.empty(ny, dtype=np.int64)
+    last = np.empty(ny, dtype=np.int64)
+    status, n, si, sj, sii, sjj, total = scan_patch(p, count, first, last, env)
+    if status != OK:
+        return status, 0.0
+    # the centroid from exact index sums: the reference's sum(x)/n to rounding
+    x_c = x0 + dx * (si / n)
+    y_c = y0 + dy * (sj / n)
+    e_xc, e_yc, e_a, e_b = ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy)
+    f = split_face(count, rule)
+    y_s = y0 + (f - 0.5) * dy
+    geo[G_XC] = x_c
+    geo[G_YC] = y_c
+    geo[G_YS] = y_s
+    geo[G_FACE] = f
+    geo[G_NCONTACT] = n
+    geo[G_LOAD] = total * (dx * dy)
+    geo[G_AREA] = n * (dx * dy)
+    geo[G_ELLIPSE] = e_xc
+    geo[G_ELLIPSE + 1] = e_yc
+    geo[G_ELLIPSE + 2] = e_a
+    geo[G_ELLIPSE + 3] = e_b
+    zone_geometry(x0, y0, dx, dy, count, first, last, env, f, x_c, y_s, True,
+                  geo[G_ZONE1:G_ZONE1 + 6])
+    zone_geometry(x0, y0, dx, dy, count, first, last, env, f, x_c, y_s, False,
+                  geo[G_ZONE2:G_ZONE2 + 6])
+    for k in range(8):
+        geo[G_FLEX1 + k] = math.nan
+    for zone, flex, code in ((G_ZONE1, G_FLEX1, E_TABLE_ZONE1),
+                             (G_ZONE2, G_FLEX2, E_TABLE_ZONE2)):
+        if geo[zone] <= 0.0:
+            continue
+        g = geo[zone + 3]
+        if not in_table(knots, g):
+            return code, g
+        t = math.log(g)
+        l1, l2, l3, l4 = half_flexibility(
+            geo[zone + 4], geo[zone + 5], spline(knots, polys[I_H11], t),
+            spline(knots, polys[I_H13], t), spline(knots, polys[I_H22], t),
+            spline(knots, polys[I_H23], t), shear_modulus)
+        geo[flex] = l1
+        geo[flex + 1] = l2
+        geo[flex + 2] = l3
+        geo[flex + 3] = l4
+    return OK, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def mae_strip_flexibility(geo, flex):
+    """Fill ``flex`` ``(4, ny)`` with each strip's zone ``L1, L2, L3, L4`` (m/Pa).
+
+    Strips of an empty zone carry no contact: any finite value will do (1).
+    """
+    f = int(geo[G_FACE])
+    for j in range(flex.shape[1]):
+        base = G_FLEX1 if j < f else G_FLEX2
+        for k in range(4):
+            v = geo[base + k]
+            flex[k, j] = 1.0 if math.isnan(v) else v
+
+
+# ---------------------------------------------------------------- traction bounds
+
+
+@njit(cache=True, error_model="numpy")
+def parabolic_bound(p, x0, y0, dx, dy, x_c, y_c, a, b, mu, load, bound):
+    """Fill ``bound`` with Kalker's parabolic ``g`` (Pa) of load ``load`` (N) on the cells.
+
+    ``g = mu N shape / sum(shape dA)``, ``shape = max(1 - x^2/a^2 - y^2/b^2, 0)``
+    on the cells in contact, the ellipse centred at ``(x_c, y_c)`` (m); as
+    :func:`fastsim_ros.contact.fastsim.traction_bound` with
+    ``bound="parabolic"``.  Return a status (the ellipse may miss the cells).
+    """
+    ny, nx = p.shape
+    u2 = np.empty(nx)
+    for i in range(nx):
+        u2[i] = ((x0 + dx * i - x_c) / a) ** 2
+    colsum = np.zeros(nx)
+    for j in range(ny):
+        v2 = ((y0 + dy * j - y_c) / b) ** 2
+        for i in range(nx):
+            s = max(1.0 - u2[i] - v2, 0.0) if p[j, i] > 0.0 else 0.0
+            bound[j, i] = s
+            colsum[i] += s
+    total = 0.0
+    for i in range(nx):
+        total += colsum[i]
+    total *= dx * dy
+    if not total > 0.0:
+        return E_PARABOLIC_MISS
+    k = mu * load
+    for j in range(ny):
+        for i in range(nx):
+            bound[j, i] = k * bound[j, i] / total
+    return OK
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_shape(n, a, b, hertz, shape, env):
+    """Fill ``shape`` ``(n, n)`` with an ellipse's pressure shape on its box; return its sum.
+
+    The grid of :func:`fastsim_ros.contact.area.ellipse` (``n`` cells across
+    ``[-a, a] x [-b, b]``, ``a``, ``b`` in m), Hertzian ``sqrt(1 - rho^2)``
+    or parabolic ``1 - rho^2`` (zero outside), and its column envelopes
+    ``env``.  Return ``(sum of shape, cells inside)``: the pressure of load
+    ``N`` is ``shape * (N / (sum * dA))``, as ``ellipse(..., load=N)``.
+    The shape is symmetric: it is computed on the quadrant nearest the grid
+    origin, bit for bit as the reference, and mirrored (the reference's other
+    quadrants differ by rounding; no cell comes near the edge ``rho = 1``, as
+    ``(2i + 1 - n)^2 + (2j + 1 - n)^2 = n^2`` has no integer solution).
+    """
+    hx = (a - -a) / n
+    hy = (b - -b) / n
+    h = (n + 1) // 2
+    u2 = np.empty(h)
+    v2 = np.empty(h)
+    for i in range(h):
+        u2[i] = ((-a + hx * (i + 0.5)) / a) ** 2
+    for j in range(h):
+        v2[j] = ((-b + hy * (j + 0.5)) / b) ** 2
+    total = 0.0
+    inside = 0
+    for j in range(h):
+        jm = n - 1 - j
+        wj = 1 if 2 * j + 1 == n else 2
+        for i in range(h):
+            r = 1.0 - (u2[i] + v2[j])
+            if r > 0.0:
+                s = math.sqrt(r) if hertz else r
+            else:
+                s = 0.0
+            im = n - 1 - i
+            shape[j, i] = s
+            shape[j, im] = s
+            shape[jm, i] = s
+            shape[jm, im] = s
+            # each quadrant cell stands for 4, 2 (centre line of an odd grid) or 1
+            wgt = wj * (1 if 2 * i + 1 == n else 2)
+            total += wgt * s
+            inside += wgt if r > 0.0 else 0
+    for i in range(h):
+        j = 0
+        while j < h and not 1.0 - (u2[i] + v2[j]) > 0.0:
+            j += 1
+        lo, hi = (n, 0) if j == h else (j, n - j)
+        env[0, i] = lo
+        env[1, i] = hi
+        env[0, n - 1 - i] = lo
+        env[1, n - 1 - i] = hi
+    return total, inside
+
+
+# ---------------------------------------------------------------- equivalent ellipse
+
+
+@njit(cache=True, error_model="numpy")
+def equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell):
+    """Validate the patch, find its equivalent ellipse and Kalker's ``L1 .. L3``.
+
+    Writes ``ell`` (length :data:`ELL_SIZE`): ``x_c, y_c, a, b`` (m), the
+    patch's load (N), ``L1, L2, L3`` (m/Pa).  Return ``(status, info)``,
+    ``info`` the ellipse's ``a/b`` when outside the table (the ellipse is
+    written then, the flexibilities are not).
+    """
+    status = check_grid(x0, y0, dx, dy)
+    if status != OK:
+        return status, 0.0
+    count = np.empty(p.shape[0], dtype=np.int64)
+    status, n, si, sj, sii, sjj, total = scan_moments(p, count)
+    if status != OK:
+        return status, 0.0
+    x_c, y_c, a, b = ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy)
+    ell[E_XC] = x_c
+    ell[E_YC] = y_c
+    ell[E_A] = a
+    ell[E_B] = b
+    ell[E_LOAD] = total * (dx * dy)
+    ratio = a / b
+    if not in_table(knots, ratio):
+        return E_TABLE_ELLIPSE, ratio
+    t = math.log(ratio)
+    l1, l2, l3 = kalker_flexibility(a, b, spline(knots, polys[I_C11], t),
+                                    spline(knots, polys[I_C22], t),
+                                    spline(knots, polys[I_C23], t), shear_modulus)
+    ell[E_L1] = l1
+    ell[E_L2] = l2
+    ell[E_L3] = l3
+    return OK, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, out_x, out_y, slip,
+                     store):
+    """Plain FastSim on the equivalent ellipse's ``n`` x ``n`` grid, bound ``mu shape scale``.
+
+    The grid of ``ellipse(a, b, nx=n, ny=n).shifted(x_c, y_c)``; Kalker's
+    flexibilities on every strip, spin flexibility ``L3``, sweep point the
+    ellipse's centre.  Return as :func:`sweep`.
+    """
+    n = shape.shape[0]
+    x_c = ell[E_XC]
+    y_c = ell[E_YC]
+    a = ell[E_A]
+    b = ell[E_B]
+    gx0 = -a + (a - -a) / n * 0.5 + x_c
+    gy0 = -b + (b - -b) / n * 0.5 + y_c
+    flex = np.empty((4, n))
+    for j in range(n):
+        flex[0, j] = ell[E_L1]
+        flex[1, j] = ell[E_L2]
+        flex[2, j] = ell[E_L3]
+        flex[3, j] = ell[E_L3]
+    xi_s = xi + phi * (yp - y_c)
+    eta_s = eta - phi * (xp - x_c)
+    return sweep(shape, mu, scale, env, gx0, gy0, 2 * a / n, 2 * b / n, xi_s, eta_s, phi,
+                 flex, x_c, y_c, xp, yp, out_x, out_y, slip, store)
+
+
+# ---------------------------------------------------------------- whole solves
+
+
+@njit(cache=True, error_model="numpy")
+def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, phi, xp, yp,
+              out_x, out_y, slip, store):
+    """MAE step 7: FastSim with each zone's ``L``'s, creepages moved to ``S = (x_c, y_s)``.
+
+    The bound is ``mu p``, or with ``parabolic`` the finished ``bound`` (Pa).
+    """
+    x_c = geo[G_XC]
+    y_s = geo[G_YS]
+    xi_s = xi + phi * (yp - y_s)
+    eta_s = eta - phi * (xp - x_c)
+    if parabolic:
+        return sweep(bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s,
+                     xp, yp, out_x, out_y, slip, store)
+    return sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
+                 out_x, out_y, slip, store)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_bound(p, x0, y0, dx, dy, geo, mu, bound):
+    """Fill ``bound`` with the parabolic bound (Pa) on the patch's equivalent ellipse."""
+    e = G_ELLIPSE
+    return parabolic_bound(p, x0, y0, dx, dy, geo[e], geo[e + 1], geo[e + 2], geo[e + 3], mu,
+                           geo[G_LOAD], bound)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+              shear_modulus, knots, polys, out_x, out_y, slip, store):
+    """Solve MAE + FastSim on one patch (:func:`fastsim_ros.contact.mae.mae_fastsim`).
+
+    ``p`` (Pa) on the grid ``x0, y0, dx, dy`` (m); creepages ``xi``, ``eta``
+    (1), ``phi`` (1/m) about ``(xp, yp)`` (m); ``parabolic``: Kalker's
+    parabolic bound on the patch's equivalent ellipse instead of ``mu p``.
+    Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells in
+    contact)`` (N, N, N m, N).
+    """
+    status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
+    if status != OK:
+        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
+    ny, nx = p.shape
+    geo = np.empty(GEO_SIZE)
+    env = np.empty((2, nx), dtype=np.int64)
+    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env)
+    if status != OK:
+        return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
+    # the given bound is mu p, applied in the sweep: no array for it
+    bound = np.empty((ny, nx) if parabolic else (0, 0))
+    if parabolic:
+        status = mae_bound(p, x0, y0, dx, dy, geo, mu, bound)
+        if status != OK:
+            return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
+    flex = np.empty((4, ny))
+    mae_strip_flexibility(geo, flex)
+    fx, fy, mz, nslip, _ = mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex,
+                                     xi, eta, phi, xp, yp, out_x, out_y, slip, store)
+    return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT])
+
+
+@njit(cache=True, error_model="numpy")
+def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
+                     shear_modulus, knots, polys, out_x, out_y, slip, store):
+    """Solve plain FastSim on the patch's equivalent ellipse (:func:`equivalent_fastsim`).
+
+    ``n``: cells across the ellipse's box along each axis (``n >= 2``);
+    ``parabolic``: Kalker's parabolic pressure on the ellipse, else
+    Hertzian.  Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells
+    in contact of the ellipse grid)``; the tractions, if stored, are on that
+    grid.
+    """
+    status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
+    if status != OK:
+        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
+    if n < 2:
+        return E_CELLS, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
+    ell = np.empty(ELL_SIZE)
+    status, info = equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell)
+    if status != OK:
+        return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
+    shape = np.empty((n, n))
+    env = np.empty((2, n), dtype=np.int64)
+    a = ell[E_A]
+    b = ell[E_B]
+    total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
+    scale = ell[E_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
+    fx, fy, mz, nslip, ncontact = equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi,
+                                                   xp, yp, out_x, out_y, slip, store)
+    return OK, 0.0, fx, fy, mz, ell[E_LOAD], nslip, ncontact
+
+
+# ---------------------------------------------------------------- batches
+
+
+@njit(cache=True, error_model="numpy")
+def _same_patch(b, pb, prev_pb, x0, y0, dx, dy):
+    """Whether item ``b`` has the patch and grid of item ``b - 1`` (its setup can be reused)."""
+    return (b > 0 and pb == prev_pb and x0[b] == x0[b - 1] and y0[b] == y0[b - 1]
+            and dx[b] == dx[b - 1] and dy[b] == dy[b - 1])
+
+
+@njit(cache=True, error_model="numpy")
+def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modulus,
+              knots, polys, out):
+    """MAE + FastSim on a batch; write ``Fx, Fy, Mz`` (N, N, N m) of item ``b`` to ``out[b]``.
+
+    ``ps`` ``(P, ny, nx)`` (Pa) with ``P`` = batch size, or ``P = 1`` for one
+    patch under every creepage; ``x0 .. dy`` (m), ``mu``: ``(B,)``; ``creep``
+    ``(B, 3)``: ``xi, eta, phi`` (1, 1, 1/m) about ``(xp, yp)`` (m).  The
+    geometry, look-ups and bound are redone only when the patch (or, for the
+    parabolic bound, ``mu``) changes from one item to the next.  Return
+    ``(status, index of the failing item, info)``; stops at the first error.
+    """
+    nb = creep.shape[0]
+    ny, nx = ps.shape[1], ps.shape[2]
+    geo = np.empty(GEO_SIZE)
+    env = np.empty((2, nx), dtype=np.int64)
+    bound = np.empty((ny, nx))
+    flex = np.empty((4, ny))
+    empty_f = np.empty((0, 0))
+    empty_b = np.empty((0, 0), dtype=np.bool_)
+    prev_pb = -1
+    for b in range(nb):
+        pb = b if ps.shape[0] > 1 else 0
+        xi, eta, phi = creep[b, 0], creep[b, 1], creep[b, 2]
+        status = check_solve_inputs(xi, eta, phi, mu[b], xp, yp)
+        if status != OK:
+            return status, b, 0.0
+        p = ps[pb]
+        same = _same_patch(b, pb, prev_pb, x0, y0, dx, dy)
+        if not same:
+            status, info = mae_prepare(p, x0[b], y0[b], dx[b], dy[b], rule, shear_modulus,
+                                       knots, polys, geo, env)
+            if status != OK:
+                return status, b, info
+            mae_strip_flexibility(geo, flex)
+        if parabolic and not (same and mu[b] == mu[b - 1]):
+            status = mae_bound(p, x0[b], y0[b], dx[b], dy[b], geo, mu[b], bound)
+            if status != OK:
+                return status, b, 0.0
+        prev_pb = pb
+        fx, fy, mz, _, _ = mae_sweep(p, mu[b], parabolic, bound, env, x0[b], y0[b], dx[b],
+                                     dy[b], geo, flex, xi, eta, phi, xp, yp, empty_f, empty_f,
+                                     empty_b, False)
+        out[b, 0] = fx
+        out[b, 1] = fy
+        out[b, 2] = mz
+    return OK, -1, 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def equivalent_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, parabolic, n, shear_modulus,
+                     knots, polys, out):
+    """Equivalent-ellipse FastSim on a batch; the layout and return of :func:`mae_batch`.
+
+    ``n``: cells across each ellipse's box (``<= 0``: ``max(nx, ny)``).
+    """
+    nb = creep.shape[0]
+    ny, nx = ps.shape[1], ps.shape[2]
+    if n <= 0:
+        n = max(nx, ny)
+    if n < 2:
+        return E_CELLS, 0, 0.0
+    ell = np.empty(ELL_SIZE)
+    shape = np.empty((n, n))
+    env = np.empty((2, n), dtype=np.int64)
+    empty_f = np.empty((0, 0))
+    empty_b = np.empty((0, 0), dtype=np.bool_)
+    scale = 0.0
+    prev_pb = -1
+    for b in range(nb):
+        pb = b if ps.shape[0] > 1 else 0
+        xi, eta, phi = creep[b, 0], creep[b, 1], creep[b, 2]
+        status = check_solve_inputs(xi, eta, phi, mu[b], xp, yp)
+        if status != OK:
+            return status, b, 0.0
+        if not _same_patch(b, pb, prev_pb, x0, y0, dx, dy):
+            status, info = equivalent_prepare(ps[pb], x0[b], y0[b], dx[b], dy[b],
+                                              shear_modulus, knots, polys, ell)
+            if status != OK:
+                return status, b, info
+            a = ell[E_A]
+            bb = ell[E_B]
+            total, _ = ellipse_shape(n, a, bb, not parabolic, shape, env)
+            scale = ell[E_LOAD] / (total * ((2 * a / n) * (2 * bb / n)))
+        prev_pb = pb
+        fx, fy, mz, _, _ = equivalent_sweep(ell, shape, scale, mu[b], env, xi, eta, phi, xp,
+                                            yp, empty_f, empty_f, empty_b, False)
+        out[b, 0] = fx
+        out[b, 1] = fy
+        out[b, 2] = mz
+    return OK, -1, 0.0
