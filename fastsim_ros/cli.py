@@ -21,7 +21,7 @@ import numpy as np
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import exact
-from fastsim_ros.contact.equivalent import equivalent_ellipse, equivalent_fastsim
+from fastsim_ros.contact.equivalent import equivalent_fastsim
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 from fastsim_ros.contact.fastsim import traction_bound
 from fastsim_ros.contact.mae import mae_coefficients, mae_fastsim, mae_geometry
@@ -98,7 +98,8 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
     fo.add_argument("--method", choices=("mae", "fastsim_ellipse", "exact"), default="mae")
     fo.add_argument("--bound", choices=("given", "parabolic"), default="given",
-                    help="traction bound: the pressure as given, or Kalker's parabolic one")
+                    help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
+                    "(Kalker's on a Hertzian patch)")
     return parser
 
 
@@ -196,7 +197,7 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         raise InvalidInputError(f"mu must be positive, got {args.mu}")
     if args.load is not None and not args.load > 0.0:
         raise InvalidInputError(f"--load must be positive, got {args.load}")
-    patch, ellipse = _force_area(args)
+    patch = _force_area(args)
     result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound}
     if args.method == "exact":
         if args.bound == "parabolic":
@@ -206,7 +207,7 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
             np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
     elif args.method == "mae":
-        bound = traction_bound(patch, args.mu, bound=args.bound, ellipse=ellipse)
+        bound = traction_bound(patch, args.mu, bound=args.bound)
         res = mae_fastsim(patch, args.xi, args.eta, args.phi, bound=bound,
                           table=coefficient_table(args.nu), shear_modulus=args.shear_modulus)
         g = res.geometry
@@ -224,27 +225,19 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     return result
 
 
-Ellipse = tuple[float, float, float, float]
-
-
-def _force_area(args: argparse.Namespace) -> tuple[areas.GridArea, Ellipse]:
-    """Return the loaded area and the ellipse ``(x_c, y_c, a, b)`` of its parabolic bound."""
+def _force_area(args: argparse.Namespace) -> areas.GridArea:
+    """Return the loaded area: a patch file, or an ellipse with Hertzian pressure."""
     if args.patch is not None:
         if args.shape is not None:
             raise UsageError("give either --shape or --patch, not both")
         patch = read_patch(args.patch)
-        if args.load is not None:
-            patch = patch.with_load(args.load)
-        e = equivalent_ellipse(patch)
-        return patch, (e.x_c, e.y_c, e.a, e.b)
+        return patch if args.load is None else patch.with_load(args.load)
     if args.shape != "ellipse" or args.a is None or args.b is None:
         raise UsageError("forces need --shape ellipse --a A --b B (with --load) or --patch FILE")
     if args.load is None:
         raise UsageError("--load is required with --shape ellipse --a A --b B")
     n = args.cells or DEFAULT_CELLS[args.method + "_forces"]
-    profile = "parabolic" if args.bound == "parabolic" else "hertz"
-    ar = areas.ellipse(args.a, args.b, nx=n, ny=n, load=args.load, pressure=profile)
-    return ar, (0.0, 0.0, args.a, args.b)
+    return areas.ellipse(args.a, args.b, nx=n, ny=n, load=args.load)
 
 
 def _print_table(command: str, result: dict[str, Any]) -> None:

@@ -51,7 +51,7 @@ def test_large_creepage_saturates_at_mu_n(bound):
     a, b = 6e-3, 4e-3
     ar = areas.ellipse(a, b, nx=40, ny=40, load=2e4)
     flex, _ = kalker_fastsim(ar, a, b, 0.28, g=8e10)
-    g = traction_bound(ar, 0.3, bound=bound, ellipse=(0.0, 0.0, a, b))
+    g = traction_bound(ar, 0.3, bound=bound)
     assert g.sum() * ar.cell_area == pytest.approx(0.3 * 2e4, rel=1e-12)
     r = fastsim(ar, 0.3, -0.4, 0.0, bound=g, flexibility=flex)
     assert math.hypot(r.fx, r.fy) == pytest.approx(0.3 * 2e4, rel=1e-3)
@@ -61,6 +61,19 @@ def test_large_creepage_saturates_at_mu_n(bound):
     l1, l2 = flex.l1[0], flex.l2[0]
     assert np.arctan2(r.fy, r.fx) == pytest.approx(np.arctan2(0.4 / l2, -0.3 / l1), abs=1e-3)
     assert r.slip[ar.mask].mean() > 0.95
+
+
+def test_parabolic_bound_of_a_hertzian_patch_is_kalkers():
+    a, b = 6e-3, 4e-3
+    hertz = areas.ellipse(a, b, nx=40, ny=40, load=2e4)
+    kalker = areas.ellipse(a, b, nx=40, ny=40, load=2e4, pressure="parabolic")
+    np.testing.assert_allclose(traction_bound(hertz, 0.3, bound="parabolic"),
+                               0.3 * np.asarray(kalker.pressure), rtol=1e-12, atol=1e-6)
+
+
+def test_unknown_bound_refused():
+    with pytest.raises(InvalidInputError, match="unknown traction bound"):
+        traction_bound(areas.ellipse(1.0, 1.0, nx=8, load=1.0), 0.3, bound="hertzian")
 
 
 def test_force_saturation_curve_is_monotone_and_bounded():

@@ -94,8 +94,6 @@ def _raise(status: int, info: float, knots: FloatArray, where: str = "") -> NoRe
                           f"outside the tables' range {span}"),
         k.E_TABLE_ELLIPSE: (OutOfTableError, f"equivalent ellipse: a/b = {info:.4g} lies "
                             f"outside the tables' range {span}"),
-        k.E_PARABOLIC_MISS: (InvalidInputError,
-                             "the parabolic bound's ellipse misses every cell in contact"),
         k.E_CELLS: (InvalidInputError,
                     "the equivalent ellipse needs at least 2 cells along each axis"),
     }
@@ -189,7 +187,7 @@ class _Solver:
         """Solve at creepages ``xi``, ``eta`` (1) and spin ``phi`` (1/m) about ``reference`` (m).
 
         ``mu``: friction coefficient; ``bound``: ``"given"`` (``g = mu p``)
-        or ``"parabolic"`` (Kalker's, on the patch's equivalent ellipse);
+        or ``"parabolic"`` (``mu N p^2 / sum(p^2 dA)``: Kalker's on a Hertzian patch);
         ``tractions``: also return the traction field.
         """
         return self._solve(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,

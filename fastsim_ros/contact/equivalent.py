@@ -6,7 +6,7 @@ area and with ``a/b`` from its second moments about the centroid
 and run Kalker's FastSim on that ellipse with Kalker's flexibilities and a
 bound for the same load: Hertzian (``bound="given"``, the ellipse's own
 pressure, since the patch's cannot be carried over to another area) or
-Kalker's parabolic one.  The patch's shape beyond its second moments is lost:
+Kalker's parabolic one (``"parabolic"``).  The patch's shape beyond its second moments is lost:
 that is what MAE is measured against.
 """
 
@@ -71,9 +71,8 @@ def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu:
     """
     e = equivalent_ellipse(area)
     n = cells or max(area.nx, area.ny)
-    profile = "parabolic" if bound == "parabolic" else "hertz"
-    grid = ellipse(e.a, e.b, nx=n, ny=n, load=area.load, pressure=profile).shifted(e.x_c, e.y_c)
-    g = traction_bound(grid, mu)
+    grid = ellipse(e.a, e.b, nx=n, ny=n, load=area.load).shifted(e.x_c, e.y_c)
+    g = traction_bound(grid, mu, bound=bound)
     c11, c22, c23 = table.kalker(e.a / e.b)
     l1, l2, l3 = kalker_flexibility(e.a, e.b, c11, c22, c23, shear_modulus)
     ones = np.ones(grid.ny)

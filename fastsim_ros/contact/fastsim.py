@@ -77,33 +77,26 @@ def kalker_flexibility(a: float, b: float, c11: float, c22: float, c23: float,
             math.pi * a * math.sqrt(a / b) / (4.0 * shear_modulus * c23))
 
 
-def traction_bound(area: GridArea, mu: float, *, bound: str = "given",
-                   ellipse: tuple[float, float, float, float] | None = None) -> FloatArray:
-    """Traction bound ``g = mu p`` (Pa) on the area's cells.
+def traction_bound(area: GridArea, mu: float, *, bound: str = "given") -> FloatArray:
+    """Return the traction bound ``g`` (Pa) on the area's cells.
 
-    ``bound="given"``: the area's pressure.  ``"parabolic"``: Kalker's
-    ``2N/(pi a b) (1 - x^2/a^2 - y^2/b^2)`` for the ellipse
-    ``(x_c, y_c, a, b)``, same total load ``N``, on the area's cells in
-    contact (the profile that makes FastSim's saturation agree with the
-    exact theory on Hertzian patches).
+    ``bound="given"``: ``mu p`` with the area's pressure.  ``"parabolic"``:
+    ``mu N p^2 / sum(p^2 dA)``, the same load with the pressure squared.  On a
+    Hertzian patch, ``p0 sqrt(1 - x^2/a^2 - y^2/b^2)``, that is exactly
+    Kalker's parabolic ``2N/(pi a b) (1 - x^2/a^2 - y^2/b^2)``, the profile
+    that makes FastSim's saturation curve agree with the exact theory; on a
+    non-Hertzian patch it keeps every cell in contact and the shape of the
+    given pressure.
     """
     if not (math.isfinite(mu) and mu > 0.0):
         raise InvalidInputError(f"mu must be positive, got {mu}")
+    p = np.asarray(area.pressure)
     if bound == "given":
-        return mu * np.asarray(area.pressure)
+        return mu * p
     if bound != "parabolic":
         raise InvalidInputError(f"unknown traction bound {bound!r}: given or parabolic")
-    if ellipse is None:
-        raise InvalidInputError("the parabolic bound needs an ellipse")
-    xc, yc, a, b = ellipse
-    x = (area.x[None, :] - xc) / a
-    y = (area.y[:, None] - yc) / b
-    shape = np.clip(1.0 - x**2 - y**2, 0.0, None) * area.mask
-    # keep the load: on a grid the discrete sum of the profile is not pi a b / 2
-    total = float(shape.sum()) * area.cell_area
-    if total <= 0.0:
-        raise InvalidInputError("the parabolic bound's ellipse misses every cell in contact")
-    return mu * area.load * shape / total
+    p2 = p * p
+    return mu * area.load * p2 / (float(p2.sum()) * area.cell_area)
 
 
 def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,

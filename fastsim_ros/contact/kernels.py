@@ -58,7 +58,6 @@ E_REFERENCE = 8           # reference point not finite
 E_TABLE_ZONE1 = 9         # zone 1's a/b outside the table (info: a/b)
 E_TABLE_ZONE2 = 10        # zone 2's a/b outside the table (info: a/b)
 E_TABLE_ELLIPSE = 11      # the equivalent ellipse's a/b outside the table (info: a/b)
-E_PARABOLIC_MISS = 12     # the parabolic bound's ellipse misses every cell in contact
 E_CELLS = 13              # fewer than 2 cells for the equivalent ellipse's grid
 
 #: layout of the MAE geometry vector ``geo`` (see :func:`mae_prepare`)
@@ -598,36 +597,23 @@ def mae_strip_flexibility(geo, flex):
 
 
 @njit(cache=True, error_model="numpy")
-def parabolic_bound(p, x0, y0, dx, dy, x_c, y_c, a, b, mu, load, bound):
-    """Fill ``bound`` with Kalker's parabolic ``g`` (Pa) of load ``load`` (N) on the cells.
+def parabolic_bound(p, dx, dy, mu, load, bound):
+    """Fill ``bound`` with the parabolic ``g = mu N p^2 / sum(p^2 dA)`` (Pa) of load ``N``.
 
-    ``g = mu N shape / sum(shape dA)``, ``shape = max(1 - x^2/a^2 - y^2/b^2, 0)``
-    on the cells in contact, the ellipse centred at ``(x_c, y_c)`` (m); as
-    :func:`fastsim_ros.contact.fastsim.traction_bound` with
-    ``bound="parabolic"``.  Return a status (the ellipse may miss the cells).
+    As :func:`fastsim_ros.contact.fastsim.traction_bound` with
+    ``bound="parabolic"`` (Kalker's parabolic bound on a Hertzian patch).
     """
     ny, nx = p.shape
-    u2 = np.empty(nx)
-    for i in range(nx):
-        u2[i] = ((x0 + dx * i - x_c) / a) ** 2
-    colsum = np.zeros(nx)
-    for j in range(ny):
-        v2 = ((y0 + dy * j - y_c) / b) ** 2
-        for i in range(nx):
-            s = max(1.0 - u2[i] - v2, 0.0) if p[j, i] > 0.0 else 0.0
-            bound[j, i] = s
-            colsum[i] += s
     total = 0.0
-    for i in range(nx):
-        total += colsum[i]
-    total *= dx * dy
-    if not total > 0.0:
-        return E_PARABOLIC_MISS
-    k = mu * load
     for j in range(ny):
         for i in range(nx):
-            bound[j, i] = k * bound[j, i] / total
-    return OK
+            s = p[j, i] * p[j, i] if p[j, i] > 0.0 else 0.0
+            bound[j, i] = s
+            total += s
+    k = mu * load / (total * dx * dy)
+    for j in range(ny):
+        for i in range(nx):
+            bound[j, i] = k * bound[j, i]
 
 
 @njit(cache=True, error_model="numpy")
@@ -773,21 +759,13 @@ def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, 
 
 
 @njit(cache=True, error_model="numpy")
-def mae_bound(p, x0, y0, dx, dy, geo, mu, bound):
-    """Fill ``bound`` with the parabolic bound (Pa) on the patch's equivalent ellipse."""
-    e = G_ELLIPSE
-    return parabolic_bound(p, x0, y0, dx, dy, geo[e], geo[e + 1], geo[e + 2], geo[e + 3], mu,
-                           geo[G_LOAD], bound)
-
-
-@njit(cache=True, error_model="numpy")
 def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
               shear_modulus, knots, polys, out_x, out_y, slip, store):
     """Solve MAE + FastSim on one patch (:func:`fastsim_ros.contact.mae.mae_fastsim`).
 
     ``p`` (Pa) on the grid ``x0, y0, dx, dy`` (m); creepages ``xi``, ``eta``
-    (1), ``phi`` (1/m) about ``(xp, yp)`` (m); ``parabolic``: Kalker's
-    parabolic bound on the patch's equivalent ellipse instead of ``mu p``.
+    (1), ``phi`` (1/m) about ``(xp, yp)`` (m); ``parabolic``: the
+    parabolic bound ``mu N p^2 / sum(p^2 dA)`` instead of ``mu p``.
     Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells in
     contact)`` (N, N, N m, N).
     """
@@ -803,9 +781,7 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     # the given bound is mu p, applied in the sweep: no array for it
     bound = np.empty((ny, nx) if parabolic else (0, 0))
     if parabolic:
-        status = mae_bound(p, x0, y0, dx, dy, geo, mu, bound)
-        if status != OK:
-            return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
+        parabolic_bound(p, dx, dy, mu, geo[G_LOAD], bound)
     flex = np.empty((4, ny))
     mae_strip_flexibility(geo, flex)
     fx, fy, mz, nslip, _ = mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex,
@@ -890,9 +866,7 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
                 return status, b, info
             mae_strip_flexibility(geo, flex)
         if parabolic and not (same and mu[b] == mu[b - 1]):
-            status = mae_bound(p, x0[b], y0[b], dx[b], dy[b], geo, mu[b], bound)
-            if status != OK:
-                return status, b, 0.0
+            parabolic_bound(p, dx[b], dy[b], mu[b], geo[G_LOAD], bound)
         prev_pb = pb
         fx, fy, mz, _, _ = mae_sweep(p, mu[b], parabolic, bound, env, x0[b], y0[b], dx[b],
                                      dy[b], geo, flex, xi, eta, phi, xp, yp, empty_f, empty_f,

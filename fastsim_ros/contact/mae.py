@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.exact import CreepCoefficients
 from fastsim_ros.contact.fastsim import FastSimResult, StripFlexibility, fastsim
 from fastsim_ros.contact.tables import CoefficientTable
@@ -102,7 +103,7 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
         yc = float((count * np.arange(area.ny)).sum() / count.sum())
         return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1))
     if rule != "widest_strip":
-        raise ValueError(f"unknown split rule {rule!r}")
+        raise InvalidInputError(f"unknown split rule {rule!r}: widest_strip or centroid")
     # the band of strips sharing the longest chord (a staircase ellipse has several)
     j0 = int(np.argmax(count))
     j1 = j0

@@ -11,8 +11,10 @@ FastSim and MAE read one set of numbers.
 Interpolation: in ``log(a/b)`` by a cubic spline (the coefficients are smooth
 in it over two decades), and in ``nu`` by a quadratic through the three
 tabulated values of ``C (1 - nu)``, which removes the ``1/(1 - nu)`` of
-Kalker's asymptotic formulas.  Outside ``0.1 <= a/b <= 10`` or
-``0 <= nu <= 0.5`` a look-up is refused (:class:`OutOfTableError`).
+Kalker's asymptotic formulas.  The tables span ``0.05 <= a/b <= 20`` (a
+margin beyond Kalker's 0.1..10: MAE's zones of real patches may measure a
+little outside it) and ``0 <= nu <= 0.5``; outside, a look-up is refused
+(:class:`OutOfTableError`).
 """
 
 from __future__ import annotations
