@@ -18,8 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from fastsim_ros.contact.area import GridArea, ellipse
-from fastsim_ros.contact.fastsim import (FastSimResult, StripFlexibility, fastsim,
-                                         kalker_flexibility, traction_bound)
+from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
+                                         traction_bound)
+from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
 
 
@@ -57,7 +58,7 @@ class EquivalentResult:
     mz: float
     ellipse: EquivalentEllipse
     grid: GridArea
-    traction: FastSimResult
+    traction: Tractions
 
 
 def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,

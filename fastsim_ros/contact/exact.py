@@ -39,6 +39,7 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import ConvergenceError, InvalidInputError
 from fastsim_ros.contact.influence import influence_kernel
+from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
 
 FloatArray = NDArray[np.float64]
 SolverKind = Literal["fft", "dense"]
@@ -173,43 +174,15 @@ class _StripPreconditioner:
 
 
 @dataclass(frozen=True, eq=False)
-class TractionSolution:
-    """Tangential tractions of one solve and their resultants.
+class TractionSolution(Tractions):
+    """Tractions of one exact solve (:class:`Tractions`), its area and solver iterations.
 
-    ``tau_x``, ``tau_y``: tractions of the rail on the wheel (Pa), shape
-    ``(ny, nx)``, zero outside the contact; ``slip``: cells in slip (all
-    false in full adhesion); ``fx``, ``fy`` (N) and ``mz`` (N m) about the
-    reference point; ``iterations`` of the iterative solver.
+    ``slip`` is all false in full adhesion; ``iterations``: GMRES iterations
+    (full adhesion) or Gauss-Seidel sweeps (Coulomb).
     """
 
     area: GridArea
-    tau_x: FloatArray
-    tau_y: FloatArray
-    slip: NDArray[np.bool_]
-    fx: float
-    fy: float
-    mz: float
     iterations: int
-
-
-def rigid_slip(area: GridArea, xi: float, eta: float, phi: float,
-               reference: tuple[float, float] = (0.0, 0.0)) -> tuple[FloatArray, FloatArray]:
-    """Rigid slip ``(w_x, w_y)`` at the cell centres, creepages about ``reference`` (m)."""
-    x = area.x[None, :] - reference[0]
-    y = area.y[:, None] - reference[1]
-    shape = area.pressure.shape
-    return (np.broadcast_to(xi - phi * y, shape).astype(float),
-            np.broadcast_to(eta + phi * x, shape).astype(float))
-
-
-def resultants(area: GridArea, tau_x: FloatArray, tau_y: FloatArray,
-               reference: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float]:
-    """``(Fx, Fy, Mz)`` of a traction field, ``Mz`` about ``reference``."""
-    x = area.x[None, :] - reference[0]
-    y = area.y[:, None] - reference[1]
-    da = area.cell_area
-    return (float(tau_x.sum() * da), float(tau_y.sum() * da),
-            float((x * tau_y - y * tau_x).sum() * da))
 
 
 def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: float,
@@ -264,7 +237,7 @@ def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: floa
     tau_x[mask] = tau[:n]
     tau_y[mask] = tau[n:]
     fx, fy, mz = resultants(area, tau_x, tau_y, reference)
-    return TractionSolution(area, tau_x, tau_y, np.zeros(mask.shape, dtype=bool), fx, fy, mz,
+    return TractionSolution(tau_x, tau_y, np.zeros(mask.shape, dtype=bool), fx, fy, mz, area,
                             iterations)
 
 
@@ -404,7 +377,7 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
     tau_y[mask] = tau[:, 1]
     slip_map[mask] = slip
     fx, fy, mz = resultants(area, tau_x, tau_y, reference)
-    return TractionSolution(area, tau_x, tau_y, slip_map, fx, fy, mz, sweep)
+    return TractionSolution(tau_x, tau_y, slip_map, fx, fy, mz, area, sweep)
 
 
 @dataclass(frozen=True)

@@ -33,6 +33,7 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.contact.traction import Tractions, resultants
 
 FloatArray = NDArray[np.float64]
 
@@ -48,23 +49,6 @@ class StripFlexibility:
     l2: FloatArray
     l3: FloatArray
     spin: FloatArray
-
-
-@dataclass(frozen=True, eq=False)
-class FastSimResult:
-    """Tractions of one FastSim solve and their resultants.
-
-    ``tau_x``, ``tau_y``: tractions of the rail on the wheel (Pa), ``(ny, nx)``;
-    ``slip``: cells on the traction bound; ``fx``, ``fy`` (N), ``mz`` (N m)
-    about the reference point.
-    """
-
-    tau_x: FloatArray
-    tau_y: FloatArray
-    slip: NDArray[np.bool_]
-    fx: float
-    fy: float
-    mz: float
 
 
 def kalker_flexibility(a: float, b: float, c11: float, c22: float, c23: float,
@@ -143,8 +127,8 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
 
 def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
             flexibility: StripFlexibility, sweep_point: tuple[float, float] = (0.0, 0.0),
-            reference: tuple[float, float] = (0.0, 0.0)) -> FastSimResult:
-    """Solve with FastSim on ``area``; creepages ``xi``, ``eta``, ``phi`` (1/m) about ``reference``.
+            reference: tuple[float, float] = (0.0, 0.0)) -> Tractions:
+    """Solve FastSim on ``area``, creepages ``xi``, ``eta``, ``phi`` (1/m) about ``reference``.
 
     ``sweep_point`` ``(x_c, y_s)`` is the point the strips' rates refer to
     (the reference point itself in plain FastSim, MAE's ``S``); creepages are
@@ -159,8 +143,4 @@ def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatAr
     eta_s = eta - phi * (xp - xc)
     tx, ty, slip = sweep(bound, area.x, area.dx, xi_s, eta_s, phi, flexibility,
                          area.y - ys, xc)
-    da = area.cell_area
-    xr = area.x[None, :] - xp
-    yr = area.y[:, None] - yp
-    return FastSimResult(tx, ty, slip, float(tx.sum() * da), float(ty.sum() * da),
-                         float((xr * ty - yr * tx).sum() * da))
+    return Tractions(tx, ty, slip, *resultants(area, tx, ty, reference))

@@ -27,7 +27,8 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.exact import CreepCoefficients
-from fastsim_ros.contact.fastsim import FastSimResult, StripFlexibility, fastsim
+from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
+from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
 
 FloatArray = NDArray[np.float64]
@@ -249,7 +250,7 @@ class MaeResult:
     fx: float
     fy: float
     mz: float
-    traction: FastSimResult
+    traction: Tractions
     geometry: MaeGeometry
     flexibility: tuple[ZoneFlexibility | None, ZoneFlexibility | None]
 

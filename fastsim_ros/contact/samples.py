@@ -87,14 +87,17 @@ def two_lobes(*, cells: int, scale: float = 1.0, load: float | None = None) -> G
 
 
 def flange_root_gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Undeformed gap (m) at ``(x, y)`` (m): wheel radius along ``x``; laterally 0.3 m of
-    relative radius on the tread side (``y < 0``) and 0.03 m on the flange side."""
+    """Return the undeformed gap (m) at ``(x, y)`` (m) of the flange-root sample.
+
+    The wheel radius along ``x``; laterally 0.3 m of relative radius on the
+    tread side (``y < 0``) and 0.03 m on the flange side.
+    """
     ry = np.where(y < 0.0, 0.3, 0.03)
     return x**2 / (2.0 * WHEEL_RADIUS) + y**2 / (2.0 * ry)
 
 
 def flange_root_patch(*, cells: int, load: float = 5.0e4) -> GridArea:
-    """The normal contact of :func:`flange_root_gap` under ``load`` (N), steel on steel.
+    """Solve the normal contact of :func:`flange_root_gap` under ``load`` (N), steel on steel.
 
     Solved by the exact normal solver on ``cells`` x ``cells`` cells over a
     box that holds the contact, then cropped to the cells in contact.
