@@ -14,7 +14,7 @@ KALKER_NU025_CIRCLE = {"C11": 4.12, "C22": 3.67, "C23": 1.47}
 
 
 def notched_area() -> areas.GridArea:
-    """An ellipse with a notch cut into its trailing half: strips of two segments."""
+    """Make an ellipse with a notch cut into its trailing half: strips of two segments."""
     e = areas.ellipse(1.0, 0.8, nx=24, ny=20)
     p = np.array(e.pressure)
     p[8:12, 6:10] = 0.0

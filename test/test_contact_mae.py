@@ -20,7 +20,7 @@ def unbounded(ar):
 
 
 def hertz_like(ar, halves):
-    """A Hertz-like pressure on two semi-ellipses ``[(a1, b1), (a2, b2)]``, unit load."""
+    """Put a Hertz-like pressure on two semi-ellipses ``[(a1, b1), (a2, b2)]``, unit load."""
     y = ar.y[:, None]
     a = np.where(y < 0, halves[0][0], halves[1][0])
     b = np.where(y < 0, halves[0][1], halves[1][1])

@@ -70,7 +70,7 @@ def test_hertz_ellipse_classical_relations(rx, ry):
 
 
 def hertz_displacement(h: HertzContact, x0: float, y0: float, es: float) -> float:
-    """Normal displacement difference (m) of the Hertz pressure at ``(x0, y0)``, by quadrature.
+    """Integrate the normal displacement (m) of the Hertz pressure at ``(x0, y0)``.
 
     ``u = 1/(pi E*) int p/|r - r0| dA``; in polar coordinates about the field
     point the radial integral of ``p0 sqrt(c0 + c1 s - c2 s^2)`` is a circle
@@ -134,7 +134,7 @@ def grid_case(rx: float, ry: float, load: float, material: dict[str, float], nx:
 
 
 def fitted_ellipse(sol: NormalSolution, level: float = 0.3) -> tuple[float, float, float]:
-    """``(a, b, p0)`` of a least-squares fit ``p^2 = p0^2 (1 - x^2/a^2 - y^2/b^2)``.
+    """Return ``(a, b, p0)`` of a least-squares fit ``p^2 = p0^2 (1 - x^2/a^2 - y^2/b^2)``.
 
     Hertz's ``p^2`` is quadratic in ``x`` and ``y``; cells below ``level``
     times the peak (the steep rim, one cell from the edge) are left out.

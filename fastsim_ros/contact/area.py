@@ -55,12 +55,12 @@ class GridArea:
 
     @property
     def ny(self) -> int:
-        """Number of lateral strips (rows)."""
+        """Return the number of lateral strips (rows)."""
         return int(self.pressure.shape[0])
 
     @property
     def nx(self) -> int:
-        """Number of cells along the rolling direction (columns)."""
+        """Return the number of cells along the rolling direction (columns)."""
         return int(self.pressure.shape[1])
 
     @property
@@ -90,7 +90,7 @@ class GridArea:
 
     @property
     def load(self) -> float:
-        """Normal load ``N = sum p dA`` (N)."""
+        """Return the normal load ``N = sum p dA`` (N)."""
         return float(self.pressure.sum()) * self.cell_area
 
     def with_pressure(self, pressure: FloatArray) -> GridArea:

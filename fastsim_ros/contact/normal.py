@@ -62,7 +62,7 @@ class HertzContact:
 
     @property
     def load(self) -> float:
-        """Normal load ``N = 2/3 pi a b p0`` (N)."""
+        """Return the normal load ``N = 2/3 pi a b p0`` (N)."""
         return 2.0 / 3.0 * math.pi * self.a * self.b * self.p0
 
     def pressure(self, x: FloatArray, y: FloatArray) -> FloatArray:
