@@ -429,9 +429,10 @@ def test_bad_solver_settings_are_refused():
         MaeSolver(NU, G, rule="middle")  # type: ignore[arg-type]
     with pytest.raises(InvalidInputError, match="cells must be at least 2"):
         EquivalentEllipseSolver(NU, G, cells=1)
+    # a one-cell patch still has an equivalent ellipse: the smallest grid, 2 x 2 cells
     single = GridArea(0.0, 0.0, 1e-3, 1e-3, np.ones((1, 1)))
-    with pytest.raises(InvalidInputError, match="at least 2 cells"):
-        EquivalentEllipseSolver(NU, G).solve(single, 1e-3, 0.0, 0.0, mu=MU)
+    r = EquivalentEllipseSolver(NU, G).solve(single, 1.0, 0.0, 0.0, mu=MU)
+    assert r.fx == pytest.approx(-MU * single.load, rel=1e-9)
 
 
 @pytest.mark.parametrize("solver_type", [MaeSolver, EquivalentEllipseSolver])

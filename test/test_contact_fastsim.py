@@ -137,3 +137,15 @@ def test_bad_friction_refused(mu):
     ar = areas.ellipse(1.0, 1.0, nx=8, load=1.0)
     with pytest.raises(InvalidInputError, match="mu must be positive"):
         traction_bound(ar, mu)
+
+
+@pytest.mark.parametrize("count", [1, 3, 80, 472, 716, 2828, 10**5])
+def test_equivalent_ellipse_grid_has_the_patch_cell_count(count):
+    from fastsim_ros.contact.equivalent import ellipse_cells
+    from fastsim_ros.contact import kernels
+    n = ellipse_cells(count)
+    assert n == kernels.ellipse_cells(count)
+    if count > 50:
+        # an n x n box around an ellipse holds about pi/4 n^2 cells in contact
+        cells = int(np.count_nonzero(areas.ellipse(1.0, 1.0, nx=n).mask))
+        assert abs(cells - count) / count < 0.05

@@ -306,7 +306,7 @@ class EquivalentEllipseSolver(_Solver):
 
     :func:`fastsim_ros.contact.equivalent.equivalent_fastsim`: the ellipse
     of the patch's area, centroid and second-moment ratio, discretised on
-    ``cells`` x ``cells`` cells (default ``max(nx, ny)`` of the patch), with
+    ``cells`` x ``cells`` cells (default: as many cells in contact as the patch), with
     Kalker's flexibilities and a Hertzian (``bound="given"``) or parabolic
     pressure of the patch's load.  ``nu``, ``shear_modulus`` (Pa) as
     :class:`MaeSolver`.
@@ -322,7 +322,8 @@ class EquivalentEllipseSolver(_Solver):
                eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
                tractions: bool) -> ContactForces:
         tractions = bool(tractions)
-        n = self.cells or max(p.shape)
+        # the kernel sizes the ellipse's grid itself (n = 0) unless tractions need arrays
+        n = self.cells or (k.ellipse_cells(int(np.count_nonzero(p > 0.0))) if tractions else 0)
         out = self._outputs((n, n), tractions)
         result = k.equivalent_solve(p, float(x0), float(y0), float(dx), float(dy), float(xi),
                                     float(eta), float(phi), float(mu), float(reference[0]),

@@ -68,8 +68,8 @@ G_ELLIPSE = 27              # the patch's equivalent ellipse x_c, y_c, a, b
 GEO_SIZE = 31
 
 #: layout of the equivalent-ellipse vector ``ell`` (see :func:`equivalent_prepare`)
-E_XC, E_YC, E_A, E_B, E_LOAD, E_L1, E_L2, E_L3 = 0, 1, 2, 3, 4, 5, 6, 7
-ELL_SIZE = 8
+E_XC, E_YC, E_A, E_B, E_LOAD, E_L1, E_L2, E_L3, E_NCELLS = 0, 1, 2, 3, 4, 5, 6, 7, 8
+ELL_SIZE = 9
 
 # |tau|^2 <= (1 - 1e-12) g^2 proves |tau| < g without a square root: the
 # reference's slip test (hypot, exact to an ulp) gives the same answer there
@@ -696,6 +696,7 @@ def equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell):
     ell[E_A] = a
     ell[E_B] = b
     ell[E_LOAD] = total * (dx * dy)
+    ell[E_NCELLS] = n
     ratio = a / b
     if not in_table(knots, ratio):
         return E_TABLE_ELLIPSE, ratio
@@ -790,6 +791,20 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
 
 
 @njit(cache=True, error_model="numpy")
+def ellipse_cells(cells_in_contact):
+    """Cells across the ellipse's box for as many cells in contact as the patch (``>= 2``).
+
+    As :func:`fastsim_ros.contact.equivalent.ellipse_cells` (Python's round: half to even).
+    """
+    v = math.sqrt(4.0 * cells_in_contact / math.pi)
+    r = math.floor(v)
+    frac = v - r
+    if frac > 0.5 or (frac == 0.5 and r % 2 == 1):
+        r += 1
+    return max(2, int(r))
+
+
+@njit(cache=True, error_model="numpy")
 def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
                      shear_modulus, knots, polys, out_x, out_y, slip, store):
     """Solve plain FastSim on the patch's equivalent ellipse (:func:`equivalent_fastsim`).
@@ -803,12 +818,14 @@ def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
     status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != OK:
         return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
-    if n < 2:
-        return E_CELLS, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
     ell = np.empty(ELL_SIZE)
     status, info = equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell)
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
+    if n <= 0:
+        n = ellipse_cells(ell[E_NCELLS])
+    if n < 2:
+        return E_CELLS, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
     shape = np.empty((n, n))
     env = np.empty((2, n), dtype=np.int64)
     a = ell[E_A]
@@ -882,17 +899,19 @@ def equivalent_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, parabolic, n, shear_
                      knots, polys, out):
     """Equivalent-ellipse FastSim on a batch; the layout and return of :func:`mae_batch`.
 
-    ``n``: cells across each ellipse's box (``<= 0``: ``max(nx, ny)``).
+    ``n``: cells across each ellipse's box (``<= 0``: :func:`ellipse_cells` of
+    each patch's cells in contact).
     """
     nb = creep.shape[0]
     ny, nx = ps.shape[1], ps.shape[2]
-    if n <= 0:
-        n = max(nx, ny)
-    if n < 2:
+    if 0 < n < 2:
         return E_CELLS, 0, 0.0
+    nmax = n if n > 0 else max(ellipse_cells(ny * nx), 2)
     ell = np.empty(ELL_SIZE)
-    shape = np.empty((n, n))
-    env = np.empty((2, n), dtype=np.int64)
+    shape_all = np.empty((nmax, nmax))
+    env_all = np.empty((2, nmax), dtype=np.int64)
+    shape = shape_all
+    env = env_all
     empty_f = np.empty((0, 0))
     empty_b = np.empty((0, 0), dtype=np.bool_)
     scale = 0.0
@@ -908,10 +927,13 @@ def equivalent_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, parabolic, n, shear_
                                               shear_modulus, knots, polys, ell)
             if status != OK:
                 return status, b, info
+            nb_cells = n if n > 0 else ellipse_cells(ell[E_NCELLS])
+            shape = shape_all[:nb_cells, :nb_cells]
+            env = env_all[:, :nb_cells]
             a = ell[E_A]
             bb = ell[E_B]
-            total, _ = ellipse_shape(n, a, bb, not parabolic, shape, env)
-            scale = ell[E_LOAD] / (total * ((2 * a / n) * (2 * bb / n)))
+            total, _ = ellipse_shape(nb_cells, a, bb, not parabolic, shape, env)
+            scale = ell[E_LOAD] / (total * ((2 * a / nb_cells) * (2 * bb / nb_cells)))
         prev_pb = pb
         fx, fy, mz, _, _ = equivalent_sweep(ell, shape, scale, mu[b], env, xi, eta, phi, xp,
                                             yp, empty_f, empty_f, empty_b, False)
