@@ -24,7 +24,8 @@ from fastsim_ros.contact import exact
 from fastsim_ros.contact.equivalent import equivalent_fastsim
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 from fastsim_ros.contact.fastsim import traction_bound
-from fastsim_ros.contact.mae import mae_coefficients, mae_fastsim, mae_geometry
+from fastsim_ros.contact.mae import (mae_coefficients, mae_fastsim, mae_fastsim_coefficients,
+                                     mae_geometry)
 from fastsim_ros.contact.tables import coefficient_table
 
 EXACT_GRIDS = (0.4, 0.6, 0.8, 1.0)
@@ -73,7 +74,8 @@ def _add_area(p: argparse.ArgumentParser, *, forces: bool) -> None:
         g.add_argument("--a", type=_finite, help="semi-axis along x (m)")
         g.add_argument("--b", type=_finite, help="semi-axis along y (m)")
     g.add_argument("--patch", type=Path, help="CSV with header x,y,pressure (m, m, Pa)")
-    p.add_argument("--cells", type=_cells, help="cells along each axis of the bounding box")
+    p.add_argument("--cells", type=_cells,
+                   help="cells along each axis of a shape's bounding box (a patch keeps its grid)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -173,21 +175,11 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
         elif args.method == "mae":
             c = mae_coefficients(mae_geometry(ar), coefficient_table(args.nu))
         else:
-            c = _fastsim_coefficients(ar, args.nu)
+            c = mae_fastsim_coefficients(ar, coefficient_table(args.nu))
         result = {k: (None if math.isnan(v) else v) for k, v in c.as_dict().items()}
         result.update(cells=[ar.nx, ar.ny], extrapolated=False)
     result.update(method=args.method, nu=args.nu, area_description=what)
     return result
-
-
-def _fastsim_coefficients(ar: areas.GridArea, nu: float) -> exact.CreepCoefficients:
-    """MAE + FastSim in full adhesion (no bound), unit creepages, G = 1 Pa."""
-    table = coefficient_table(nu)
-    unbounded = np.where(ar.mask, np.inf, 0.0)
-    unit = tuple(mae_fastsim(ar, *cr, bound=unbounded, table=table, shear_modulus=1.0)
-                 for cr in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
-    return exact.coefficients_from_unit_solutions(ar.area, tuple((r.fx, r.fy, r.mz)
-                                                                 for r in unit))
 
 
 def forces(args: argparse.Namespace) -> dict[str, Any]:

@@ -36,10 +36,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import exact, samples  # noqa: E402
-from fastsim_ros.contact.equivalent import equivalent_fastsim  # noqa: E402
+from fastsim_ros.contact.equivalent import (equivalent_coefficients,  # noqa: E402
+                                            equivalent_fastsim)
 from fastsim_ros.contact.fastsim import traction_bound  # noqa: E402
-from fastsim_ros.contact.mae import (mae_coefficients, mae_fastsim, mae_geometry,  # noqa: E402
-                                     strip_flexibility)
+from fastsim_ros.contact.mae import (mae_coefficients, mae_fastsim,  # noqa: E402
+                                     mae_fastsim_coefficients, mae_geometry, strip_flexibility)
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
 
 DOCS = ROOT / "docs"
@@ -165,19 +166,7 @@ def _extrapolated(make: AreaMaker, nu: float) -> dict[str, float]:
     return out
 
 
-def _fastsim_coefficients(ar: areas.GridArea, nu: float, method: str) -> dict[str, float]:
-    t = coefficient_table(nu)
-    unbounded = np.where(ar.mask, np.inf, 0.0)
-    unit = []
-    for cr in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)):
-        if method == "mae":
-            r = mae_fastsim(ar, *cr, bound=unbounded, table=t, shear_modulus=1.0)
-            unit.append((r.fx, r.fy, r.mz))
-        else:
-            # the equivalent ellipse in adhesion: the bound is irrelevant, so give a huge mu
-            e = equivalent_fastsim(ar.with_load(1.0), *cr, mu=1e300, table=t, shear_modulus=1.0)
-            unit.append((e.fx, e.fy, e.mz))
-    c = exact.coefficients_from_unit_solutions(ar.area, tuple(unit))
+def _as_dict(c: exact.CreepCoefficients) -> dict[str, float]:
     return {k: getattr(c, k) for k in ("C11", "C12", "C13", "C21", "C22", "C23")}
 
 
@@ -219,13 +208,12 @@ def part_coefficients() -> None:
         for rule in ("widest_strip", "centroid"):
             geo = mae_geometry(ar, rule)
             c = mae_coefficients(geo, t)
-            entry[f"mae_{rule}"] = {k: getattr(c, k) for k in
-                                    ("C11", "C12", "C13", "C21", "C22", "C23")}
+            entry[f"mae_{rule}"] = _as_dict(c)
             entry[f"geometry_{rule}"] = {
                 "y_s": geo.y_s, "x_c": geo.x_c, "y_c": geo.y_c,
                 "zones": [[z.area, z.a, z.b, z.a_over_b] for z in (geo.zone1, geo.zone2)]}
-        entry["mae_fastsim"] = _fastsim_coefficients(ar, NU_COEF, "mae")
-        entry["ellipse_fastsim"] = _fastsim_coefficients(ar, NU_COEF, "ellipse")
+        entry["mae_fastsim"] = _as_dict(mae_fastsim_coefficients(ar, t))
+        entry["ellipse_fastsim"] = _as_dict(equivalent_coefficients(ar, t))
         entry["cells"] = [ar.nx, ar.ny]
         res[name] = entry
         print(name, {k: round(v, 4) for k, v in ex.items() if not k.endswith("err")},

@@ -18,6 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fastsim_ros.contact.area import GridArea, ellipse
+from fastsim_ros.contact.exact import (UNIT_CREEPAGES, CreepCoefficients,
+                                       coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
                                          traction_bound)
 from fastsim_ros.contact.traction import Tractions
@@ -91,3 +93,18 @@ def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu:
     res = fastsim(grid, xi, eta, phi, bound=g, flexibility=flex, sweep_point=(e.x_c, e.y_c),
                   reference=reference)
     return EquivalentResult(res.fx, res.fy, res.mz, e, grid, res)
+
+
+def equivalent_coefficients(area: GridArea, table: CoefficientTable, *,
+                            reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
+    """Return the generalised coefficients of equivalent-ellipse FastSim in full adhesion.
+
+    Normalised with the area's own discrete area, as the exact theory's are.
+    """
+    unit_load = area.with_load(1.0)
+    # a friction coefficient so large that no cell reaches the bound: full adhesion
+    unit = tuple(equivalent_fastsim(unit_load, *cr, mu=1e300, table=table, shear_modulus=1.0,
+                                    reference=reference)
+                 for cr in UNIT_CREEPAGES)
+    return coefficients_from_unit_solutions(area.area, tuple((r.fx, r.fy, r.mz) for r in unit),
+                                            reference=reference)

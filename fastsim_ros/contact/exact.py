@@ -424,12 +424,16 @@ def coefficients_from_unit_solutions(
         area=area, reference=reference)
 
 
+#: unit xi, eta and phi (1/m): the creepages whose forces define the coefficients
+UNIT_CREEPAGES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
 def unit_solutions(area: GridArea, *, nu: float, reference: tuple[float, float] = (0.0, 0.0),
                    solver: SolverKind = "fft") -> tuple[TractionSolution, ...]:
     """Full-adhesion solutions for unit ``xi``, unit ``eta`` and unit ``phi`` (G = 1 Pa)."""
     op = SteadyRollingOperator.of(area, nu=nu)
     return tuple(full_adhesion(area, *cr, nu=nu, reference=reference, solver=solver, operator=op)
-                 for cr in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
+                 for cr in UNIT_CREEPAGES)
 
 
 def creep_coefficients(area: GridArea, *, nu: float,

@@ -26,7 +26,8 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import InvalidInputError
-from fastsim_ros.contact.exact import CreepCoefficients
+from fastsim_ros.contact.exact import (UNIT_CREEPAGES, CreepCoefficients,
+                                       coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
@@ -275,3 +276,18 @@ def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: Flo
     zones = tuple(None if z.empty else zone_flexibility(z, table, shear_modulus)
                   for z in (geometry.zone1, geometry.zone2))
     return MaeResult(res.fx, res.fy, res.mz, res, geometry, (zones[0], zones[1]))
+
+
+def mae_fastsim_coefficients(area: GridArea, table: CoefficientTable, *,
+                             reference: tuple[float, float] = (0.0, 0.0),
+                             rule: SplitRule = DEFAULT_SPLIT) -> CreepCoefficients:
+    """Return the generalised coefficients of MAE + FastSim in full adhesion (no bound).
+
+    What the pair gives at vanishing creepage, to set beside MAE's own
+    coefficients (:func:`mae_coefficients`) and the exact theory's.
+    """
+    unbounded = np.where(area.mask, np.inf, 0.0)
+    unit = tuple(mae_fastsim(area, *cr, bound=unbounded, table=table, shear_modulus=1.0,
+                             reference=reference, rule=rule) for cr in UNIT_CREEPAGES)
+    return coefficients_from_unit_solutions(area.area, tuple((r.fx, r.fy, r.mz) for r in unit),
+                                            reference=reference)
