@@ -27,7 +27,7 @@ def main() -> int:
                 "# G = 8e10 Pa, nu = 0.28. Made by: python scripts/make_example_patch.py\n")
         f.write("x,y,pressure\n")
         for j, i in zip(jj, ii):
-            f.write(f"{ar.x[i]:.9e},{ar.y[j]:.9e},{ar.pressure[j, i]:.9e}\n")
+            f.write(f"{float(ar.x[i])!r},{float(ar.y[j])!r},{float(ar.pressure[j, i])!r}\n")
     print(f"{out}: {jj.size} cells, N = {ar.load:.6g} N, area = {ar.area * 1e6:.4g} mm^2")
     return 0
 
