@@ -18,7 +18,8 @@ setup(
         (os.path.join('share', package_name, 'config'), glob('config/*.yaml')),
     ],
     install_requires=['setuptools'],
-    zip_safe=True,
+    # numba caches compiled kernels beside their module; the tables are read as files
+    zip_safe=False,
     maintainer='fastsim_ros team',
     maintainer_email='fastsim@example.com',
     description=(
