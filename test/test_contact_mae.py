@@ -192,3 +192,30 @@ def test_semi_ellipses_c13_within_15_percent_of_exact(g1):
     mae = mae_coefficients(mae_geometry(areas.semi_ellipses(g1, 1.0, cells=100)),
                            coefficient_table(0.25))
     assert mae.C13 == pytest.approx(exact_c13, rel=0.15)
+
+
+@pytest.mark.parametrize("cut", [0.0, 0.1])
+def test_auto_split_falls_back_to_centroid_on_a_truncated_ellipse(cut):
+    from fastsim_ros.contact import samples
+    ar = samples.truncated_ellipse(cells=60, cut=cut)
+    widest = mae_geometry(ar, "widest_strip")
+    auto = mae_geometry(ar, "auto")
+    centroid = mae_geometry(ar, "centroid")
+    # the longest chord lies on the edge: widest_strip leaves a zone empty ...
+    assert widest.zone2.empty
+    # ... auto takes the centroid split instead, and so recovers two zones
+    assert auto.y_s == centroid.y_s and not auto.zone2.empty
+    t = coefficient_table(0.25)
+    from fastsim_ros.contact import exact
+    ex = exact.creep_coefficients(ar, nu=0.25)
+    for geo, worst in ((widest, 0.25), (auto, 0.06)):
+        c = mae_coefficients(geo, t)
+        err = max(abs(c.C11 / ex.C11 - 1), abs(c.C22 / ex.C22 - 1), abs(c.C23 / ex.C23 - 1))
+        # the empty-zone split misses by over 25%; the centroid split within 6%
+        assert (err > worst) if geo is widest else (err < worst)
+
+
+@pytest.mark.parametrize("g1", [0.1, 0.5, 2.0, 5.0])
+def test_auto_split_keeps_the_join_line_of_semi_ellipses(g1):
+    ar = areas.semi_ellipses(g1, 1.0, cells=60)
+    assert split_face(ar, "auto") == split_face(ar, "widest_strip")

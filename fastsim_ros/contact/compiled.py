@@ -40,9 +40,10 @@ if TYPE_CHECKING:  # the reference modules pull in the exact solver (scipy): not
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 Bound = Literal["given", "parabolic"]
-Rule = Literal["widest_strip", "centroid"]
+Rule = Literal["auto", "widest_strip", "centroid"]
 
-_RULES = {"widest_strip": k.RULE_WIDEST_STRIP, "centroid": k.RULE_CENTROID}
+_RULES = {"auto": k.RULE_AUTO, "widest_strip": k.RULE_WIDEST_STRIP,
+          "centroid": k.RULE_CENTROID}
 # placeholders for the kernels' traction outputs when none are wanted: one
 # argument type for both cases, so one compiled specialisation
 _NO_FLOAT = np.empty((0, 0))
@@ -230,10 +231,10 @@ class MaeSolver(_Solver):
     """
 
     def __init__(self, nu: float, shear_modulus: float, *,
-                 rule: Rule = "widest_strip") -> None:
+                 rule: Rule = "auto") -> None:
         super().__init__(nu, shear_modulus)
         if rule not in _RULES:
-            raise InvalidInputError(f"unknown split rule {rule!r}: widest_strip or centroid")
+            raise InvalidInputError(f"unknown split rule {rule!r}: auto, widest_strip or centroid")
         self.rule: Rule = rule
         self._rule = _RULES[rule]
 

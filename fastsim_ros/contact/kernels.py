@@ -43,7 +43,9 @@ I_C11, I_C22, I_C23 = 0, 1, 2
 I_H11, I_H13, I_H22, I_H23 = 4, 6, 8, 9
 
 #: split rules of :func:`fastsim_ros.contact.mae.split_face`
-RULE_WIDEST_STRIP, RULE_CENTROID = 0, 1
+RULE_WIDEST_STRIP, RULE_CENTROID, RULE_AUTO = 0, 1, 2
+#: as fastsim_ros.contact.mae.MIN_ZONE_SHARE
+MIN_ZONE_SHARE = 0.15
 
 #: status codes of the kernels
 OK = 0
@@ -385,7 +387,7 @@ def _round_half_even(v):
 def split_face(count, rule):
     """Index ``f`` of the cell face the MAE split runs along, from the strips' counts.
 
-    ``count[j]``: cells in contact in strip ``j``.  The two rules of
+    ``count[j]``: cells in contact in strip ``j``.  The three rules of
     :func:`fastsim_ros.contact.mae.split_face`, branch for branch.
     """
     ny = count.shape[0]
@@ -396,13 +398,35 @@ def split_face(count, rule):
         moment += count[j] * j
     yc = moment / total
     if rule == RULE_CENTROID:
-        r0 = 0
-        while count[r0] == 0:
-            r0 += 1
-        r1 = ny - 1
-        while count[r1] == 0:
-            r1 -= 1
-        return min(max(_round_half_even(yc + 0.5), r0), r1 + 1)
+        return _centroid_face(count, yc)
+    f = _widest_strip_face(count, yc)
+    if rule == RULE_AUTO:
+        below = 0
+        for j in range(f):
+            below += count[j]
+        share = below / total
+        if min(share, 1.0 - share) < MIN_ZONE_SHARE:
+            return _centroid_face(count, yc)
+    return f
+
+
+@njit(cache=True, error_model="numpy")
+def _centroid_face(count, yc):
+    """Return the face through the band of strips with the longest chord (or a jump side)."""
+    ny = count.shape[0]
+    r0 = 0
+    while count[r0] == 0:
+        r0 += 1
+    r1 = ny - 1
+    while count[r1] == 0:
+        r1 -= 1
+    return min(max(_round_half_even(yc + 0.5), r0), r1 + 1)
+
+
+@njit(cache=True, error_model="numpy")
+def _widest_strip_face(count, yc):
+    """Return the face through the band of strips with the longest chord (or its jump side)."""
+    ny = count.shape[0]
     # the band of strips sharing the longest chord (a staircase ellipse has several)
     j0 = 0
     for j in range(1, ny):

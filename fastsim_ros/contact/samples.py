@@ -7,6 +7,8 @@ extrapolated over several grids, the online methods are judged on one.
 - two semi-ellipses joined along ``y = 0`` (the paper's Table 5 family);
 - an ellipse with a notch cut into one side (strips of two segments);
 - two overlapping lobes of different size (a waisted, two-lobed area);
+- an ellipse truncated just beyond its centre line (a patch cut off where a
+  profile region ends): its longest chord lies on its edge;
 - a flange-root patch: the normal contact of a gap whose lateral curvature
   is ten times larger on the flange side (``y > 0``) than on the tread side,
   as where a wheel's flange root runs against the rail's gauge corner.
@@ -84,6 +86,16 @@ def two_lobes(*, cells: int, scale: float = 1.0, load: float | None = None) -> G
     # a Hertz-like peak that grows with the lobe's size
     p = np.maximum.reduce([a * _hertz_like(xx - xc, yy - yc, a, b) for xc, yc, a, b in lobes])
     return _finish(x, y, dx, dy, p, scale, load)
+
+
+def truncated_ellipse(*, cells: int, scale: float = 1.0, load: float | None = None,
+                      cut: float = 0.1) -> GridArea:
+    """Ellipse ``a/b = 1.5`` (``a b = scale^2/pi``) without the part beyond ``y = cut * b``."""
+    a, b = semi_ellipse_axes(1.5)
+    x, y, dx, dy = _grid((-a, a), (-b, b), cells)
+    xx, yy = x[None, :], y[:, None]
+    p = _hertz_like(xx, yy, a, b) * (yy <= cut * b)
+    return _finish(x, y, dx, dy, p, scale, load).cropped()
 
 
 def flange_root_gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
