@@ -412,7 +412,7 @@ def split_face(count, rule):
 
 @njit(cache=True, error_model="numpy")
 def _centroid_face(count, yc):
-    """Return the face through the band of strips with the longest chord (or a jump side)."""
+    """Return the face nearest the centroid row coordinate ``yc`` (within the contact)."""
     ny = count.shape[0]
     r0 = 0
     while count[r0] == 0:
@@ -425,7 +425,7 @@ def _centroid_face(count, yc):
 
 @njit(cache=True, error_model="numpy")
 def _widest_strip_face(count, yc):
-    """Return the face through the band of strips with the longest chord (or its jump side)."""
+    """Return the face through the band of strips with the longest chord (or a jump side)."""
     ny = count.shape[0]
     # the band of strips sharing the longest chord (a staircase ellipse has several)
     j0 = 0
