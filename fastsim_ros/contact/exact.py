@@ -98,6 +98,31 @@ class SteadyRollingOperator:
         bxy = self.kernel_xy[dj, di]
         return np.block([[bxx, bxy], [bxy, byy]])
 
+    def strip_blocks(self) -> list[tuple[NDArray[np.int_], FloatArray, FloatArray]]:
+        """Return each lateral strip's own block of the operator, strip by strip.
+
+        Per strip with cells in contact: their indices among the contact cells
+        (row-major, as :meth:`dense` orders them), and the ``xx`` and ``yy``
+        blocks between them (``K_xy`` vanishes within a strip, ``dj = 0``).
+        Strips with the same pattern of cells share their block arrays.
+        """
+        mask = self.area.mask
+        flat = np.cumsum(mask.ravel()).reshape(mask.shape) - 1
+        row_x = self.kernel_xx[self.area.ny - 1]
+        row_y = self.kernel_yy[self.area.ny - 1]
+        cache: dict[bytes, tuple[FloatArray, FloatArray]] = {}
+        blocks = []
+        for j in range(self.area.ny):
+            cols = np.flatnonzero(mask[j])
+            if cols.size == 0:
+                continue
+            key = (cols - cols[0]).tobytes()
+            if key not in cache:
+                d = cols[:, None] - cols[None, :] + self.area.nx - 1
+                cache[key] = (row_x[d], row_y[d])
+            blocks.append((flat[j, cols], *cache[key]))
+        return blocks
+
     def fft_product(self) -> _FFTProduct:
         """FFT-based product with tractions on the whole grid."""
         return _FFTProduct(self)
@@ -143,22 +168,14 @@ class _StripPreconditioner:
     """
 
     def __init__(self, op: SteadyRollingOperator) -> None:
-        mask = op.area.mask
-        self.n = int(np.count_nonzero(mask))
-        flat = np.cumsum(mask.ravel()).reshape(mask.shape) - 1
-        row_x = op.kernel_xx[op.area.ny - 1]
-        row_y = op.kernel_yy[op.area.ny - 1]
+        self.n = int(np.count_nonzero(op.area.mask))
         self.blocks = []
-        cache: dict[bytes, tuple[object, object]] = {}
-        for j in range(op.area.ny):
-            cols = np.flatnonzero(mask[j])
-            if cols.size == 0:
-                continue
-            key = (cols - cols[0]).tobytes()
-            if key not in cache:
-                d = cols[:, None] - cols[None, :] + op.area.nx - 1
-                cache[key] = (scipy.linalg.lu_factor(row_x[d]), scipy.linalg.lu_factor(row_y[d]))
-            self.blocks.append((flat[j, cols], *cache[key]))
+        # strips of one pattern share their block arrays: factor each once
+        factored: dict[int, tuple[object, object]] = {}
+        for idx, bxx, byy in op.strip_blocks():
+            if id(bxx) not in factored:
+                factored[id(bxx)] = (scipy.linalg.lu_factor(bxx), scipy.linalg.lu_factor(byy))
+            self.blocks.append((idx, *factored[id(bxx)]))
 
     def solve(self, v: FloatArray) -> FloatArray:
         out = np.empty_like(v)
@@ -325,8 +342,7 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
             raise InvalidInputError(f"{name} must be finite")
     op = operator or SteadyRollingOperator.of(area, nu=nu, shear_modulus=shear_modulus)
     mask = area.mask
-    jj, ii = np.nonzero(mask)
-    n = jj.size
+    n = int(np.count_nonzero(mask))
     # rows of B's transpose are contiguous: the update of all slips by one
     # strip's traction change reads them.
     bt = np.ascontiguousarray(op.dense().T)
@@ -336,23 +352,17 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
     c = 1.0 / math.sqrt(d_x * d_y)
     tau = np.zeros((n, 2))
     s = np.concatenate([wx[mask], wy[mask]])
-    row_x = op.kernel_xx[area.ny - 1]
-    row_y = op.kernel_yy[area.ny - 1]
     strips = []
-    cache: dict[bytes, FloatArray] = {}
-    for j in range(area.ny):
-        idx = np.flatnonzero(jj == j)
-        if idx.size == 0:
-            continue
-        cols = ii[idx]
-        key = (cols - cols[0]).tobytes()
-        if key not in cache:
-            d = cols[:, None] - cols[None, :] + area.nx - 1
+    # each strip's block, negated (positive diagonal) and x/y interleaved; shared
+    # by strips of one pattern
+    interleaved: dict[int, FloatArray] = {}
+    for idx, bxx, byy in op.strip_blocks():
+        if id(bxx) not in interleaved:
             bp = np.zeros((2 * idx.size, 2 * idx.size))
-            bp[0::2, 0::2] = -row_x[d]
-            bp[1::2, 1::2] = -row_y[d]
-            cache[key] = bp
-        strips.append((idx, cache[key]))
+            bp[0::2, 0::2] = -bxx
+            bp[1::2, 1::2] = -byy
+            interleaved[id(bxx)] = bp
+        strips.append((idx, interleaved[id(bxx)]))
     scale = mu * float(area.pressure.max())
     slip = np.zeros(n, dtype=bool)
     for sweep in range(1, max_sweeps + 1):
