@@ -40,7 +40,8 @@ from fastsim_ros.contact.equivalent import (equivalent_coefficients,  # noqa: E4
                                             equivalent_fastsim)
 from fastsim_ros.contact.fastsim import traction_bound  # noqa: E402
 from fastsim_ros.contact.mae import (mae_coefficients, mae_fastsim,  # noqa: E402
-                                     mae_fastsim_coefficients, mae_geometry, strip_flexibility)
+                                     mae_fastsim_coefficients, mae_geometry, strip_flexibility,
+                                     zone_flexibilities)
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
 
 DOCS = ROOT / "docs"
@@ -182,7 +183,7 @@ def _notch_carry_over() -> dict[str, float]:
     t = coefficient_table(NU_COEF)
     ar = samples.notched_ellipse(cells=ONLINE_CELLS)
     geo = mae_geometry(ar)
-    flex = strip_flexibility(ar, geo, t, 1.0)
+    flex = strip_flexibility(ar, geo, zone_flexibilities(geo, t, 1.0))
     c2 = ar.area / math.pi
     unbounded = np.where(ar.mask, np.inf, 0.0)
     restart = mae_fastsim(ar, 1.0, 0.0, 0.0, bound=unbounded, table=t, shear_modulus=1.0)

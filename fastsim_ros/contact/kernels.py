@@ -607,14 +607,15 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
 def mae_strip_flexibility(geo, flex):
     """Fill ``flex`` ``(4, ny)`` with each strip's zone ``L1, L2, L3, L4`` (m/Pa).
 
-    Strips of an empty zone carry no contact: any finite value will do (1).
+    Strips of an empty zone hold no cell in contact: infinite flexibility, as
+    :func:`fastsim_ros.contact.mae.strip_flexibility` gives them.
     """
     f = int(geo[G_FACE])
     for j in range(flex.shape[1]):
         base = G_FLEX1 if j < f else G_FLEX2
         for k in range(4):
             v = geo[base + k]
-            flex[k, j] = 1.0 if math.isnan(v) else v
+            flex[k, j] = math.inf if math.isnan(v) else v
 
 
 # ---------------------------------------------------------------- traction bounds

@@ -242,19 +242,30 @@ def zone_flexibility(zone: Zone, table: CoefficientTable,
                            math.pi * a**1.5 / (8.0 * g * math.sqrt(b) * h["c23"]), l4)
 
 
-def strip_flexibility(area: GridArea, geometry: MaeGeometry, table: CoefficientTable,
-                      shear_modulus: float) -> StripFlexibility:
-    """Each strip's ``L1, L2, L3, L4`` from its zone."""
+ZonePair = tuple[ZoneFlexibility | None, ZoneFlexibility | None]
+
+
+def zone_flexibilities(geometry: MaeGeometry, table: CoefficientTable,
+                       shear_modulus: float) -> ZonePair:
+    """Return both zones' flexibilities (``None`` for an empty zone)."""
+    z1, z2 = (None if z.empty else zone_flexibility(z, table, shear_modulus)
+              for z in (geometry.zone1, geometry.zone2))
+    return z1, z2
+
+
+def strip_flexibility(area: GridArea, geometry: MaeGeometry,
+                      zones: ZonePair) -> StripFlexibility:
+    """Each strip's ``L1, L2, L3, L4`` from its zone's (:func:`zone_flexibilities`).
+
+    The strips of an empty zone hold no cell in contact; they get an infinite
+    flexibility, with which no traction builds.
+    """
     lower = area.y < geometry.y_s
-    out = {}
-    for name in ("l1", "l2", "l3", "l4"):
-        out[name] = np.full(area.ny, math.nan)
-    for zone, rows in ((geometry.zone1, lower), (geometry.zone2, ~lower)):
-        if zone.empty:
-            continue
-        f = zone_flexibility(zone, table, shear_modulus)
-        for name in out:
-            out[name][rows] = getattr(f, name)
+    out = {name: np.full(area.ny, math.inf) for name in ("l1", "l2", "l3", "l4")}
+    for f, rows in zip(zones, (lower, ~lower)):
+        if f is not None:
+            for name in out:
+                out[name][rows] = getattr(f, name)
     return StripFlexibility(out["l1"], out["l2"], out["l3"], out["l4"])
 
 
@@ -267,7 +278,7 @@ class MaeResult:
     mz: float
     traction: Tractions
     geometry: MaeGeometry
-    flexibility: tuple[ZoneFlexibility | None, ZoneFlexibility | None]
+    flexibility: ZonePair
 
 
 def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
@@ -281,15 +292,11 @@ def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: Flo
     combined ``G`` (Pa); ``table``: coefficients at the material's ``nu``.
     """
     geometry = mae_geometry(area, rule)
-    flex = strip_flexibility(area, geometry, table, shear_modulus)
-    # strips outside both zones carry no contact: any finite flexibility will do
-    safe = StripFlexibility(*(np.nan_to_num(v, nan=1.0) for v in
-                              (flex.l1, flex.l2, flex.l3, flex.spin)))
-    res = fastsim(area, xi, eta, phi, bound=bound, flexibility=safe,
+    zones = zone_flexibilities(geometry, table, shear_modulus)
+    res = fastsim(area, xi, eta, phi, bound=bound,
+                  flexibility=strip_flexibility(area, geometry, zones),
                   sweep_point=(geometry.x_c, geometry.y_s), reference=reference)
-    zones = tuple(None if z.empty else zone_flexibility(z, table, shear_modulus)
-                  for z in (geometry.zone1, geometry.zone2))
-    return MaeResult(res.fx, res.fy, res.mz, res, geometry, (zones[0], zones[1]))
+    return MaeResult(res.fx, res.fy, res.mz, res, geometry, zones)
 
 
 def mae_fastsim_coefficients(area: GridArea, table: CoefficientTable, *,
