@@ -204,7 +204,7 @@ def scan_patch(p, count, first, last, env):
 
 @njit(cache=True, error_model="numpy")
 def in_table(knots, a_over_b):
-    """Whether ``a/b`` lies in the tables' range (``tables._log_ratio``'s test)."""
+    """Whether ``a/b`` lies in the tables' range (``CoefficientTable._log_ratio``'s test)."""
     if not (math.isfinite(a_over_b) and a_over_b > 0.0):
         return False
     t = math.log(a_over_b)

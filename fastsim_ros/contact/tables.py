@@ -97,7 +97,20 @@ class CoefficientTable:
 
     def __call__(self, name: str, a_over_b: float) -> float:
         """Return coefficient ``name`` (``"C11"`` ... ``"c23"``) at ``a/b``."""
-        t = _log_ratio(a_over_b)
+        return self._at(name, self._log_ratio(a_over_b))
+
+    def _log_ratio(self, a_over_b: float) -> float:
+        """Return ``log(a/b)``; refuse a ratio outside the knots."""
+        if not (math.isfinite(a_over_b) and a_over_b > 0.0):
+            raise InvalidInputError(f"a/b must be positive and finite, got {a_over_b}")
+        t = math.log(a_over_b)
+        lo, hi = float(self.knots[0]), float(self.knots[-1])
+        if not (lo - 1e-12 <= t <= hi + 1e-12):
+            raise OutOfTableError(f"a/b = {a_over_b:.4g} lies outside the tables' range "
+                                  f"[{math.exp(lo):g}, {math.exp(hi):g}]")
+        return t
+
+    def _at(self, name: str, t: float) -> float:
         k = min(max(int(np.searchsorted(self.knots, t)) - 1, 0), self.knots.size - 2)
         c = self.poly[name][:, k]
         u = t - self.knots[k]
@@ -105,28 +118,13 @@ class CoefficientTable:
 
     def kalker(self, a_over_b: float) -> tuple[float, float, float]:
         """Return Kalker's ``(C11, C22, C23)`` of a full ellipse."""
-        return self("C11", a_over_b), self("C22", a_over_b), self("C23", a_over_b)
+        t = self._log_ratio(a_over_b)
+        return self._at("C11", t), self._at("C22", t), self._at("C23", t)
 
     def half(self, a_over_b: float) -> dict[str, float]:
         """Return the half-ellipse ``c11 ... c23`` (METHOD.md section 3.4)."""
-        return {n: self(n, a_over_b) for n in HALF_NAMES}
-
-    @property
-    def log_range(self) -> tuple[float, float]:
-        """``log(a/b)`` range the table covers."""
-        return float(self.knots[0]), float(self.knots[-1])
-
-
-def _log_ratio(a_over_b: float) -> float:
-    if not (math.isfinite(a_over_b) and a_over_b > 0.0):
-        raise InvalidInputError(f"a/b must be positive and finite, got {a_over_b}")
-    t = math.log(a_over_b)
-    data = table_data()
-    lo, hi = math.log(data.a_over_b[0]), math.log(data.a_over_b[-1])
-    if not (lo - 1e-12 <= t <= hi + 1e-12):
-        raise OutOfTableError(f"a/b = {a_over_b:.4g} lies outside the tables' range "
-                              f"[{data.a_over_b[0]:g}, {data.a_over_b[-1]:g}]")
-    return t
+        t = self._log_ratio(a_over_b)
+        return {n: self._at(n, t) for n in HALF_NAMES}
 
 
 @lru_cache(maxsize=16)
