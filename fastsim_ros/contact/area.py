@@ -116,11 +116,6 @@ class GridArea:
         """Return the area with all lengths scaled by ``k``; pressure unchanged."""
         return GridArea(self.x0 * k, self.y0 * k, self.dx * k, self.dy * k, self.pressure)
 
-    def padded(self, left: int = 0, right: int = 0, bottom: int = 0, top: int = 0) -> GridArea:
-        """Return the same area on a grid with empty cells added (x: left/right, y: bottom/top)."""
-        p = np.pad(self.pressure, ((bottom, top), (left, right)))
-        return GridArea(self.x0 - left * self.dx, self.y0 - bottom * self.dy, self.dx, self.dy, p)
-
     def cropped(self) -> GridArea:
         """Return the area on the smallest grid that holds every cell in contact."""
         rows = np.flatnonzero(self.mask.any(axis=1))

@@ -79,14 +79,6 @@ class InfluenceKernel:
     xy: FloatArray
     zz: FloatArray
 
-    def at(self, di: NDArray[np.int_] | int, dj: NDArray[np.int_] | int) -> tuple[
-        FloatArray, FloatArray, FloatArray
-    ]:
-        """Tangential coefficients ``(xx, yy, xy)`` at offsets ``di``, ``dj``."""
-        i = np.asarray(di) + self.mx
-        j = np.asarray(dj) + self.my
-        return self.xx[j, i], self.yy[j, i], self.xy[j, i]
-
 
 def influence_kernel(
     hx: float, hy: float, mx: int, my: int, *, shear_modulus: float, nu: float
