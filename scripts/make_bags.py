@@ -1,0 +1,687 @@
+#!/usr/bin/env python3
+"""Write the bundled scenario bags into ``bags/`` (deterministic: same content every run).
+
+Each bag is a rosbag2 directory (``metadata.yaml`` version 9 and one
+``.mcap`` with zstd chunk compression, CDR, ``ros2msg`` schemas) with the
+wheelset twist and the contact patches of ``../shared/INTERFACE.md``, and a
+parameter file ``bags/<name>.params.yaml`` for the node ``fastsim``.  The
+bad-input bag also gets ``bags/bad_inputs.expected.yaml``: the outcome of
+every patch by contact, computed by reading the written bag back and
+classifying each patch by the interface's rules.  ``bags/README.md`` is
+written by hand and describes the scenarios.
+
+Usage: ``python scripts/make_bags.py [--out DIR] [--only NAME ...]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+import shutil
+import sys
+import time
+from typing import Any, Callable
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from fastsim_ros.contact.area import GridArea  # noqa: E402
+from fastsim_ros.contact.normal import hertz_ellipse, solve_normal  # noqa: E402
+from fastsim_ros.contact.samples import semi_ellipses_patch  # noqa: E402
+from rosbags.interfaces import (  # noqa: E402
+    Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime)
+from rosbags.rosbag2 import Reader, Writer  # noqa: E402
+from rosbags.rosbag2.enums import CompressionFormat, CompressionMode, StoragePlugin  # noqa: E402
+from rosbags.typesys import get_typestore, Stores  # noqa: E402
+
+TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+T = TYPESTORE.types
+CLOUD = "sensor_msgs/msg/PointCloud2"
+TWIST = "geometry_msgs/msg/TwistStamped"
+
+#: first stamp of every bag (ns since the epoch): realistic, the same every run
+T0_NS = 1_700_000_000 * 10**9
+FRAME = "wheelset"
+G = 8.0e10
+NU = 0.28
+R = 0.46            # wheel radius (m)
+Y_WHEEL = 0.75      # lateral position of the nominal tread contact (m)
+TWIST_DT = 0.005    # 200 Hz
+PATCH_DT = 0.010    # 100 Hz
+PATCH_OFFSET = 0.0025  # patches lie between twists: no stamp ties, no boundary ages
+FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure")
+REASONS = ("nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",
+           "old_stamp", "no_kinematics", "stale_kinematics", "standstill", "too_large",
+           "degenerate", "out_of_table")
+#: parameters of the node that the bad-input bag relies on
+MAX_PATCH_CELLS = 4096
+MAX_KINEMATICS_AGE = 0.05
+MIN_ROLLING_SPEED = 0.1
+
+QOS = [Qos(QosHistory.KEEP_LAST, 10, QosReliability.RELIABLE, QosDurability.VOLATILE,
+           QosTime(0, 0), QosTime(0, 0), QosLiveliness.AUTOMATIC, QosTime(0, 0), False)]
+
+
+# --------------------------------------------------------------------- messages
+
+def stamp_ns(t: float) -> int:
+    """Return the stamp (ns) of time ``t`` (s) after the bag's start, rounded to 1 us."""
+    return T0_NS + int(round(t * 1e6)) * 1000
+
+
+def header(ns: int, frame: str = FRAME) -> Any:
+    """Make a ``std_msgs/Header``."""
+    return T["std_msgs/msg/Header"](
+        stamp=T["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9),
+        frame_id=frame)
+
+
+def vec(v: Any) -> Any:
+    """Make a ``geometry_msgs/Vector3``."""
+    return T["geometry_msgs/msg/Vector3"](x=float(v[0]), y=float(v[1]), z=float(v[2]))
+
+
+def twist_msg(ns: int, linear: Any, angular: Any) -> Any:
+    """Make a ``geometry_msgs/TwistStamped`` in the wheelset frame."""
+    return T[TWIST](header=header(ns),
+                    twist=T["geometry_msgs/msg/Twist"](linear=vec(linear), angular=vec(angular)))
+
+
+def contact_axes(normal: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return ``e_x, e_y, e_z`` of a contact plane with normal ``normal`` (into the wheel)."""
+    ez = np.asarray(normal, dtype=float)
+    ez = ez / np.linalg.norm(ez)
+    ex = np.array([1.0, 0.0, 0.0])
+    ex = ex - ez * float(ez @ ex)
+    ex /= np.linalg.norm(ex)
+    return ex, np.cross(ez, ex), ez
+
+
+def left_normal(gamma: float) -> np.ndarray:
+    """Return the contact normal of the left wheel at contact angle ``gamma`` (rad)."""
+    return np.array([0.0, -math.sin(gamma), math.cos(gamma)])
+
+
+def right_normal(gamma: float) -> np.ndarray:
+    """Return the contact normal of the right wheel at contact angle ``gamma`` (rad)."""
+    return np.array([0.0, math.sin(gamma), math.cos(gamma)])
+
+
+def cloud_points(area: GridArea, origin: Any, normal: Any) -> np.ndarray:
+    """Return the ``(ny, nx, 7)`` float32 points of ``area`` laid on its contact plane.
+
+    ``origin``: the contact point in the wheelset frame (the area's in-plane
+    origin); ``normal``: the contact normal, pointing into the wheel.
+    """
+    ex, ey, ez = contact_axes(normal)
+    xx, yy = np.meshgrid(area.x, area.y)
+    pos = np.asarray(origin, float) + xx[..., None] * ex + yy[..., None] * ey
+    pts = np.empty(area.pressure.shape + (7,), dtype=np.float32)
+    pts[..., 0:3] = pos
+    pts[..., 3:6] = ez
+    pts[..., 6] = area.pressure
+    return pts
+
+
+def cloud_msg(ns: int, pts: np.ndarray, *, frame: str = FRAME,
+              fields: tuple[str, ...] = FIELDS) -> Any:
+    """Make an organised ``sensor_msgs/PointCloud2`` of ``(ny, nx, k)`` float32 points."""
+    ny, nx, k = pts.shape
+    assert k == len(fields)
+    pf = T["sensor_msgs/msg/PointField"]
+    return T[CLOUD](
+        header=header(ns, frame), height=ny, width=nx,
+        fields=[pf(name=f, offset=4 * i, datatype=pf.FLOAT32, count=1)
+                for i, f in enumerate(fields)],
+        is_bigendian=False, point_step=4 * k, row_step=4 * k * nx,
+        data=np.frombuffer(np.ascontiguousarray(pts, dtype="<f4").tobytes(), dtype=np.uint8),
+        is_dense=True)
+
+
+# ------------------------------------------------------------------------ areas
+
+def centred(area: GridArea) -> GridArea:
+    """Return ``area`` translated so that its pressure-weighted centroid is at the origin."""
+    w = area.pressure / area.pressure.sum()
+    cx = float((w.sum(axis=0) * area.x).sum())
+    cy = float((w.sum(axis=1) * area.y).sum())
+    return area.shifted(-cx, -cy)
+
+
+def padded(area: GridArea, nx: int, ny: int) -> GridArea:
+    """Return ``area`` on an ``nx`` x ``ny`` grid (same cells, zero border added around it)."""
+    px, py = nx - area.nx, ny - area.ny
+    assert px >= 2 and py >= 2, (area.nx, area.ny, nx, ny)
+    i0, j0 = px // 2, py // 2
+    p = np.zeros((ny, nx))
+    p[j0:j0 + area.ny, i0:i0 + area.nx] = area.pressure
+    return GridArea(area.x0 - i0 * area.dx, area.y0 - j0 * area.dy, area.dx, area.dy, p)
+
+
+def hertz_area(rx: float, ry: float, load: float, cells: int) -> GridArea:
+    """Return the Hertzian ellipse of gap radii ``rx``, ``ry`` (m) under ``load`` (N).
+
+    ``cells`` x ``cells`` cells over the ellipse's bounding box grown by 1.5
+    cells each side (an empty border); the discrete load is exactly ``load``.
+    """
+    hz = hertz_ellipse(rx, ry, load, shear_modulus=G, nu=NU)
+    hx, hy = hz.a * cells / (cells - 3), hz.b * cells / (cells - 3)
+    dx, dy = 2 * hx / cells, 2 * hy / cells
+    x = -hx + dx * (np.arange(cells) + 0.5)
+    y = -hy + dy * (np.arange(cells) + 0.5)
+    p = hz.pressure(x[None, :], y[:, None])
+    return GridArea(float(x[0]), float(y[0]), dx, dy, p).with_load(load)
+
+
+def normal_area(rx: float, ry_neg: float, ry_pos: float, load: float, cells: int) -> GridArea:
+    """Solve the normal contact of a two-sided gap under ``load`` (N) on ``cells`` x ``cells``.
+
+    The gap is ``x^2/(2 rx) + y^2/(2 ry)`` with ``ry = ry_neg`` for ``y < 0``
+    and ``ry_pos`` for ``y > 0`` (m).  A first solve on 1.5 times the box of
+    the Hertz ellipse of the flatter side finds the contact's extent; the
+    second solves on that extent grown by 1.5 cells each side, so the patch
+    fills its grid with an empty border.  The result is centred on its
+    pressure centroid.
+    """
+    gap = _side_gap(rx, ry_neg, ry_pos)
+    hz = hertz_ellipse(rx, max(ry_neg, ry_pos), load, shear_modulus=G, nu=NU)
+    box = (-1.5 * hz.a, 1.5 * hz.a, -1.5 * hz.b, 1.5 * hz.b)
+    for _ in range(2):
+        dx, dy = (box[1] - box[0]) / cells, (box[3] - box[2]) / cells
+        x = box[0] + dx * (np.arange(cells) + 0.5)
+        y = box[2] + dy * (np.arange(cells) + 0.5)
+        sol = solve_normal(float(x[0]), float(y[0]), dx, dy, gap(x[None, :], y[:, None]),
+                           load=load, shear_modulus=G, nu=NU)
+        if sol.touches_edge:
+            raise RuntimeError("normal solve: the box is too small")
+        m = sol.area.mask
+        xs, ys = x[m.any(axis=0)], y[m.any(axis=1)]
+        lo_x, hi_x = xs[0] - dx / 2, xs[-1] + dx / 2
+        lo_y, hi_y = ys[0] - dy / 2, ys[-1] + dy / 2
+        kx, ky = (hi_x - lo_x) * 1.5 / (cells - 3), (hi_y - lo_y) * 1.5 / (cells - 3)
+        box = (lo_x - kx, hi_x + kx, lo_y - ky, hi_y + ky)
+    return centred(sol.area)
+
+
+def semi_ellipse_area() -> GridArea:
+    """Return the two semi-ellipses ``a1/b1 = 0.5``, ``a2/b2 = 2`` of 1 cm^2 at 60 kN."""
+    base = semi_ellipses_patch(0.5, 2.0, cells=22, scale=0.01, load=6.0e4)
+    return centred(padded(base, base.nx + 2, base.ny + 2))
+
+
+# ------------------------------------------------------------------------- bags
+
+class Bag:
+    """Messages of one bag, written in log-time order (ties by topic order)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.topics: dict[str, str] = {}
+        self.items: list[tuple[int, int, int, Any]] = []  # log ns, topic idx, seq, msg
+        self.tags: dict[tuple[str, int], str] = {}  # (topic, seq) -> intended outcome
+
+    def topic(self, name: str, msgtype: str) -> None:
+        """Declare a topic; connections are written in declaration order."""
+        self.topics[name] = msgtype
+
+    def add(self, topic: str, log_ns: int, msg: Any, tag: str | None = None) -> None:
+        """Add a message logged at ``log_ns`` (ns)."""
+        idx = list(self.topics).index(topic)
+        self.items.append((log_ns, idx, len(self.items), msg))
+        if tag is not None:
+            self.tags[(topic, len(self.items) - 1)] = tag
+
+    def write(self, out: Path) -> Path:
+        """Write ``out/<name>/`` (replacing it) and return its path."""
+        path = out / self.name
+        if path.exists():
+            shutil.rmtree(path)
+        writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
+        writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+        writer.set_custom_data("generator", "scripts/make_bags.py")
+        names = list(self.topics)
+        with writer:
+            conns = [writer.add_connection(t, self.topics[t], typestore=TYPESTORE,
+                                           offered_qos_profiles=QOS) for t in names]
+            for log_ns, idx, _, msg in sorted(self.items, key=lambda it: it[:3]):
+                writer.write(conns[idx], log_ns,
+                             TYPESTORE.serialize_cdr(msg, self.topics[names[idx]]))
+        return path
+
+
+def patch_times(duration: float) -> list[float]:
+    """Return the patch times (s) of a bag: 100 Hz, offset from the twists."""
+    return [PATCH_OFFSET + PATCH_DT * k for k in range(int(round(duration / PATCH_DT)))]
+
+
+def twist_times(duration: float, start: float = 0.0) -> list[float]:
+    """Return the twist times (s) from ``start`` to ``duration``: 200 Hz."""
+    n0 = int(round(start / TWIST_DT))
+    return [TWIST_DT * k for k in range(n0, int(round(duration / TWIST_DT)))]
+
+
+def omega_for(v0: float, xi: float, radius: float) -> float:
+    """Return the axle spin (rad/s) that gives creepage ``xi`` at speed ``v0`` and ``radius``."""
+    return v0 * (1.0 - xi / 2.0) / (1.0 + xi / 2.0) / radius
+
+
+def ramp(t: float, t0: float, t1: float, y0: float, y1: float) -> float:
+    """Return the value at ``t`` of a ramp from ``y0`` at ``t0`` to ``y1`` at ``t1``, held."""
+    s = min(max((t - t0) / (t1 - t0), 0.0), 1.0)
+    return y0 + (y1 - y0) * s
+
+
+def track_bag(name: str, contacts: list[str]) -> Bag:
+    """Return a bag with the wheelset twist and the patch topics of ``contacts``."""
+    bag = Bag(name)
+    bag.topic("/wheelset/twist", TWIST)
+    for c in contacts:
+        bag.topic(f"/contact/{c}/patch", CLOUD)
+    return bag
+
+
+def hertz_ramp() -> tuple[Bag, dict[str, Any]]:
+    """Build (a): Hertzian treads, braking creepage ramp 0 -> 1e-2 at 20 m/s."""
+    dur, v0 = 4.0, 20.0
+    bag = track_bag("hertz_ramp", ["left", "right"])
+    area = hertz_area(R, 0.3, 6.0e4, 24)
+    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
+           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
+    for t in twist_times(dur):
+        xi = ramp(t, 0.5, 3.5, 0.0, 1.0e-2)
+        bag.add("/wheelset/twist", stamp_ns(t),
+                twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, xi, R), 0)))
+    for t in patch_times(dur):
+        for c in ("left", "right"):
+            bag.add(f"/contact/{c}/patch", stamp_ns(t), cloud_msg(stamp_ns(t), pts[c]))
+    return bag, {}
+
+
+def semi_ellipses_spin() -> tuple[Bag, dict[str, Any]]:
+    """Build (b): two semi-ellipses, contact angle ramp 0 -> 0.4 rad, xi = eta = 0."""
+    dur, v0 = 4.0, 20.0
+    bag = track_bag("semi_ellipses_spin", ["left", "right"])
+    area = semi_ellipse_area()
+    mirror = area.mirrored_y()
+    for t in twist_times(dur):
+        bag.add("/wheelset/twist", stamp_ns(t),
+                twist_msg(stamp_ns(t), (v0, 0, 0), (0, v0 / R, 0)))
+    for t in patch_times(dur):
+        gamma = ramp(t, 0.5, 3.5, 0.0, 0.4)
+        ns = stamp_ns(t)
+        bag.add("/contact/left/patch", ns,
+                cloud_msg(ns, cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(gamma))))
+        bag.add("/contact/right/patch", ns,
+                cloud_msg(ns, cloud_points(mirror, (0.0, -Y_WHEEL, -R), right_normal(gamma))))
+    return bag, {}
+
+
+def _side_gap(rx: float, ry_neg: float, ry_pos: float) -> Callable[..., np.ndarray]:
+    def gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return x**2 / (2 * rx) + y**2 / (2 * np.where(y < 0.0, ry_neg, ry_pos))
+    return gap
+
+
+def flange_shift() -> tuple[Bag, dict[str, Any]]:
+    """Build (c): normal-solver patches, lateral shift tread -> flange root, two-point stretch.
+
+    Ten shifts ``s = k/9`` held 0.4 s each.  Left tread: contact angle
+    0.03 -> 0.5 rad, rolling radius 0.46 -> 0.466 m, lateral radius on the
+    flange side (in-plane ``y < 0``) 0.3 -> 0.03 m.  Right tread: angle
+    0.03 -> 0.01 rad, radius 0.46 -> 0.458 m, field-side radius 0.45 -> 0.75 m.
+    From ``k = 7`` on the left flange (angle 1.1 rad, radius 0.475 m) carries
+    15, 30, 45 kN and the left tread the rest of 60 kN.  The axle spins at
+    ``v0 / mean(R_left, R_right)``: the wheels get opposite creepages.
+    """
+    dur, v0, hold, nshift = 4.0, 20.0, 0.4, 10
+    bag = track_bag("flange_shift", ["left", "right", "left_flange"])
+    radii, clouds = [], []
+    fl_area = None
+    for k in range(nshift):
+        s = k / (nshift - 1)
+        d = 0.008 * s
+        g_l, r_l = 0.03 + 0.47 * s, 0.46 + 0.006 * s
+        g_r, r_r = 0.03 - 0.02 * s, 0.46 - 0.002 * s
+        flange_load = 15.0e3 * (k - 6) if k >= 7 else 0.0
+        left = normal_area(r_l / math.cos(g_l), 0.3 * 0.1**s, 0.3, 6.0e4 - flange_load, 24)
+        right = normal_area(r_r / math.cos(g_r), 0.3, 0.45 + 0.3 * s, 6.0e4, 24)
+        pl = (0.0, Y_WHEEL - d, -r_l)
+        pr = (0.0, -Y_WHEEL - d, -r_r)
+        c = {"left": cloud_points(left, pl, left_normal(g_l)),
+             "right": cloud_points(right, pr, right_normal(g_r))}
+        g_f, r_f = 1.1, 0.475
+        pf = (0.0, Y_WHEEL - d - 0.035, -r_f)
+        if flange_load > 0.0:
+            fl_area = normal_area(r_f / math.cos(g_f), 0.04, 0.08, flange_load, 24)
+            c["left_flange"] = cloud_points(fl_area, pf, left_normal(g_f))
+        clouds.append(c)
+        radii.append((r_l, r_r))
+    # no flange contact: empty patches on the first flange patch's grid
+    assert fl_area is not None
+    empty = cloud_points(fl_area.with_pressure(np.ones_like(fl_area.pressure)),
+                         (0.0, Y_WHEEL - 0.035, -0.475), left_normal(1.1))
+    empty[..., 6] = 0.0
+    for t in twist_times(dur):
+        k = min(int(t / hold), nshift - 1)
+        omega = v0 / (0.5 * (radii[k][0] + radii[k][1]))
+        bag.add("/wheelset/twist", stamp_ns(t), twist_msg(stamp_ns(t), (v0, 0, 0),
+                                                          (0, omega, 0)))
+    for t in patch_times(dur):
+        k = min(int(t / hold), nshift - 1)
+        ns = stamp_ns(t)
+        for name in ("left", "right", "left_flange"):
+            pts = clouds[k].get(name, empty)
+            bag.add(f"/contact/{name}/patch", ns, cloud_msg(ns, pts))
+    return bag, {}
+
+
+def roller_rig() -> tuple[Bag, dict[str, Any]]:
+    """Build (d): one wheel on a roller, speed mismatch xi -5e-3 -> +5e-3 at 15 m/s."""
+    dur, s_r, r_roll = 4.0, 15.0, 0.5
+    bag = Bag("roller_rig")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/rail/twist", TWIST)
+    bag.topic("/contact/wheel/patch", CLOUD)
+    area = hertz_area(1.0 / (1.0 / R + 1.0 / r_roll), 0.3, 5.0e4, 24)
+    pts = cloud_points(area, (0.0, 0.0, -R), (0.0, 0.0, 1.0))
+    omega_r = s_r / r_roll
+    w_r = np.array([0.0, -omega_r, 0.0])
+    v_r = np.cross(w_r, -np.array([0.0, 0.0, -(R + r_roll)]))
+    for t in twist_times(dur):
+        xi = ramp(t, 0.25, 3.75, -5.0e-3, 5.0e-3)
+        ns = stamp_ns(t)
+        bag.add("/wheelset/twist", ns, twist_msg(ns, (0, 0, 0), (0, omega_for(s_r, xi, R), 0)))
+        bag.add("/rail/twist", ns, twist_msg(ns, v_r, w_r))
+    for t in patch_times(dur):
+        bag.add("/contact/wheel/patch", stamp_ns(t), cloud_msg(stamp_ns(t), pts))
+    return bag, {"contacts": ["wheel"], "rail_twist_required": True}
+
+
+def bad_inputs() -> tuple[Bag, dict[str, Any]]:
+    """Build (e): good Hertzian patches on two treads interleaved with bad ones.
+
+    See ``bags/README.md`` for the timeline; every patch is tagged with the
+    outcome it is meant to have, and the tags are checked against a
+    classification of the bag read back.
+    """
+    dur, v0, xi = 3.0, 15.0, 2.0e-3
+    contacts = ["left", "right"]
+    bag = track_bag("bad_inputs", contacts)
+    area = hertz_area(R, 0.3, 6.0e4, 20)
+    origin = {"left": (0.0, Y_WHEEL, -R), "right": (0.0, -Y_WHEEL, -R)}
+    normal = {"left": left_normal(0.0), "right": right_normal(0.0)}
+    good = {c: cloud_points(area, origin[c], normal[c]) for c in contacts}
+    omega = omega_for(v0, xi, R)
+    for t in twist_times(dur, start=0.1):
+        if 1.5 <= t < 1.7 - 1e-9:  # the twist stops: stale kinematics
+            continue
+        ns = stamp_ns(t)
+        moving = not (2.2 <= t < 2.4 - 1e-9)  # standstill
+        bag.add("/wheelset/twist", ns, twist_msg(ns, (v0 if moving else 0.0, 0, 0),
+                                                 (0, omega if moving else 0.0, 0)))
+    times = patch_times(dur)
+    kinds = ["nonfinite_p", "negative_pressure", "missing_field", "wrong_frame", "old_stamp",
+             "irregular_grid", "too_large", "degenerate", "nonfinite_x", "negative_pressure",
+             "missing_field", "wrong_frame", "old_stamp", "irregular_grid", "too_large",
+             "degenerate", "nonfinite_n"]
+    bad: dict[str, dict[int, str]] = {c: {} for c in contacts}
+    for c, first in (("left", 20), ("right", 22)):  # slots from 0.2025 s, every 5th
+        for i, kind in enumerate(kinds):
+            bad[c][first + 5 * i] = kind
+        # a wheel lifting: empty patches
+        lifts = (180, 181, 182, 183, 184, 200, 201, 202, 203, 204) if c == "left" \
+            else (190, 191, 205, 206)
+        for slot in lifts:
+            bad[c][slot] = "no_contact"
+    for k, t in enumerate(times):
+        for c in contacts:
+            kind = bad[c].get(k, "good")
+            ns = stamp_ns(t)
+            topic = f"/contact/{c}/patch"
+            bag.add(topic, ns, bad_patch(kind, ns, stamp_ns(times[k - 1]), good[c], area,
+                                         origin[c], normal[c]), tag=kind)
+    return bag, {"max_patch_cells": MAX_PATCH_CELLS}
+
+
+def bad_patch(kind: str, ns: int, prev_ns: int, good: np.ndarray, area: GridArea,
+              origin: Any, normal: Any) -> Any:
+    """Return the patch message of ``kind`` ("good" or a bad kind) logged at ``ns``."""
+    pts = good.copy()
+    inside = np.argwhere(area.pressure > 0.0)
+    j, i = (int(v) for v in inside[len(inside) // 2])  # a cell in contact
+    if kind == "good":
+        return cloud_msg(ns, pts)
+    if kind == "nonfinite_p":
+        pts[j, i, 6] = np.nan
+    elif kind == "nonfinite_x":
+        pts[j, i, 0] = np.nan
+    elif kind == "nonfinite_n":
+        pts[j, i, 5] = np.inf
+    elif kind == "negative_pressure":
+        pts[j, i, 6] = -pts[j, i, 6]
+    elif kind == "missing_field":
+        return cloud_msg(ns, np.ascontiguousarray(pts[..., :6]), fields=FIELDS[:6])
+    elif kind == "wrong_frame":
+        return cloud_msg(ns, pts, frame="base_link")
+    elif kind == "old_stamp":
+        return cloud_msg(prev_ns - 3_000_000, pts)  # logged at ns, stamped before the last
+    elif kind == "irregular_grid":
+        ex = contact_axes(normal)[0]
+        pts[j, :, 0:3] += (0.3 * area.dx * ex).astype(np.float32)
+    elif kind == "too_large":
+        big = padded(area, 80, 80)
+        pts = cloud_points(big, origin, normal)
+    elif kind == "degenerate":
+        p = np.zeros_like(area.pressure)
+        p[j, i - 1:i + 2] = area.pressure[j, i]
+        pts = cloud_points(area.with_pressure(p), origin, normal)
+    elif kind == "no_contact":
+        pts[..., 6] = 0.0
+    else:
+        raise ValueError(kind)
+    return cloud_msg(ns, pts)
+
+
+# ------------------------------------------------------------ expected outcomes
+
+def classify_bag(path: Path, params: dict[str, Any]) -> list[tuple[str, str, int]]:
+    """Return ``(contact, outcome, log ns)`` of every patch of a bag, read back from disk.
+
+    The rules of INTERFACE.md, in this order: the size bound, frame, fields,
+    non-finite values, negative pressure, grid regularity, stamp order, empty
+    (``no_contact``), fewer than 4 cells (``degenerate``), kinematics
+    (``no_kinematics``, ``stale_kinematics``), ``standstill``; else
+    ``served``.  Each bad patch of the bag has one fault only, so the order
+    does not decide any outcome.
+    """
+    max_cells = int(params.get("max_patch_cells", MAX_PATCH_CELLS))
+    out: list[tuple[str, str, int]] = []
+    last_twist: Any = None
+    last_stamp: dict[str, int] = {}
+    with Reader(path) as reader:
+        for conn, log_ns, raw in reader.messages():
+            msg = TYPESTORE.deserialize_cdr(raw, conn.msgtype)
+            if conn.topic == "/wheelset/twist":
+                last_twist = msg
+                continue
+            contact = conn.topic.split("/")[2]
+            ns = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+            outcome = _classify_patch(msg, max_cells)
+            if outcome is None:
+                if contact in last_stamp and ns < last_stamp[contact]:
+                    outcome = "old_stamp"
+                else:
+                    last_stamp[contact] = ns
+                    outcome = _kinematics(msg, ns, last_twist)
+            out.append((contact, outcome, log_ns))
+    return out
+
+
+def _classify_patch(msg: Any, max_cells: int) -> str | None:
+    if msg.height * msg.width > max_cells:
+        return "too_large"
+    if msg.header.frame_id != FRAME:
+        return "wrong_frame"
+    names = [f.name for f in msg.fields]
+    if any(f not in names for f in FIELDS):
+        return "missing_field"
+    pts = np.frombuffer(msg.data.tobytes(), dtype="<f4").reshape(msg.height, msg.width, -1)
+    if not np.all(np.isfinite(pts)):
+        return "nonfinite"
+    if np.any(pts[..., 6] < 0.0):
+        return "negative_pressure"
+    # regular grid: constant steps along rows and along columns
+    pos = pts[..., 0:3].astype(float)
+    step_x = np.diff(pos, axis=1)
+    step_y = np.diff(pos, axis=0)
+    tol = 1e-3 * min(np.linalg.norm(step_x[0, 0]), np.linalg.norm(step_y[0, 0]))
+    if np.abs(step_x - step_x[0, 0]).max() > tol or np.abs(step_y - step_y[0, 0]).max() > tol:
+        return "irregular_grid"
+    return None
+
+
+def _kinematics(msg: Any, ns: int, twist: Any) -> str:
+    pts = np.frombuffer(msg.data.tobytes(), dtype="<f4").reshape(msg.height, msg.width, -1)
+    p = pts[..., 6].astype(float)
+    n_in = int(np.count_nonzero(p > 0.0))
+    if n_in == 0:
+        return "no_contact"
+    if n_in < 4:
+        return "degenerate"
+    if twist is None:
+        return "no_kinematics"
+    t_ns = twist.header.stamp.sec * 10**9 + twist.header.stamp.nanosec
+    if ns - t_ns > MAX_KINEMATICS_AGE * 1e9:
+        return "stale_kinematics"
+    # rolling speed on track at the pressure centroid
+    w = p / p.sum()
+    c = (pts[..., 0:3].astype(float) * w[..., None]).sum(axis=(0, 1))
+    ez = (pts[..., 3:6].astype(float) * p[..., None]).sum(axis=(0, 1))
+    ez /= np.linalg.norm(ez)
+    ex = np.array([1.0, 0.0, 0.0]) - ez * ez[0]
+    ex /= np.linalg.norm(ex)
+    lin = np.array([twist.twist.linear.x, twist.twist.linear.y, twist.twist.linear.z])
+    ang = np.array([twist.twist.angular.x, twist.twist.angular.y, twist.twist.angular.z])
+    u_w = lin + np.cross(ang, c)
+    cp = lin + np.cross(np.array([ang[0], 0.0, ang[2]]), c)
+    speed = float(ex @ (cp - u_w / 2.0))
+    return "standstill" if abs(speed) < MIN_ROLLING_SPEED else "served"
+
+
+def expected_counts(outcomes: list[tuple[str, str, int]]) -> dict[str, Any]:
+    """Return the per-contact counts of patches, served, no_contact and each rejection."""
+    res: dict[str, Any] = {}
+    for contact in sorted({c for c, _, _ in outcomes}):
+        got = [o for c, o, _ in outcomes if c == contact]
+        res[contact] = {
+            "patches": len(got),
+            "served": got.count("served"),
+            "no_contact": got.count("no_contact"),
+            "rejected": {r: got.count(r) for r in REASONS},
+        }
+    return res
+
+
+# ------------------------------------------------------------------ params, main
+
+SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
+    "hertz_ramp": hertz_ramp,
+    "semi_ellipses_spin": semi_ellipses_spin,
+    "flange_shift": flange_shift,
+    "roller_rig": roller_rig,
+    "bad_inputs": bad_inputs,
+}
+
+BASE_PARAMS: dict[str, Any] = {
+    "contacts": ["left", "right"],
+    "wheelset_frame": FRAME,
+    "shear_modulus": G,
+    "poisson_ratio": NU,
+    "friction_coefficient": 0.3,
+    "method": "mae",
+    "traction_bound": "given",
+    "min_rolling_speed": MIN_ROLLING_SPEED,
+    "max_kinematics_age": MAX_KINEMATICS_AGE,
+    "publish_traction": False,
+}
+
+
+def _yaml_value(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float):
+        return f"{v:.1e}" if abs(v) >= 1e5 else repr(v)
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_yaml_value(x) for x in v) + "]"
+    return f'"{v}"'
+
+
+def params_text(name: str, params: dict[str, Any]) -> str:
+    """Return the ROS 2 parameter file of bag ``name`` (node ``fastsim``)."""
+    lines = [f"# Node parameters for bags/{name} (made by scripts/make_bags.py)",
+             "fastsim:", "  ros__parameters:"]
+    lines += [f"    {k}: {_yaml_value(v)}" for k, v in params.items()]
+    return "\n".join(lines) + "\n"
+
+
+def expected_text(counts: dict[str, Any]) -> str:
+    """Return ``bad_inputs.expected.yaml``: outcomes by contact."""
+    lines = ["# Expected outcome of every patch of bags/bad_inputs by contact, computed by",
+             "# scripts/make_bags.py from the bag it wrote (params: bad_inputs.params.yaml).",
+             "# served: a wrench from a solve; no_contact: an empty patch, a zero wrench;",
+             "# rejected/<reason>: no wrench.", "contacts:"]
+    for contact, c in counts.items():
+        lines += [f"  {contact}:", f"    patches: {c['patches']}", f"    served: {c['served']}",
+                  f"    no_contact: {c['no_contact']}", "    rejected:"]
+        lines += [f"      {r}: {n}" for r, n in c["rejected"].items()]
+    return "\n".join(lines) + "\n"
+
+
+def build(name: str, out: Path) -> Path:
+    """Write bag ``name``, its params file and (bad inputs) its expected outcomes."""
+    bag, extra = SCENARIOS[name]()
+    params = dict(BASE_PARAMS, **extra)
+    path = bag.write(out)
+    (out / f"{name}.params.yaml").write_text(params_text(name, params))
+    if bag.tags:
+        outcomes = classify_bag(path, params)
+        for contact in sorted({c for c, _, _ in outcomes}):
+            topic = f"/contact/{contact}/patch"
+            seen = [o for c, o, _ in outcomes if c == contact]
+            keys = sorted((key for key in bag.tags if key[0] == topic),
+                          key=lambda key: bag.items[key[1]][:3])
+            assert len(seen) == len(keys)
+            for got, key in zip(seen, keys):
+                want = bag.tags[key]
+                want = "nonfinite" if want.startswith("nonfinite") else want
+                if want == "good":
+                    assert got in ("served", "no_kinematics", "stale_kinematics",
+                                   "standstill"), got
+                else:
+                    assert got == want, (contact, got, want)
+        (out / f"{name}.expected.yaml").write_text(expected_text(expected_counts(outcomes)))
+    return path
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Write the bags; print each one's message count, size and build time."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=ROOT / "bags")
+    ap.add_argument("--only", nargs="+", choices=list(SCENARIOS), default=list(SCENARIOS))
+    args = ap.parse_args(argv)
+    args.out.mkdir(parents=True, exist_ok=True)
+    for name in args.only:
+        t0 = time.perf_counter()
+        path = build(name, args.out)
+        size = sum(f.stat().st_size for f in path.iterdir())
+        print(f"{path}: {size / 1e6:.3f} MB in {time.perf_counter() - t0:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
