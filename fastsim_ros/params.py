@@ -1,0 +1,203 @@
+"""The node's parameters: one table of names, types, defaults, ranges and descriptions.
+
+The node declares its ROS parameters from :data:`PARAMETERS` (descriptor,
+range, read-only flag), and the offline replay checks a params file against
+the same table, so a value the node refuses the replay refuses too, with the
+same message.  INTERFACE.md ("Executables and parameters") fixes the names.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+#: the methods of the library the node offers (INTERFACE.md: ``method``)
+METHODS = ("mae", "fastsim_ellipse")
+#: friction laws available today (slip-dependent friction is issue 13)
+FRICTION_LAWS = ("constant",)
+_NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
+
+
+class ParameterError(ValueError):
+    """A parameter value outside its type or range; the message names both."""
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """One parameter: ``kind`` is ``double``, ``integer``, ``bool``, ``string`` or ``string_array``.
+
+    ``low``/``high``: inclusive numeric range; ``choices``: allowed strings;
+    ``dynamic``: may change while the node runs (else start-up only).
+    """
+
+    name: str
+    kind: str
+    default: Any
+    description: str
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[str, ...] = ()
+    dynamic: bool = False
+
+    def allowed(self) -> str:
+        """Return the allowed values in words (for descriptors and error messages)."""
+        if self.choices:
+            return "one of " + ", ".join(self.choices)
+        if self.low is not None:
+            return f"in [{self.low:g}, {self.high:g}]"
+        if self.kind == "string_array":
+            return "a non-empty list of distinct names ([A-Za-z][A-Za-z0-9_]*)"
+        if self.kind == "string":
+            return "a non-empty name"
+        return f"a {self.kind}"
+
+    def check(self, value: Any) -> Any:
+        """Return ``value`` converted to this parameter's type, or raise ParameterError."""
+        bad = ParameterError(f"parameter {self.name!r}: {value!r} is not allowed; "
+                             f"it must be {self.allowed()}")
+        if self.kind == "double":
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise bad
+            value = float(value)
+            if not math.isfinite(value):
+                raise bad
+        elif self.kind == "integer":
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise bad
+        elif self.kind == "bool":
+            if not isinstance(value, bool):
+                raise bad
+        elif self.kind == "string":
+            if not isinstance(value, str) or not value:
+                raise bad
+        elif self.kind == "string_array":
+            if (not isinstance(value, (list, tuple)) or not value
+                    or not all(isinstance(v, str) and _NAME.match(v) for v in value)
+                    or len(set(value)) != len(value)):
+                raise bad
+            value = tuple(value)
+        if self.low is not None and not (self.low <= value <= self.high):  # type: ignore
+            raise bad
+        if self.choices and value not in self.choices:
+            raise bad
+        return value
+
+
+PARAMETERS: tuple[ParameterSpec, ...] = (
+    ParameterSpec("contacts", "string_array", ("left", "right"),
+                  "names of the contacts: topics contact/<name>/patch in, "
+                  "contact/<name>/wrench etc. out"),
+    ParameterSpec("wheelset_frame", "string", "wheelset",
+                  "frame id of the patches and twists (moves with the wheelset centre, "
+                  "does not spin with the axle)"),
+    ParameterSpec("shear_modulus", "double", 8.0e10, "combined shear modulus G (Pa)",
+                  low=1.0e6, high=1.0e13),
+    ParameterSpec("poisson_ratio", "double", 0.28, "combined Poisson ratio nu",
+                  low=0.0, high=0.5),
+    ParameterSpec("friction_coefficient", "double", 0.3,
+                  "friction coefficient mu (the static mu_s of a slip-dependent law)",
+                  low=1.0e-3, high=5.0, dynamic=True),
+    ParameterSpec("method", "string", "mae",
+                  "tangential solver: mae (MAE + FastSim, Alonso & Gimenez 2007) or "
+                  "fastsim_ellipse (FastSim on the equivalent ellipse)",
+                  choices=METHODS, dynamic=True),
+    ParameterSpec("traction_bound", "string", "given",
+                  "traction bound: given (mu p) or parabolic (mu N p^2 / sum(p^2 dA))",
+                  choices=("given", "parabolic"), dynamic=True),
+    ParameterSpec("min_rolling_speed", "double", 0.1,
+                  "below this |V| (m/s) creepages are undefined: standstill, no wrench",
+                  low=1.0e-6, high=100.0, dynamic=True),
+    ParameterSpec("max_kinematics_age", "double", 0.05,
+                  "a patch is solved with kinematics at most this old by stamp (s)",
+                  low=0.0, high=10.0, dynamic=True),
+    ParameterSpec("publish_traction", "bool", False,
+                  "publish contact/<name>/traction (PointCloud2 of tau_x, tau_y, slip)",
+                  dynamic=True),
+    ParameterSpec("max_patch_cells", "integer", 16384,
+                  "largest patch grid (height x width) accepted, checked before any "
+                  "allocation; larger patches are rejected as too_large",
+                  low=4, high=4_000_000, dynamic=True),
+    ParameterSpec("rail_twist_required", "bool", False,
+                  "a patch needs a fresh rail/twist (roller rigs); else a rail at rest",
+                  dynamic=True),
+    ParameterSpec("friction_law", "string", "constant",
+                  "friction law: constant (Coulomb with friction_coefficient)",
+                  choices=FRICTION_LAWS, dynamic=True),
+    ParameterSpec("friction_limit_ratio", "double", 1.0,
+                  "A of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
+                  low=1.0e-6, high=1.0, dynamic=True),
+    ParameterSpec("friction_decay", "double", 0.0,
+                  "B (s/m) of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
+                  low=0.0, high=1.0e4, dynamic=True),
+    ParameterSpec("publish_markers", "bool", True,
+                  "publish contact/markers (one creep-force arrow per contact)", dynamic=True),
+    ParameterSpec("marker_scale", "double", 1.0e-5,
+                  "arrow length per newton of creep force (m/N)", low=0.0, high=1.0,
+                  dynamic=True),
+    ParameterSpec("marker_rate", "double", 30.0,
+                  "most marker arrays per second by patch stamps (0: every solve)",
+                  low=0.0, high=1.0e4, dynamic=True),
+    ParameterSpec("patch_reliability", "string", "best_effort",
+                  "QoS reliability of the patch and twist subscriptions (best_effort "
+                  "matches every publisher)", choices=("best_effort", "reliable")),
+    ParameterSpec("output_reliability", "string", "reliable",
+                  "QoS reliability of the publishers (reliable matches every subscriber)",
+                  choices=("reliable", "best_effort")),
+    ParameterSpec("qos_depth", "integer", 10, "history depth of every subscription and "
+                  "publisher", low=1, high=10000),
+)
+
+SPECS: dict[str, ParameterSpec] = {spec.name: spec for spec in PARAMETERS}
+
+
+def defaults() -> dict[str, Any]:
+    """Return every parameter at its default."""
+    return {spec.name: spec.default for spec in PARAMETERS}
+
+
+def checked(values: Mapping[str, Any]) -> dict[str, Any]:
+    """Return the defaults updated with ``values``, each checked; raise ParameterError."""
+    out = defaults()
+    for name, value in values.items():
+        spec = SPECS.get(name)
+        if spec is None:
+            raise ParameterError(f"unknown parameter {name!r}")
+        out[name] = spec.check(value)
+    return out
+
+
+def load_params_file(path: Path, node_name: str = "fastsim") -> dict[str, Any]:
+    """Read a ROS 2 parameter file (``<node>: ros__parameters: ...``) and check it.
+
+    The node's own section (``fastsim``, ``/fastsim``) or the wildcard
+    ``/**`` is taken; the node's section wins over the wildcard.  Raises
+    ParameterError naming the file on any problem.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+        data = yaml.safe_load(text)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
+        raise ParameterError(f"{path}: cannot read parameters: {e}") from None
+    if not isinstance(data, dict):
+        raise ParameterError(f"{path}: not a ROS 2 parameter file")
+    values: dict[str, Any] = {}
+    for key in ("/**", node_name, "/" + node_name):
+        section = data.get(key)
+        if section is None:
+            continue
+        params = section.get("ros__parameters") if isinstance(section, dict) else None
+        if not isinstance(params, dict):
+            raise ParameterError(f"{path}: section {key!r} has no ros__parameters")
+        values.update(params)
+    if not values and not any(k in data for k in ("/**", node_name, "/" + node_name)):
+        raise ParameterError(f"{path}: no section for node {node_name!r} or '/**'")
+    try:
+        return checked(values)
+    except ParameterError as e:
+        raise ParameterError(f"{path}: {e}") from None

@@ -1,0 +1,420 @@
+"""The pipeline the node and the replay share: kinematics and patches in, creep forces out.
+
+:class:`Pipeline` holds the checked configuration, the compiled solver and
+the latest kinematics; :meth:`Pipeline.on_patch` turns one patch (a decoded
+:class:`~msg_adapters.cdr.Cloud`) into an :class:`Outcome`: the solved
+contact (frame, creepages, forces) and, once per rig cycle, the wheelset
+wrench, or a rejection with its reason key (INTERFACE.md).  It never reads
+a clock for anything it outputs: stamps come from the messages, so a replay
+is deterministic (only the solve-time statistics use ``perf_counter``).
+No ``rclpy.node`` here: the node and ``fastsim_replay`` are thin front ends.
+
+Physics (INTERFACE.md "Creepages", METHOD.md 1): the solvers roll towards
+``+x``; when the rolling speed ``V`` is negative (reverse running) the patch
+is turned by 180 degrees about the contact normal (``x, y -> -x, -y``), solved
+with ``(xi, eta, -phi)``, and ``(-Fx', -Fy', Mz')`` is reported in the
+unchanged contact frame, so the creep force always opposes the slip.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from fastsim_ros import params as parameters
+from fastsim_ros.contact.compiled import ContactForces, EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.contact.errors import ContactError, OutOfTableError
+from msg_adapters.cdr import Cloud, StampedTwist
+from msg_adapters.errors import REJECTION_REASONS, RejectedInput
+from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
+from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud
+
+#: twists kept for matching patch stamps (at 1 kHz: 0.25 s of history)
+TWIST_HISTORY = 256
+#: solve times kept per contact for the percentiles of the diagnostics
+SOLVE_TIME_WINDOW = 1000
+#: a frame "changes" (and is published again) when its origin moves by more
+#: than this (m) or an axis turns by more than this (rad, small angles)
+FRAME_TOLERANCE = 1e-6
+
+SOLVED, NO_CONTACT = "solved", "no_contact"
+
+
+@dataclass(frozen=True)
+class PipelineConfig:
+    """The checked parameters of INTERFACE.md (see :mod:`fastsim_ros.params`)."""
+
+    values: Mapping[str, Any]
+
+    @classmethod
+    def from_values(cls, values: Mapping[str, Any]) -> PipelineConfig:
+        """Check ``values`` (missing names take their defaults); raise ParameterError."""
+        return cls(parameters.checked(values))
+
+    def __getitem__(self, name: str) -> Any:
+        return self.values[name]
+
+    @property
+    def contacts(self) -> tuple[str, ...]:
+        """Return the configured contact names."""
+        return tuple(self.values["contacts"])
+
+
+@dataclass(frozen=True, slots=True)
+class WheelsetWrench:
+    """Sum of the contacts' wrenches in the wheelset frame about its origin (N, N m)."""
+
+    stamp_ns: int
+    force: tuple[float, float, float]
+    torque: tuple[float, float, float]
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class Outcome:
+    """What one patch gave.
+
+    ``status``: ``"solved"``, ``"no_contact"`` (zero wrench) or a rejection
+    reason of :data:`~msg_adapters.errors.REJECTION_REASONS` (no wrench);
+    ``detail``: words for the log.  When solved: the contact ``frame`` (and
+    whether it moved since it was last published), ``creepage``, ``forces``
+    (``fx, fy`` (N), ``mz`` (N m) about the contact origin, ``n`` (N)) and
+    the ``patch``.  ``wheelset``: the wheelset wrench when this patch
+    completed a rig cycle; ``markers``: whether markers are due.
+    """
+
+    contact: str
+    stamp_ns: int
+    status: str
+    detail: str = ""
+    frame: ContactFrame | None = None
+    frame_changed: bool = False
+    creepage: Creepage | None = None
+    forces: ContactForces | None = None
+    patch: ContactPatch | None = None
+    wheelset: WheelsetWrench | None = None
+    markers: bool = False
+
+    @property
+    def has_wrench(self) -> bool:
+        """Return whether a wrench is published for this patch (solved or no contact)."""
+        return self.status in (SOLVED, NO_CONTACT)
+
+
+@dataclass
+class ContactStats:
+    """Counters and solve times of one contact (cumulative since start)."""
+
+    counts: dict[str, int] = field(default_factory=lambda: {
+        key: 0 for key in (SOLVED, NO_CONTACT) + REJECTION_REASONS})
+    solve_times: np.ndarray = field(default_factory=lambda: np.zeros(SOLVE_TIME_WINDOW))
+    solves: int = 0
+    window_inputs: int = 0
+    window_first_ns: int | None = None
+    window_last_ns: int | None = None
+    last_detail: str = ""
+
+    def add_solve_time(self, seconds: float) -> None:
+        """Record one solve's wall time (s)."""
+        self.solve_times[self.solves % SOLVE_TIME_WINDOW] = seconds
+        self.solves += 1
+
+    def percentiles_us(self) -> tuple[float, float]:
+        """Return the p50 and p99 of the recent solve times (us); NaN before any."""
+        filled = self.solve_times[:min(self.solves, SOLVE_TIME_WINDOW)]
+        if filled.size == 0:
+            return math.nan, math.nan
+        p50, p99 = np.percentile(filled, (50.0, 99.0))
+        return float(p50) * 1e6, float(p99) * 1e6
+
+
+@dataclass(frozen=True)
+class ContactReport:
+    """One contact's diagnostics: level (0 OK, 1 WARN, 2 ERROR), message, key-values."""
+
+    name: str
+    level: int
+    message: str
+    values: tuple[tuple[str, str], ...]
+
+
+class _ContactState:
+    __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
+                 "wrench_fresh", "stats")
+
+    def __init__(self) -> None:
+        self.last_stamp_ns: int | None = None
+        self.last_frame: ContactFrame | None = None
+        self.last_marker_ns: int | None = None
+        # the latest wrench in the wheelset frame: (stamp, force, torque)
+        self.wrench: tuple[int, tuple[float, float, float], tuple[float, float, float]] | None
+        self.wrench = None
+        self.wrench_fresh = False
+        self.stats = ContactStats()
+
+
+def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
+    if a is None:
+        return True
+    moved = max(abs(u - v) for u, v in zip(a.origin, b.origin))
+    turned = max(abs(u - v) for ea, eb in zip(a.axes, b.axes) for u, v in zip(ea, eb))
+    return moved > FRAME_TOLERANCE or turned > FRAME_TOLERANCE
+
+
+def _newest_before(history: deque[StampedTwist], stamp_ns: int) -> StampedTwist | None:
+    for twist in reversed(history):
+        if twist.stamp_ns <= stamp_ns:
+            return twist
+    return None
+
+
+class Pipeline:
+    """Patches + kinematics -> creep forces, with the node's rules (INTERFACE.md).
+
+    Build it from a :class:`PipelineConfig`; feed it :meth:`on_wheel_twist`,
+    :meth:`on_rail_twist` and :meth:`on_patch` in arrival (log-time) order;
+    :meth:`update` changes the parameters that may change while running.
+    """
+
+    def __init__(self, config: PipelineConfig) -> None:
+        self.config = config
+        nu, g = config["poisson_ratio"], config["shear_modulus"]
+        self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver] = {
+            "mae": MaeSolver(nu, g), "fastsim_ellipse": EquivalentEllipseSolver(nu, g)}
+        self._wheel: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
+        self._rail: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
+        self._contacts = {name: _ContactState() for name in config.contacts}
+        self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
+                                  "old_stamp": 0}
+        self._apply(config)
+
+    def _apply(self, config: PipelineConfig) -> None:
+        self.config = config
+        self._solver = self._solvers[config["method"]]
+        self._mu = float(config["friction_coefficient"])
+        self._bound = config["traction_bound"]
+        self._frame_id = config["wheelset_frame"]
+        self._max_cells = int(config["max_patch_cells"])
+        self._max_age_ns = round(config["max_kinematics_age"] * 1e9)
+        self._min_speed = float(config["min_rolling_speed"])
+        self._rail_required = bool(config["rail_twist_required"])
+        self._tractions = bool(config["publish_traction"])
+        rate = float(config["marker_rate"])
+        self._markers = bool(config["publish_markers"])
+        self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
+
+    def update(self, changes: Mapping[str, Any]) -> None:
+        """Apply new values of parameters (checked; the material and contacts stay)."""
+        values = dict(self.config.values)
+        values.update(changes)
+        config = PipelineConfig.from_values(values)
+        for name in ("contacts", "wheelset_frame", "shear_modulus", "poisson_ratio"):
+            if config[name] != self.config[name]:
+                raise parameters.ParameterError(f"parameter {name!r} is set at start only")
+        self._apply(config)
+
+    # ---------------------------------------------------------------- kinematics
+
+    def _twist(self, history: deque[StampedTwist], twist: StampedTwist, what: str) -> str:
+        if twist.frame_id != self._frame_id:
+            reason = "wrong_frame"
+        elif not twist_is_finite(twist):
+            reason = "nonfinite"
+        elif history and twist.stamp_ns < history[-1].stamp_ns:
+            reason = "old_stamp"
+        else:
+            history.append(twist)
+            self.kinematics_counts[what] += 1
+            return "ok"
+        self.kinematics_counts[reason] += 1
+        return reason
+
+    def on_wheel_twist(self, twist: StampedTwist) -> str:
+        """Take a wheelset twist; return ``"ok"`` or why it was dropped."""
+        return self._twist(self._wheel, twist, "wheel")
+
+    def on_rail_twist(self, twist: StampedTwist) -> str:
+        """Take a rail twist (roller, moving rail); return ``"ok"`` or why it was dropped."""
+        return self._twist(self._rail, twist, "rail")
+
+    def _kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
+        wheel = _newest_before(self._wheel, stamp_ns)
+        if wheel is None:
+            if not self._wheel:
+                raise RejectedInput("no_kinematics", "no wheelset twist yet")
+            raise RejectedInput("stale_kinematics", "every wheelset twist is newer than "
+                                "the patch")
+        if stamp_ns - wheel.stamp_ns > self._max_age_ns:
+            raise RejectedInput("stale_kinematics", f"newest wheelset twist is "
+                                f"{(stamp_ns - wheel.stamp_ns) * 1e-9:.4g} s old")
+        rail = _newest_before(self._rail, stamp_ns)
+        if rail is not None and stamp_ns - rail.stamp_ns > self._max_age_ns:
+            rail = None
+        if rail is None:
+            if self._rail_required:
+                raise RejectedInput("stale_kinematics", "no fresh rail twist "
+                                    "(rail_twist_required)")
+            rail = REST
+        return wheel, rail
+
+    # ---------------------------------------------------------------- patches
+
+    def on_patch(self, contact: str, cloud: Cloud) -> Outcome:
+        """Solve one patch of ``contact`` with the kinematics it matches."""
+        state = self._contacts[contact]
+        stamp = cloud.stamp_ns
+        stats = state.stats
+        stats.window_inputs += 1
+        if stats.window_first_ns is None:
+            stats.window_first_ns = stamp
+        stats.window_last_ns = stamp
+        try:
+            if cloud.frame_id != self._frame_id:
+                raise RejectedInput("wrong_frame", f"frame {cloud.frame_id!r}, expected "
+                                    f"{self._frame_id!r}")
+            if state.last_stamp_ns is not None and stamp < state.last_stamp_ns:
+                raise RejectedInput("old_stamp", f"stamp {stamp} ns is older than the last, "
+                                    f"{state.last_stamp_ns} ns")
+            state.last_stamp_ns = stamp
+            patch = patch_from_cloud(cloud, max_cells=self._max_cells)
+            if patch is None:
+                return self._no_contact(contact, state, stamp)
+            wheel, rail = self._kinematics(stamp)
+            creep = creepages(patch.frame, wheel, rail)
+            if not abs(creep.speed) >= self._min_speed:
+                raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
+            forces = self._solve(patch, creep, stats)
+        except RejectedInput as e:
+            stats.counts[e.reason] += 1
+            stats.last_detail = str(e)
+            return Outcome(contact, stamp, e.reason, e.detail)
+        stats.counts[SOLVED] += 1
+        changed = _frame_moved(state.last_frame, patch.frame)
+        if changed:
+            state.last_frame = patch.frame
+        f_ws = patch.frame.to_wheelset((forces.fx, forces.fy, forces.n))
+        m_ws = patch.frame.to_wheelset((0.0, 0.0, forces.mz))
+        o = patch.frame.origin
+        torque = (o[1] * f_ws[2] - o[2] * f_ws[1] + m_ws[0],
+                  o[2] * f_ws[0] - o[0] * f_ws[2] + m_ws[1],
+                  o[0] * f_ws[1] - o[1] * f_ws[0] + m_ws[2])
+        wheelset = self._add_wrench(state, stamp, f_ws, torque)
+        return Outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces, patch,
+                       wheelset, self._markers_due(state, stamp))
+
+    def _no_contact(self, contact: str, state: _ContactState, stamp: int) -> Outcome:
+        state.stats.counts[NO_CONTACT] += 1
+        wheelset = self._add_wrench(state, stamp, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        return Outcome(contact, stamp, NO_CONTACT, "no cell with positive pressure",
+                       wheelset=wheelset, markers=self._markers_due(state, stamp))
+
+    def _solve(self, patch: ContactPatch, creep: Creepage, stats: ContactStats) -> ContactForces:
+        p, x0, y0, dx, dy = patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy
+        xi, eta, phi = creep.xi, creep.eta, creep.phi
+        reverse = creep.speed < 0.0
+        if reverse:  # turn the patch by 180 degrees about z: the leading edge at +x
+            p = p[::-1, ::-1]
+            x0 = -(x0 + (p.shape[1] - 1) * dx)
+            y0 = -(y0 + (p.shape[0] - 1) * dy)
+            phi = -phi
+        start = time.perf_counter()
+        try:
+            f = self._solver.solve_arrays(p, x0, y0, dx, dy, xi, eta, phi, self._mu,
+                                          bound=self._bound, tractions=self._tractions)
+        except OutOfTableError as e:
+            raise RejectedInput("out_of_table", str(e)) from None
+        except ContactError as e:  # inputs the adapters passed but the solver refuses
+            raise RejectedInput("nonfinite" if "finite" in str(e) else "degenerate",
+                                str(e)) from None
+        stats.add_solve_time(time.perf_counter() - start)
+        if reverse:
+            tau_x = tau_y = slip = None
+            if f.tau_x is not None and f.tau_y is not None and f.slip is not None:
+                tau_x, tau_y, slip = -f.tau_x[::-1, ::-1], -f.tau_y[::-1, ::-1], \
+                    f.slip[::-1, ::-1]
+            grid = None
+            if f.grid is not None:  # the turned grid's cell [0, 0] is the original's last
+                gx0, gy0, gdx, gdy = f.grid
+                n_y, n_x = (tau_x.shape if tau_x is not None else (1, 1))
+                grid = (-(gx0 + (n_x - 1) * gdx), -(gy0 + (n_y - 1) * gdy), gdx, gdy)
+            f = ContactForces(-f.fx, -f.fy, f.mz, f.n, f.slip_fraction, tau_x, tau_y, slip,
+                              grid)
+        if not all(math.isfinite(v) for v in (f.fx, f.fy, f.mz, f.n)):
+            raise RejectedInput("nonfinite", "the solve gave a non-finite force")
+        return f
+
+    def _add_wrench(self, state: _ContactState, stamp: int, force: tuple[float, float, float],
+                    torque: tuple[float, float, float]) -> WheelsetWrench | None:
+        """Keep the contact's wrench; return the wheelset wrench if every contact has a new one."""
+        state.wrench = (stamp, force, torque)
+        state.wrench_fresh = True
+        if not all(s.wrench_fresh for s in self._contacts.values()):
+            return None
+        fs = [0.0, 0.0, 0.0]
+        ts = [0.0, 0.0, 0.0]
+        newest = stamp
+        for s in self._contacts.values():
+            assert s.wrench is not None
+            newest = max(newest, s.wrench[0])
+            for k in range(3):
+                fs[k] += s.wrench[1][k]
+                ts[k] += s.wrench[2][k]
+            s.wrench_fresh = False
+        return WheelsetWrench(newest, (fs[0], fs[1], fs[2]), (ts[0], ts[1], ts[2]))
+
+    def _markers_due(self, state: _ContactState, stamp: int) -> bool:
+        if not self._markers:
+            return False
+        last = state.last_marker_ns
+        if last is not None and 0 <= stamp - last < self._marker_period_ns:
+            return False
+        state.last_marker_ns = stamp
+        return True
+
+    # ---------------------------------------------------------------- diagnostics
+
+    def latest_wrench(self, contact: str) -> tuple[int, tuple[float, float, float],
+                                                   tuple[float, float, float]] | None:
+        """Return the contact's latest wrench in the wheelset frame ``(stamp, F, M)``."""
+        return self._contacts[contact].wrench
+
+    def counts(self, contact: str) -> dict[str, int]:
+        """Return a copy of the contact's cumulative counts by status."""
+        return dict(self._contacts[contact].stats.counts)
+
+    def report(self, contact: str) -> ContactReport:
+        """Return the contact's diagnostics and start a new rate window."""
+        stats = self._contacts[contact].stats
+        p50, p99 = stats.percentiles_us()
+        rate = 0.0
+        first, last = stats.window_first_ns, stats.window_last_ns
+        if first is not None and last is not None and last > first:
+            rate = (stats.window_inputs - 1) / ((last - first) * 1e-9)
+        rejected = sum(stats.counts[r] for r in REJECTION_REASONS)
+        values: list[tuple[str, str]] = [
+            ("method", self.config["method"]),
+            ("friction_law", self.config["friction_law"]),
+            ("friction_coefficient", f"{self._mu:g}"),
+            ("traction_bound", self._bound),
+            ("solve_time_p50_us", f"{p50:.1f}"),
+            ("solve_time_p99_us", f"{p99:.1f}"),
+            ("input_rate_hz", f"{rate:.1f}"),
+            ("wrenches", str(stats.counts[SOLVED] + stats.counts[NO_CONTACT])),
+            ("solved", str(stats.counts[SOLVED])),
+            ("no_contact", str(stats.counts[NO_CONTACT])),
+            ("rejected", str(rejected)),
+        ]
+        values += [(f"rejected/{r}", str(stats.counts[r])) for r in REJECTION_REASONS]
+        level, message = 0, "ok"
+        if stats.window_inputs == 0:
+            level, message = 1, "no patch in the last period"
+        elif rejected:
+            level, message = 1, f"{rejected} rejected; last: {stats.last_detail}"
+        stats.window_inputs = 0
+        stats.window_first_ns = stats.window_last_ns = None
+        return ContactReport(f"fastsim: {contact}", level, message, tuple(values))

@@ -1,0 +1,204 @@
+"""Just enough CDR (XCDR1, the ROS 2 wire format) for the node's hot messages.
+
+The node subscribes to patches and twists raw and publishes its wrenches
+as bytes: a PointCloud2 of 30 x 30 cells costs rclpy about as much to turn
+into a Python message as the MAE solve itself, while its point buffer is one
+contiguous block that numpy can view in place.  The replay reads the same
+bytes from bags.  Layouts follow the ``.msg`` definitions of
+``std_msgs/Header``, ``sensor_msgs/PointCloud2``, ``sensor_msgs/PointField``
+and ``geometry_msgs`` (Twist, Wrench, Vector3, Pose): primitives aligned to
+their size relative to the end of the 4-byte encapsulation header, strings
+as ``uint32`` length (NUL included) + bytes + NUL, sequences as ``uint32``
+count + elements.  Tests compare every encoder and decoder with
+``rclpy.serialization``.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+
+from msg_adapters.errors import MalformedMessageError
+
+#: encapsulation headers: CDR big endian, CDR little endian
+_CDR_BE = b"\x00\x00\x00\x00"
+_CDR_LE = b"\x00\x01\x00\x00"
+
+_U32 = {"<": struct.Struct("<I"), ">": struct.Struct(">I")}
+_I32U32 = {"<": struct.Struct("<iI"), ">": struct.Struct(">iI")}
+_FIELD_TAIL = {"<": struct.Struct("<IBxxxI"), ">": struct.Struct(">IBxxxI")}
+_SIX_DOUBLES = {"<": struct.Struct("<6d"), ">": struct.Struct(">6d")}
+_PC2_STEPS = {"<": struct.Struct("<?xxxII"), ">": struct.Struct(">?xxxII")}
+
+
+@dataclass(frozen=True, slots=True)
+class PointFieldSpec:
+    """One ``sensor_msgs/PointField``: byte offset in a point, datatype code, count."""
+
+    offset: int
+    datatype: int
+    count: int
+
+
+@dataclass(frozen=True, slots=True)
+class Cloud:
+    """A ``sensor_msgs/PointCloud2`` with its point buffer as a memoryview (no copy).
+
+    ``stamp_ns``: header stamp (ns since the epoch of the stamp's clock);
+    ``fields``: by name.  The point of row ``j``, column ``i`` starts at
+    byte ``j * row_step + i * point_step`` of ``data``.
+    """
+
+    stamp_ns: int
+    frame_id: str
+    height: int
+    width: int
+    fields: dict[str, PointFieldSpec]
+    is_bigendian: bool
+    point_step: int
+    row_step: int
+    data: memoryview
+
+
+@dataclass(frozen=True, slots=True)
+class StampedTwist:
+    """A ``geometry_msgs/TwistStamped``: stamp (ns), frame, linear (m/s), angular (rad/s)."""
+
+    stamp_ns: int
+    frame_id: str
+    linear: tuple[float, float, float]
+    angular: tuple[float, float, float]
+
+
+class _Reader:
+    """A cursor over one CDR buffer."""
+
+    __slots__ = ("buf", "pos", "end", "order")
+
+    def __init__(self, buf: bytes | memoryview) -> None:
+        view = memoryview(buf)
+        if view.format != "B" or view.ndim != 1:
+            view = view.cast("B")
+        if len(view) < 4:
+            raise MalformedMessageError("shorter than the CDR encapsulation header")
+        kind = view[1]
+        if view[0] != 0 or kind > 1:
+            raise MalformedMessageError(f"not plain CDR (encapsulation {bytes(view[:2]).hex()})")
+        self.order = "<" if kind == 1 else ">"
+        self.buf = view[4:]
+        self.pos = 0
+        self.end = len(self.buf)
+
+    def _take(self, size: int, align: int) -> int:
+        pos = self.pos + (-self.pos % align)
+        if pos + size > self.end:
+            raise MalformedMessageError("truncated")
+        self.pos = pos + size
+        return pos
+
+    def u32(self) -> int:
+        value: int = _U32[self.order].unpack_from(self.buf, self._take(4, 4))[0]
+        return value
+
+    def stamp_ns(self) -> int:
+        sec, nanosec = _I32U32[self.order].unpack_from(self.buf, self._take(8, 4))
+        return int(sec) * 1_000_000_000 + int(nanosec)
+
+    def string(self) -> str:
+        size = self.u32()
+        if size == 0:  # some writers send no NUL for an empty string
+            return ""
+        start = self._take(size, 1)
+        raw = bytes(self.buf[start:start + size - 1])
+        try:
+            return raw.decode("utf-8")
+        except UnicodeDecodeError:
+            raise MalformedMessageError("a string that is not UTF-8") from None
+
+    def doubles6(self) -> tuple[float, ...]:
+        values: tuple[float, ...] = _SIX_DOUBLES[self.order].unpack_from(
+            self.buf, self._take(48, 8))
+        return values
+
+
+_FIELDS_CACHE: dict[bytes, tuple[dict[str, PointFieldSpec], int]] = {}
+
+
+def _read_fields(r: _Reader, count: int) -> dict[str, PointFieldSpec]:
+    """Read ``count`` PointFields; the same bytes give the same (cached) dict."""
+    start = r.pos
+    # a patch topic sends the same field list every time: key the parse on its
+    # bytes (the first 32 bytes per field cover the usual names and layout)
+    probe = bytes(r.buf[start:start + 32 * count])
+    hit = _FIELDS_CACHE.get(probe)
+    if hit is not None and start + hit[1] <= r.end:
+        r.pos = start + hit[1]
+        return hit[0]
+    fields: dict[str, PointFieldSpec] = {}
+    tail = _FIELD_TAIL[r.order]
+    for _ in range(count):
+        name = r.string()
+        offset, datatype, n = tail.unpack_from(r.buf, r._take(12, 4))
+        fields[name] = PointFieldSpec(int(offset), int(datatype), int(n))
+    length = r.pos - start
+    if length <= len(probe) and len(_FIELDS_CACHE) < 64:
+        _FIELDS_CACHE[bytes(r.buf[start:start + 32 * count])] = (fields, length)
+    return fields
+
+
+def read_cloud(buf: bytes | memoryview) -> Cloud:
+    """Decode a serialized ``sensor_msgs/PointCloud2``; the points stay in ``buf``.
+
+    The returned ``fields`` dict may be shared between calls: do not change it.
+    """
+    r = _Reader(buf)
+    stamp = r.stamp_ns()
+    frame = r.string()
+    height = r.u32()
+    width = r.u32()
+    count = r.u32()
+    if count > 64:
+        raise MalformedMessageError(f"{count} point fields")
+    fields = _read_fields(r, count)
+    bigendian, point_step, row_step = _PC2_STEPS[r.order].unpack_from(r.buf, r._take(12, 1))
+    size = r.u32()
+    start = r._take(size, 1)
+    return Cloud(stamp, frame, int(height), int(width), fields, bool(bigendian),
+                 int(point_step), int(row_step), r.buf[start:start + size])
+
+
+def read_twist(buf: bytes | memoryview) -> StampedTwist:
+    """Decode a serialized ``geometry_msgs/TwistStamped``."""
+    r = _Reader(buf)
+    stamp = r.stamp_ns()
+    frame = r.string()
+    v = r.doubles6()
+    return StampedTwist(stamp, frame, (v[0], v[1], v[2]), (v[3], v[4], v[5]))
+
+
+def _header(stamp_ns: int, frame_id: str) -> bytearray:
+    """Return encapsulation + ``std_msgs/Header`` (little endian), unpadded."""
+    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    name = frame_id.encode("utf-8") + b"\x00"
+    out = bytearray(_CDR_LE)
+    out += struct.pack("<iII", sec, nanosec, len(name))
+    out += name
+    return out
+
+
+def _pad8(out: bytearray) -> None:
+    """Pad to the next multiple of 8 of the payload (which starts at byte 4)."""
+    out += b"\x00" * (-(len(out) - 4) % 8)
+
+
+def stamped_doubles(stamp_ns: int, frame_id: str, values: tuple[float, ...]) -> bytes:
+    """Serialize a header followed by doubles.
+
+    That is the layout of ``WrenchStamped`` (6 doubles), ``Vector3Stamped``
+    (3), ``PointStamped`` (3) and ``PoseStamped`` (7: position, then the
+    orientation quaternion ``x, y, z, w``).
+    """
+    out = _header(stamp_ns, frame_id)
+    _pad8(out)
+    out += struct.pack(f"<{len(values)}d", *values)
+    return bytes(out)

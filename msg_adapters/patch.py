@@ -1,0 +1,324 @@
+"""PointCloud2 -> contact patch: the contact frame, the in-plane grid, the pressure.
+
+INTERFACE.md ("Inputs"): the cloud is organised, each row one lateral strip
+whose points run along the rolling direction; fields ``x y z`` (cell centre
+on the contact surface, m, in the wheelset frame), ``normal_x normal_y
+normal_z`` (surface normal pointing into the wheel) and ``pressure`` (Pa,
+zero outside the contact), float32 or float64, either byte order, in any
+order and with any padding.  The contact frame: origin at the
+pressure-weighted centroid, ``z`` along ``sum p n`` over the cells in
+contact, ``x`` the wheelset's ``x`` projected on the contact plane, ``y = z
+x x``.  Cells must form a regular grid in that plane (rows along ``x``);
+their spacing is the cell size and ``N = sum p dA``.
+
+Every check runs on the message's own numbers before the grid is used, and
+the size bound before anything is allocated: a patch either converts or
+raises :class:`~msg_adapters.errors.RejectedInput` with its reason key.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from msg_adapters.cdr import Cloud
+from msg_adapters.errors import RejectedInput
+
+FloatArray = NDArray[np.float64]
+
+#: PointField datatype codes (sensor_msgs/PointField) the adapter reads
+FLOAT32, FLOAT64 = 7, 8
+PATCH_FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure")
+#: a cell centre may sit this share of a cell off the regular grid (float32
+#: coordinates a metre from the wheelset origin carry ~1e-7 m, 1e-4 of a
+#: 1 mm cell; a patch meshed on another grid is off by a large share)
+GRID_TOLERANCE = 0.02
+#: cells smaller than this (m) describe no wheel-rail contact (and 1e-200 m
+#: cells would underflow the cell area)
+MIN_CELL_SIZE = 1e-9
+#: fewer cells in contact than this are `degenerate` (INTERFACE.md)
+MIN_CONTACT_CELLS = 4
+
+
+@dataclass(frozen=True, slots=True)
+class ContactFrame:
+    """The contact frame in the wheelset frame.
+
+    ``origin``: (m); ``axes``: rows ``e_x, e_y, e_z`` (unit vectors).
+    """
+
+    origin: tuple[float, float, float]
+    axes: tuple[tuple[float, float, float], tuple[float, float, float],
+                tuple[float, float, float]]
+
+    def quaternion(self) -> tuple[float, float, float, float]:
+        """Return the frame's orientation as a unit quaternion ``(x, y, z, w)``."""
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = self.axes
+        # rotation matrix columns are the axes: R[i][j] = axes[j][i]
+        m00, m01, m02 = xx, yx, zx
+        m10, m11, m12 = xy, yy, zy
+        m20, m21, m22 = xz, yz, zz
+        trace = m00 + m11 + m22
+        if trace > 0.0:
+            s = 2.0 * math.sqrt(trace + 1.0)
+            q = ((m21 - m12) / s, (m02 - m20) / s, (m10 - m01) / s, 0.25 * s)
+        elif m00 > m11 and m00 > m22:
+            s = 2.0 * math.sqrt(1.0 + m00 - m11 - m22)
+            q = (0.25 * s, (m01 + m10) / s, (m02 + m20) / s, (m21 - m12) / s)
+        elif m11 > m22:
+            s = 2.0 * math.sqrt(1.0 + m11 - m00 - m22)
+            q = ((m01 + m10) / s, 0.25 * s, (m12 + m21) / s, (m02 - m20) / s)
+        else:
+            s = 2.0 * math.sqrt(1.0 + m22 - m00 - m11)
+            q = ((m02 + m20) / s, (m12 + m21) / s, 0.25 * s, (m10 - m01) / s)
+        return q
+
+    def to_wheelset(self, v: tuple[float, float, float]) -> tuple[float, float, float]:
+        """Return the contact-frame vector ``v`` in wheelset-frame components."""
+        (xx, xy, xz), (yx, yy, yz), (zx, zy, zz) = self.axes
+        return (v[0] * xx + v[1] * yx + v[2] * zx,
+                v[0] * xy + v[1] * yy + v[2] * zy,
+                v[0] * xz + v[1] * yz + v[2] * zz)
+
+
+@dataclass(frozen=True, slots=True, eq=False)
+class ContactPatch:
+    """One converted patch: frame, in-plane grid and pressure.
+
+    ``pressure[j, i]`` (Pa) on cells centred at ``(x0 + i dx, y0 + j dy)``
+    (m) in the contact frame (rows = lateral strips, ``x`` increasing);
+    ``load``: ``N = sum p dA`` (N); ``cells``: cells in contact.
+    ``row_order`` and ``column_order``: +1 or -1, how rows and columns map
+    to the cloud's (-1: reversed), so that results can be laid back on the
+    cloud's points (``points``, the cells' positions in the wheelset frame).
+    """
+
+    stamp_ns: int
+    frame: ContactFrame
+    pressure: FloatArray
+    x0: float
+    y0: float
+    dx: float
+    dy: float
+    load: float
+    cells: int
+    row_order: int
+    column_order: int
+    points: FloatArray
+
+
+def _field_columns(cloud: Cloud) -> tuple[str, list[int], int]:
+    """Check the patch fields; return ``(numpy dtype, byte offsets, size)``."""
+    order = ">" if cloud.is_bigendian else "<"
+    offsets: list[int] = []
+    sizes: set[int] = set()
+    for name in PATCH_FIELDS:
+        spec = cloud.fields.get(name)
+        if spec is None:
+            raise RejectedInput("missing_field", f"no field {name!r}")
+        if spec.datatype not in (FLOAT32, FLOAT64) or spec.count != 1:
+            raise RejectedInput("missing_field", f"field {name!r} is not one float32 or "
+                                f"float64 (datatype {spec.datatype}, count {spec.count})")
+        size = 4 if spec.datatype == FLOAT32 else 8
+        if spec.offset < 0 or spec.offset + size > cloud.point_step:
+            raise RejectedInput("irregular_grid", f"field {name!r} at byte {spec.offset} "
+                                f"lies outside the point_step of {cloud.point_step}")
+        offsets.append(spec.offset)
+        sizes.add(size)
+    if len(sizes) > 1:
+        return "", offsets, 0
+    size = sizes.pop()
+    return order + ("f4" if size == 4 else "f8"), offsets, size
+
+
+def _field_values(cloud: Cloud) -> FloatArray:
+    """Return the patch fields as ``(ny * nx, 7)`` float64, in PATCH_FIELDS order.
+
+    Where every field has one type and all offsets and steps are multiples
+    of its size (the usual layout), the buffer is viewed as one array and
+    the seven columns are gathered in one copy; otherwise per field.
+    """
+    ny, nx = cloud.height, cloud.width
+    dtype, offsets, size = _field_columns(cloud)
+    if cloud.row_step < nx * cloud.point_step or len(cloud.data) < (
+            (ny - 1) * cloud.row_step + nx * cloud.point_step):
+        raise RejectedInput("irregular_grid", f"{len(cloud.data)} bytes of data do not hold "
+                            f"{ny} rows of {nx} points (point_step {cloud.point_step}, "
+                            f"row_step {cloud.row_step})")
+    if size and not (cloud.point_step % size or cloud.row_step % size
+                     or any(o % size for o in offsets)):
+        words = np.frombuffer(cloud.data, dtype=dtype,
+                              count=((ny - 1) * cloud.row_step + nx * cloud.point_step) // size)
+        grid = np.lib.stride_tricks.as_strided(
+            words, shape=(ny, nx, cloud.point_step // size),
+            strides=(cloud.row_step, cloud.point_step, size), writeable=False)
+        columns = [o // size for o in offsets]
+        if columns == list(range(columns[0], columns[0] + 7)):
+            picked = grid[:, :, columns[0]:columns[0] + 7]
+        else:
+            picked = grid[:, :, columns]
+        return picked.astype(np.float64).reshape(ny * nx, 7)
+    order = ">" if cloud.is_bigendian else "<"
+    out = np.empty((ny * nx, 7))
+    for k, (name, offset) in enumerate(zip(PATCH_FIELDS, offsets)):
+        spec = cloud.fields[name]
+        column = np.ndarray((ny, nx), dtype=order + ("f4" if spec.datatype == FLOAT32 else "f8"),
+                            buffer=cloud.data, offset=offset,
+                            strides=(cloud.row_step, cloud.point_step))
+        out[:, k] = column.reshape(-1)
+    return out
+
+
+_INDEX: dict[int, FloatArray] = {}
+
+
+def _index(n: int) -> FloatArray:
+    """Return ``arange(n)`` as float64 (cached: patches keep their size)."""
+    a = _INDEX.get(n)
+    if a is None:
+        a = np.arange(n, dtype=np.float64)
+        a.setflags(write=False)
+        _INDEX[n] = a
+    return a
+
+
+def _regular_axis(coord: FloatArray, axis: int, what: str) -> tuple[float, float, int]:
+    """Return ``(first, step, order)`` of a coordinate that is linear along ``axis``.
+
+    ``coord[j, i]`` must equal ``first + step * (index along axis)`` for all
+    points within ``GRID_TOLERANCE`` of a cell (so it must not vary along
+    the other index); ``order`` is -1 where the points run towards negative
+    values (``first`` and ``step`` are then those of the reversed order).
+    """
+    n = coord.shape[axis]
+    other = coord.size // n
+    if axis == 1:
+        span = float(coord[:, -1].sum() - coord[:, 0].sum())
+        index = _index(n)[None, :]
+    else:
+        span = float(coord[-1, :].sum() - coord[0, :].sum())
+        index = _index(n)[:, None]
+    step = span / (other * (n - 1))
+    if not abs(step) >= MIN_CELL_SIZE:
+        raise RejectedInput("degenerate", f"cells {what} are {abs(step):.3g} m apart")
+    first = float(coord.sum()) / coord.size - step * 0.5 * (n - 1)
+    off = coord - index * step
+    worst = max(float(off.max()) - first, first - float(off.min()))
+    if not worst <= GRID_TOLERANCE * abs(step):
+        raise RejectedInput("irregular_grid", f"a cell centre lies {worst / abs(step):.3g} "
+                            f"cells off the regular grid {what}")
+    if step < 0.0:
+        return first + step * (n - 1), -step, -1
+    return first, step, 1
+
+
+def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
+    """Convert a patch cloud; ``None`` for an empty patch (no positive pressure).
+
+    ``max_cells``: the largest grid (``height * width``) accepted; larger is
+    ``too_large``, checked before anything is read or allocated.  Raises
+    :class:`RejectedInput` with the reason key of INTERFACE.md otherwise.
+    """
+    ny, nx = cloud.height, cloud.width
+    if ny * nx > max_cells:
+        raise RejectedInput("too_large", f"{ny} x {nx} cells exceed max_patch_cells = "
+                            f"{max_cells}")
+    if ny * nx == 0:
+        _field_columns(cloud)
+        return None
+    values = _field_values(cloud)
+    if not np.isfinite(values).all():
+        raise RejectedInput("nonfinite", "NaN or infinite values in the patch")
+    p = values[:, 6]
+    low = float(p.min())
+    if low < 0.0:
+        raise RejectedInput("negative_pressure", f"pressure down to {low:.4g} Pa")
+    cells = int(np.count_nonzero(p))
+    if cells == 0:
+        return None
+    if cells < MIN_CONTACT_CELLS or ny < 2 or nx < 2:
+        raise RejectedInput("degenerate", f"{cells} cells in contact on a {ny} x {nx} grid "
+                            f"(at least {MIN_CONTACT_CELLS} on a grid of 2 x 2 or more)")
+    total = float(p.sum())
+    # p is zero outside the contact: sums over all cells are sums over the contact
+    sums = p @ values[:, :6]
+    ox, oy, oz = (float(v) / total for v in sums[:3])
+    nx_, ny_, nz_ = (float(v) for v in sums[3:6])
+    norm = math.sqrt(nx_ * nx_ + ny_ * ny_ + nz_ * nz_)
+    if not norm > 0.0:
+        raise RejectedInput("degenerate", "the cells' normals cancel out")
+    ez = (nx_ / norm, ny_ / norm, nz_ / norm)
+    # e_x: the wheelset's x projected on the contact plane; e_y = e_z x e_x
+    exx, exy, exz = 1.0 - ez[0] * ez[0], -ez[0] * ez[1], -ez[0] * ez[2]
+    ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
+    if not ex_norm > 1e-6:
+        raise RejectedInput("degenerate", "the contact normal lies along the wheelset's x")
+    ex = (exx / ex_norm, exy / ex_norm, exz / ex_norm)
+    ey = (ez[1] * ex[2] - ez[2] * ex[1], ez[2] * ex[0] - ez[0] * ex[2],
+          ez[0] * ex[1] - ez[1] * ex[0])
+    xyz = values[:, :3]
+    local = xyz @ np.array([ex, ey]).T
+    xl = local[:, 0].reshape(ny, nx) - (ox * ex[0] + oy * ex[1] + oz * ex[2])
+    yl = local[:, 1].reshape(ny, nx) - (ox * ey[0] + oy * ey[1] + oz * ey[2])
+    # each checks the whole grid: x must not vary across strips, nor y along them
+    x0, dx, column_order = _regular_axis(xl, 1, "along a strip")
+    y0, dy, row_order = _regular_axis(yl, 0, "across the strips")
+    cell_area = dx * dy
+    load = total * cell_area
+    if not (cell_area > 0.0 and math.isfinite(load) and load > 0.0):
+        raise RejectedInput("degenerate", f"cell area {cell_area:.3g} m^2, load {load:.3g} N")
+    pressure = p.reshape(ny, nx)
+    if row_order < 0 or column_order < 0:
+        pressure = np.ascontiguousarray(pressure[::row_order, ::column_order])
+    frame = ContactFrame((ox, oy, oz), (ex, ey, ez))
+    return ContactPatch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, cells,
+                        row_order, column_order, xyz.reshape(ny, nx, 3))
+
+
+def planar_points(origin: tuple[float, float, float], axes: ContactFrame | None, x0: float,
+                  y0: float, dx: float, dy: float, ny: int, nx: int) -> FloatArray:
+    """Return cell centres ``(ny, nx, 3)`` of a grid in a contact plane, in the wheelset frame.
+
+    ``axes``: a frame whose ``e_x, e_y`` span the plane (its origin is
+    ignored; ``origin`` places cell ``(x, y) = (0, 0)``).  The inverse of
+    the in-plane coordinates :func:`patch_from_cloud` derives.
+    """
+    (ex, ey, _) = (np.asarray(a, dtype=np.float64) for a in
+                   (axes.axes if axes is not None else ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0),
+                                                        (0.0, 0.0, 1.0))))
+    xs = x0 + dx * np.arange(nx)
+    ys = y0 + dy * np.arange(ny)
+    return (np.asarray(origin, dtype=np.float64) + xs[None, :, None] * ex
+            + ys[:, None, None] * ey)
+
+
+def frame_from_normal(normal: tuple[float, float, float]) -> ContactFrame:
+    """Return the contact axes of INTERFACE.md for a unit ``normal`` (origin at 0)."""
+    ez = np.asarray(normal, dtype=np.float64)
+    ez = ez / math.sqrt(float(ez @ ez))
+    ex = np.array([1.0, 0.0, 0.0]) - ez[0] * ez
+    ex /= math.sqrt(float(ex @ ex))
+    ey = np.cross(ez, ex)
+    return ContactFrame((0.0, 0.0, 0.0), (tuple(map(float, ex)), tuple(map(float, ey)),
+                                          tuple(map(float, ez))))  # type: ignore[arg-type]
+
+
+def cloud_bytes(points: FloatArray, normals: FloatArray, pressure: FloatArray, *,
+                dtype: str = "<f4") -> tuple[list[tuple[str, int]], int, bytes]:
+    """Return ``(fields, point_step, data)`` of a patch cloud in INTERFACE.md's layout.
+
+    ``points``, ``normals``: ``(ny, nx, 3)`` (a normal may be given once,
+    shape ``(3,)``); ``pressure``: ``(ny, nx)`` (Pa); fields ``x y z
+    normal_x normal_y normal_z pressure`` packed in that order with
+    ``dtype`` (``<f4``, ``>f8``, ...).  ``fields``: ``(name, offset)``.
+    """
+    ny, nx = pressure.shape
+    size = np.dtype(dtype).itemsize
+    rec = np.empty((ny, nx, 7), dtype=dtype)
+    rec[..., 0:3] = points
+    rec[..., 3:6] = np.broadcast_to(normals, (ny, nx, 3))
+    rec[..., 6] = pressure
+    return [(name, k * size) for k, name in enumerate(PATCH_FIELDS)], 7 * size, rec.tobytes()
