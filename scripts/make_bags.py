@@ -668,6 +668,54 @@ def build(name: str, out: Path) -> Path:
     return path
 
 
+BEGIN, END = "<!-- make_bags: begin -->", "<!-- make_bags: end -->"
+
+
+def summary_text(out: Path) -> str:
+    """Return the generated block of ``bags/README.md``: the bags on disk and expected outcomes."""
+    lines = [BEGIN, "", "| bag | topic: messages | duration | size |", "| --- | --- | --- | --- |"]
+    for name in SCENARIOS:
+        path = out / name
+        if not path.is_dir():
+            continue
+        with Reader(path) as reader:
+            topics = ", ".join(f"`{c.topic}`: {c.msgcount}" for c in reader.connections)
+            dur = reader.duration / 1e9
+        size = sum(f.stat().st_size for f in path.iterdir())
+        lines.append(f"| `{name}` | {topics} | {dur:.3f} s | {size / 1e3:.0f} kB |")
+    total = sum(f.stat().st_size for f in out.rglob("*") if f.is_file() and f.name != "README.md")
+    lines += ["", f"All of `bags/` but this file: {total / 1e6:.3f} MB.", ""]
+    exp = out / "bad_inputs.expected.yaml"
+    if exp.exists():
+        counts = expected_counts(classify_bag(out / "bad_inputs", {}))
+        names = list(counts)
+        lines += ["Expected outcomes of `bad_inputs` (as in `bad_inputs.expected.yaml`):", "",
+                  "| outcome | " + " | ".join(f"`{c}`" for c in names) + " |",
+                  "| --- |" + " --- |" * len(names)]
+        rows = [("patches", [counts[c]["patches"] for c in names]),
+                ("served (a wrench from a solve)", [counts[c]["served"] for c in names]),
+                ("`no_contact` (a zero wrench)", [counts[c]["no_contact"] for c in names])]
+        rows += [(f"`rejected/{r}`", [counts[c]["rejected"][r] for c in names])
+                 for r in REASONS]
+        lines += [f"| {label} | " + " | ".join(str(v) for v in vals) + " |"
+                  for label, vals in rows]
+        lines.append("")
+    return "\n".join(lines + [END])
+
+
+def update_readme(out: Path) -> None:
+    """Replace the generated block of ``out/README.md``, if it has one."""
+    readme = out / "README.md"
+    if not readme.exists():
+        return
+    text = readme.read_text()
+    if BEGIN not in text or END not in text:
+        return
+    head, rest = text.split(BEGIN, 1)
+    tail = rest.split(END, 1)[1]
+    readme.write_text(head + summary_text(out) + tail)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Write the bags; print each one's message count, size and build time."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -680,6 +728,7 @@ def main(argv: list[str] | None = None) -> int:
         path = build(name, args.out)
         size = sum(f.stat().st_size for f in path.iterdir())
         print(f"{path}: {size / 1e6:.3f} MB in {time.perf_counter() - t0:.1f} s")
+    update_readme(args.out)
     return 0
 
 
