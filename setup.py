@@ -31,6 +31,8 @@ setup(
     entry_points={
         'console_scripts': [
             'fastsim_contact = fastsim_ros.cli:main',
+            'fastsim_node = fastsim_ros.node:main',
+            'fastsim_replay = fastsim_ros.replay:main',
         ],
     },
 )

@@ -30,8 +30,9 @@ import numpy as np
 from fastsim_ros import params as parameters
 from fastsim_ros.contact.compiled import ContactForces, EquivalentEllipseSolver, MaeSolver
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
-from msg_adapters.cdr import Cloud, StampedTwist
-from msg_adapters.errors import REJECTION_REASONS, RejectedInput
+from msg_adapters import outputs as out
+from msg_adapters.cdr import Cloud, StampedTwist, read_cloud, read_twist
+from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
 from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud
 
@@ -44,6 +45,31 @@ SOLVE_TIME_WINDOW = 1000
 FRAME_TOLERANCE = 1e-6
 
 SOLVED, NO_CONTACT = "solved", "no_contact"
+
+
+def patch_topic(contact: str) -> str:
+    """Return the (relative) patch topic of a contact."""
+    return f"contact/{contact}/patch"
+
+
+WHEEL_TWIST_TOPIC, RAIL_TWIST_TOPIC = "wheelset/twist", "rail/twist"
+WHEELSET_WRENCH_TOPIC, MARKERS_TOPIC = "wheelset/wrench", "contact/markers"
+DIAGNOSTICS_TOPIC = "/diagnostics"
+#: output topics of a contact: relative name -> message type
+CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
+                   "creepage": "geometry_msgs/msg/Vector3Stamped",
+                   "frame": "geometry_msgs/msg/PoseStamped",
+                   "traction": "sensor_msgs/msg/PointCloud2"}
+
+
+def output_topics(contacts: tuple[str, ...]) -> dict[str, str]:
+    """Return every output topic (relative, but /diagnostics) with its message type."""
+    topics = {f"contact/{c}/{kind}": msgtype for c in contacts
+              for kind, msgtype in CONTACT_OUTPUTS.items()}
+    topics[WHEELSET_WRENCH_TOPIC] = "geometry_msgs/msg/WrenchStamped"
+    topics[MARKERS_TOPIC] = "visualization_msgs/msg/MarkerArray"
+    topics[DIAGNOSTICS_TOPIC] = "diagnostic_msgs/msg/DiagnosticArray"
+    return topics
 
 
 @dataclass(frozen=True)
@@ -115,6 +141,7 @@ class ContactStats:
     solve_times: np.ndarray = field(default_factory=lambda: np.zeros(SOLVE_TIME_WINDOW))
     solves: int = 0
     window_inputs: int = 0
+    window_rejected: int = 0
     window_first_ns: int | None = None
     window_last_ns: int | None = None
     last_detail: str = ""
@@ -190,7 +217,7 @@ class Pipeline:
         self._rail: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
         self._contacts = {name: _ContactState() for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
-                                  "old_stamp": 0}
+                                  "old_stamp": 0, "malformed": 0}
         self._apply(config)
 
     def _apply(self, config: PipelineConfig) -> None:
@@ -220,7 +247,14 @@ class Pipeline:
 
     # ---------------------------------------------------------------- kinematics
 
-    def _twist(self, history: deque[StampedTwist], twist: StampedTwist, what: str) -> str:
+    def _twist(self, history: deque[StampedTwist], twist: StampedTwist | bytes | memoryview,
+               what: str) -> str:
+        if not isinstance(twist, StampedTwist):
+            try:
+                twist = read_twist(twist)
+            except MalformedMessageError:
+                self.kinematics_counts["malformed"] += 1
+                return "malformed"
         if twist.frame_id != self._frame_id:
             reason = "wrong_frame"
         elif not twist_is_finite(twist):
@@ -234,11 +268,11 @@ class Pipeline:
         self.kinematics_counts[reason] += 1
         return reason
 
-    def on_wheel_twist(self, twist: StampedTwist) -> str:
-        """Take a wheelset twist; return ``"ok"`` or why it was dropped."""
+    def on_wheel_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
+        """Take a wheelset twist (decoded or CDR); return ``"ok"`` or why it was dropped."""
         return self._twist(self._wheel, twist, "wheel")
 
-    def on_rail_twist(self, twist: StampedTwist) -> str:
+    def on_rail_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
         """Take a rail twist (roller, moving rail); return ``"ok"`` or why it was dropped."""
         return self._twist(self._rail, twist, "rail")
 
@@ -264,11 +298,18 @@ class Pipeline:
 
     # ---------------------------------------------------------------- patches
 
-    def on_patch(self, contact: str, cloud: Cloud) -> Outcome:
-        """Solve one patch of ``contact`` with the kinematics it matches."""
+    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview) -> Outcome:
+        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches."""
         state = self._contacts[contact]
-        stamp = cloud.stamp_ns
         stats = state.stats
+        if not isinstance(cloud, Cloud):
+            try:
+                cloud = read_cloud(cloud)
+            except MalformedMessageError as e:  # not a PointCloud2: its fields are missing
+                stats.counts["missing_field"] += 1
+                stats.last_detail = f"missing_field: {e}"
+                return Outcome(contact, -1, "missing_field", str(e))
+        stamp = cloud.stamp_ns
         stats.window_inputs += 1
         if stats.window_first_ns is None:
             stats.window_first_ns = stamp
@@ -291,6 +332,7 @@ class Pipeline:
             forces = self._solve(patch, creep, stats)
         except RejectedInput as e:
             stats.counts[e.reason] += 1
+            stats.window_rejected += 1
             stats.last_detail = str(e)
             return Outcome(contact, stamp, e.reason, e.detail)
         stats.counts[SOLVED] += 1
@@ -376,6 +418,59 @@ class Pipeline:
         state.last_marker_ns = stamp
         return True
 
+    # ---------------------------------------------------------------- messages
+
+    def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
+        """Return the ``(topic, message)`` pairs to publish for an outcome, in order.
+
+        Per-patch messages come as CDR bytes, the rest as message objects
+        (INTERFACE.md "Outputs"): the contact's wrench and creepage, its
+        frame when it moved, its traction cloud when asked for, its marker
+        when due, and the wheelset wrench when the rig cycle is complete.
+        """
+        if not outcome.has_wrench:
+            return []
+        c, stamp, frame_id = outcome.contact, outcome.stamp_ns, self._frame_id
+        base = f"contact/{c}/"
+        f = outcome.forces
+        msgs: list[tuple[str, Any]] = []
+        if f is None or outcome.frame is None or outcome.creepage is None:
+            msgs.append((base + "wrench", out.contact_wrench_cdr(stamp, c, 0.0, 0.0, 0.0, 0.0)))
+        else:
+            msgs.append((base + "wrench", out.contact_wrench_cdr(stamp, c, f.fx, f.fy, f.n,
+                                                                 f.mz)))
+            msgs.append((base + "creepage", out.creepage_cdr(stamp, c, outcome.creepage)))
+            if outcome.frame_changed:
+                msgs.append((base + "frame", out.pose_cdr(stamp, frame_id, outcome.frame)))
+            if (f.tau_x is not None and f.tau_y is not None and f.slip is not None
+                    and f.grid is not None):
+                msgs.append((base + "traction", out.traction_cloud(
+                    stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid)))
+        if outcome.markers:
+            index = self.config.contacts.index(c)
+            fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)
+            marker = out.force_marker(stamp, frame_id, index, c, outcome.frame, fx, fy,
+                                      float(self.config["marker_scale"]))
+            msgs.append((MARKERS_TOPIC, out.marker_array([marker])))
+        w = outcome.wheelset
+        if w is not None:
+            msgs.append((WHEELSET_WRENCH_TOPIC, out.wrench_cdr(w.stamp_ns, frame_id, w.force,
+                                                               w.torque)))
+        return msgs
+
+    def diagnostics(self, stamp_ns: int) -> Any:
+        """Return the ``DiagnosticArray`` of every contact (and the kinematics), stamped ``stamp_ns``."""
+        statuses = []
+        for c in self.config.contacts:
+            r = self.report(c)
+            statuses.append((r.name, r.level, r.message, r.values))
+        k = self.kinematics_counts
+        dropped = k["nonfinite"] + k["wrong_frame"] + k["old_stamp"] + k["malformed"]
+        statuses.append(("fastsim: kinematics", 1 if dropped else 0,
+                         f"{dropped} twists dropped" if dropped else "ok",
+                         [(f"twists/{key}", str(v)) for key, v in k.items()]))
+        return out.diagnostic_array(stamp_ns, statuses)
+
     # ---------------------------------------------------------------- diagnostics
 
     def latest_wrench(self, contact: str) -> tuple[int, tuple[float, float, float],
@@ -413,8 +508,9 @@ class Pipeline:
         level, message = 0, "ok"
         if stats.window_inputs == 0:
             level, message = 1, "no patch in the last period"
-        elif rejected:
-            level, message = 1, f"{rejected} rejected; last: {stats.last_detail}"
-        stats.window_inputs = 0
+        elif stats.window_rejected:
+            level, message = 1, (f"{stats.window_rejected} of {stats.window_inputs} patches "
+                                 f"rejected; last: {stats.last_detail}")
+        stats.window_inputs = stats.window_rejected = 0
         stats.window_first_ns = stats.window_last_ns = None
         return ContactReport(f"fastsim: {contact}", level, message, tuple(values))

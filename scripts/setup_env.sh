@@ -28,3 +28,19 @@ export PATH="$venv/bin:$PATH"
 colcon build \
     --build-base build --install-base install \
     --event-handlers console_cohesion- console_start_end- status- desktop_notification-
+
+# The installed console scripts run with nothing sourced: the venv's python
+# finds the installed package (and its entry-point metadata) through a .pth
+# file, and .venv/bin links the scripts, so `.venv/bin/fastsim_node` works.
+site="$("$venv/bin/python" -c 'import sysconfig; print(sysconfig.get_path("purelib"))')"
+installed=(install/fastsim_ros/lib/python3.*/site-packages)
+echo "$root/${installed[0]}" > "$site/fastsim_ros_install.pth"
+for script in fastsim_node fastsim_replay fastsim_contact; do
+    ln -sf "$root/install/fastsim_ros/lib/fastsim_ros/$script" "$venv/bin/$script"
+done
+
+# Fill numba's on-disk cache for the installed kernels (a cold compile takes
+# about 18 s; a cached load a fraction of a second), so that the first start
+# of the node reaches its first wrench quickly.  No-op when cached.
+(cd / && "$venv/bin/python" -c \
+    'from fastsim_ros.contact import compiled; compiled.warm_up()')

@@ -1,0 +1,201 @@
+"""``fastsim_node``: the ROS 2 node (default name ``fastsim``), a thin front end of the pipeline.
+
+Topics, frames and parameters: INTERFACE.md (and the README's "Running the
+node").  The node declares every parameter of :mod:`fastsim_ros.params`
+with its descriptor and range, builds one :class:`~fastsim_ros.pipeline.Pipeline`
+and wires topics to it.  The hot path is lean on purpose: patches and
+twists arrive raw (CDR bytes, decoded by :mod:`msg_adapters.cdr` with numpy
+views on the point buffer, no Python message built), and the per-patch
+outputs are published as bytes.
+
+QoS, chosen so that every peer matches: subscriptions best effort (a best
+effort subscription matches reliable and best-effort publishers, and a
+late patch is worth less than the next one), publishers reliable (matches
+every subscriber), depth ``qos_depth``; both configurable at start.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+import rclpy
+from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
+                              ParameterException)
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import PoseStamped, TwistStamped, Vector3Stamped, WrenchStamped
+from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
+                                ParameterType, SetParametersResult)
+from sensor_msgs.msg import PointCloud2
+from visualization_msgs.msg import MarkerArray
+
+from fastsim_ros import params as parameters
+from fastsim_ros.contact import compiled
+from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, RAIL_TWIST_TOPIC,
+                                  WHEEL_TWIST_TOPIC, WHEELSET_WRENCH_TOPIC, Outcome, Pipeline,
+                                  PipelineConfig, patch_topic)
+
+NODE_NAME = "fastsim"
+_TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
+          "integer": ParameterType.PARAMETER_INTEGER,
+          "bool": ParameterType.PARAMETER_BOOL,
+          "string": ParameterType.PARAMETER_STRING,
+          "string_array": ParameterType.PARAMETER_STRING_ARRAY}
+_MESSAGE_TYPES = {"wrench": WrenchStamped, "creepage": Vector3Stamped, "frame": PoseStamped,
+                  "traction": PointCloud2}
+
+
+class StartupError(Exception):
+    """A configuration the node cannot start with: reported in one line, exit 2."""
+
+
+def descriptor(spec: parameters.ParameterSpec) -> ParameterDescriptor:
+    """Return the ROS parameter descriptor of a parameter spec."""
+    d = ParameterDescriptor(type=_TYPES[spec.kind], description=spec.description,
+                            additional_constraints=spec.allowed(),
+                            read_only=not spec.dynamic)
+    if spec.low is not None and spec.high is not None:
+        if spec.kind == "double":
+            d.floating_point_range = [FloatingPointRange(
+                from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
+        else:
+            d.integer_range = [IntegerRange(from_value=int(spec.low), to_value=int(spec.high),
+                                            step=1)]
+    return d
+
+
+def _qos(reliability: str, depth: int) -> QoSProfile:
+    return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                      reliability=(ReliabilityPolicy.BEST_EFFORT if reliability == "best_effort"
+                                   else ReliabilityPolicy.RELIABLE))
+
+
+class FastsimNode(Node):
+    """Creep forces for every contact patch received (INTERFACE.md)."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        values = {}
+        try:
+            for spec in parameters.PARAMETERS:
+                default = list(spec.default) if spec.kind == "string_array" else spec.default
+                value = self.declare_parameter(spec.name, default, descriptor(spec)).value
+                values[spec.name] = spec.check(value)
+        except (InvalidParameterValueException, InvalidParameterTypeException,
+                ParameterException, parameters.ParameterError) as e:
+            raise StartupError(_one_line(e, spec)) from None
+        config = PipelineConfig.from_values(values)
+        warm = compiled.warm_up()
+        self.pipeline = Pipeline(config)
+        depth = int(config["qos_depth"])
+        qos_in = _qos(config["patch_reliability"], depth)
+        qos_out = _qos(config["output_reliability"], depth)
+        self._pubs: dict[str, Any] = {}
+        for c in config.contacts:
+            for kind, msgtype in _MESSAGE_TYPES.items():
+                topic = f"contact/{c}/{kind}"
+                self._pubs[topic] = self.create_publisher(msgtype, topic, qos_out)
+        self._pubs[WHEELSET_WRENCH_TOPIC] = self.create_publisher(
+            WrenchStamped, WHEELSET_WRENCH_TOPIC, qos_out)
+        self._pubs[MARKERS_TOPIC] = self.create_publisher(MarkerArray, MARKERS_TOPIC, qos_out)
+        self._diagnostics = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
+        self.create_subscription(TwistStamped, WHEEL_TWIST_TOPIC, self._on_wheel_twist, qos_in,
+                                 raw=True)
+        self.create_subscription(TwistStamped, RAIL_TWIST_TOPIC, self._on_rail_twist, qos_in,
+                                 raw=True)
+        for c in config.contacts:
+            self.create_subscription(PointCloud2, patch_topic(c),
+                                     lambda raw, c=c: self._on_patch(c, raw), qos_in, raw=True)
+        self.create_timer(1.0, self._publish_diagnostics)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.get_logger().info(
+            f"solving {', '.join(config.contacts)} with {config['method']} "
+            f"(mu {config['friction_coefficient']:g}, bound {config['traction_bound']}); "
+            f"kernels ready in {warm:.2f} s")
+
+    def _on_wheel_twist(self, raw: bytes) -> None:
+        verdict = self.pipeline.on_wheel_twist(raw)
+        if verdict != "ok":
+            self.get_logger().warning(f"wheelset twist dropped: {verdict}",
+                                      throttle_duration_sec=1.0)
+
+    def _on_rail_twist(self, raw: bytes) -> None:
+        verdict = self.pipeline.on_rail_twist(raw)
+        if verdict != "ok":
+            self.get_logger().warning(f"rail twist dropped: {verdict}",
+                                      throttle_duration_sec=1.0)
+
+    def _on_patch(self, contact: str, raw: bytes) -> None:
+        outcome: Outcome = self.pipeline.on_patch(contact, raw)
+        if not outcome.has_wrench:
+            self.get_logger().warning(f"{contact}: patch rejected, {outcome.status}: "
+                                      f"{outcome.detail}", throttle_duration_sec=1.0)
+            return
+        pubs = self._pubs
+        for topic, msg in self.pipeline.messages(outcome):
+            pubs[topic].publish(msg)
+
+    def _publish_diagnostics(self) -> None:
+        self._diagnostics.publish(self.pipeline.diagnostics(self.get_clock().now().nanoseconds))
+
+    def _on_set_parameters(self, changes: list[Parameter]) -> SetParametersResult:
+        values = {}
+        for p in changes:
+            spec = parameters.SPECS.get(p.name)
+            if spec is None:
+                return SetParametersResult(successful=False,
+                                           reason=f"unknown parameter {p.name!r}")
+            if not spec.dynamic:
+                return SetParametersResult(successful=False, reason=(
+                    f"parameter {p.name!r} is set at start only"))
+            try:
+                values[p.name] = spec.check(p.value)
+            except parameters.ParameterError as e:
+                return SetParametersResult(successful=False, reason=str(e))
+        try:
+            self.pipeline.update(values)
+        except parameters.ParameterError as e:
+            return SetParametersResult(successful=False, reason=str(e))
+        self.get_logger().info("parameters set: " + ", ".join(
+            f"{k} = {v!r}" for k, v in values.items()))
+        return SetParametersResult(successful=True)
+
+
+def _one_line(error: Exception, spec: parameters.ParameterSpec) -> str:
+    """Return a start-up parameter error as one line naming the parameter and its range."""
+    if isinstance(error, parameters.ParameterError):
+        return str(error)
+    return (f"parameter {spec.name!r}: {str(error).splitlines()[0]}; it must be "
+            f"{spec.allowed()}")
+
+
+def main(args: Sequence[str] | None = None) -> int:
+    """Run the node until SIGINT or SIGTERM; return the exit status (2: bad parameters)."""
+    rclpy.init(args=list(args) if args is not None else None)
+    node = None
+    status = 0
+    try:
+        node = FastsimNode()
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    except StartupError as e:
+        print(f"fastsim_node: {e}", file=sys.stderr)
+        status = 2
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
