@@ -218,6 +218,7 @@ class Bag:
     """Messages of one bag, written in log-time order (ties by topic order)."""
 
     def __init__(self, name: str) -> None:
+        """Start an empty bag called ``name``."""
         self.name = name
         self.topics: dict[str, str] = {}
         self.items: list[tuple[int, int, int, Any]] = []  # log ns, topic idx, seq, msg
