@@ -376,7 +376,7 @@ def flange_shift() -> tuple[Bag, dict[str, Any]]:
         for name in ("left", "right", "left_flange"):
             pts = clouds[k].get(name, empty)
             bag.add(f"/contact/{name}/patch", ns, cloud_msg(ns, pts))
-    return bag, {}
+    return bag, {"contacts": ["left", "right", "left_flange"]}
 
 
 def roller_rig() -> tuple[Bag, dict[str, Any]]:
