@@ -3,7 +3,18 @@
 Two commands (INTERFACE.md): ``coefficients`` prints an area's generalised
 creepage coefficients, ``forces`` the creep forces at given creepages.  SI
 units throughout.  ``--json`` prints exactly one JSON object on stdout.  Bad
-input gives one line on stderr and exit status 2, never a traceback.
+input gives one line on stderr and exit status 2, never a traceback, and no
+non-finite number is ever printed as a result.
+
+``forces --method mae`` and ``fastsim_ellipse`` run the compiled solvers of
+:mod:`fastsim_ros.contact.compiled`, the code the node runs; ``exact`` runs
+the exact theory (:mod:`fastsim_ros.contact.exact`).
+
+What the command line accepts is bounded (:data:`LIMITS`, :data:`MAX_PATCH_CELLS`,
+:data:`MAX_STRIP_CELLS`, :data:`MAX_EXACT_FORCE_CELLS`): every real contact lies
+far inside, and inside them no intermediate quantity can overflow or underflow,
+and no grid or operator outgrows memory; each bound is checked before the
+arrays it limits are allocated.
 """
 
 from __future__ import annotations
@@ -12,21 +23,17 @@ import argparse
 import csv
 import json
 import math
+import re
 import sys
-from collections.abc import Callable, Sequence
+import warnings
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
 import numpy as np
 
 from fastsim_ros.contact import area as areas
-from fastsim_ros.contact import exact
-from fastsim_ros.contact.equivalent import equivalent_fastsim
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
-from fastsim_ros.contact.fastsim import traction_bound
-from fastsim_ros.contact.mae import (mae_coefficients, mae_fastsim, mae_fastsim_coefficients,
-                                     mae_geometry)
-from fastsim_ros.contact.tables import coefficient_table
 
 EXACT_GRIDS = (0.4, 0.6, 0.8, 1.0)
 #: cells across the bounding box of a shape, per method: exact coefficients are
@@ -34,13 +41,51 @@ EXACT_GRIDS = (0.4, 0.6, 0.8, 1.0)
 #: cells is 0.1% on ellipses (docs/validation.md).
 DEFAULT_CELLS = {"exact": 100, "mae": 100, "fastsim": 60, "exact_forces": 60,
                  "mae_forces": 60, "fastsim_ellipse_forces": 60}
+#: the most cells along each axis of a shape's grid (``--cells``)
+MAX_CELLS = 400
+#: the most cells the grid of a patch file may span (its cells' bounding box at
+#: their spacing): 400 x 400, the largest ``--cells`` grid
+MAX_PATCH_CELLS = MAX_CELLS * MAX_CELLS
+#: the most cells along ``x`` for the exact solver (each strip's own operator
+#: block is dense: strips x cells^2 doubles)
+MAX_STRIP_CELLS = MAX_CELLS
+#: the most cells in contact for ``forces --method exact`` (its Coulomb solver
+#: holds the dense operator, (2 n)^2 doubles: 0.5 GB at 4,000 cells)
+MAX_EXACT_FORCE_CELLS = 4000
+#: the largest patch file read (bytes): far more than MAX_PATCH_CELLS rows need
+MAX_PATCH_BYTES = 64 * 2**20
+#: accepted ranges (SI): (smallest, largest) magnitude
+LIMITS = {
+    "length": (1e-9, 1e3),        # m: --a, --b, a patch's cell sizes
+    "coordinate": (0.0, 1e6),     # m: |x|, |y| of a patch's cells
+    "pressure": (1e-3, 1e13),     # Pa: a loaded patch's largest pressure (forces)
+    "shear_modulus": (1.0, 1e15),  # Pa
+    "mu": (0.0, 100.0),           # exclusive of 0
+    "creepage": (0.0, 100.0),     # |xi|, |eta|
+    "spin": (0.0, 1e6),           # |phi|, 1/m
+    "a_over_b": (1e-3, 1e3),      # --a-over-b
+}
 
 
 class UsageError(Exception):
     """A command line that cannot be run: reported in one line, exit status 2."""
 
 
+# argparse reads a token that starts with "-" as a flag unless it looks like a
+# negative number, and its test knows neither exponents nor inf/nan: "-1e-4"
+# would be "expected one argument".  This one knows every float Python reads.
+_NEGATIVE_NUMBER = re.compile(
+    r"^-(\d[\d_]*\.?[\d_]*|\.\d[\d_]*)([eE][-+]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE)
+
+
 class _Parser(argparse.ArgumentParser):
+    """No prefix abbreviations (``--a`` is not ``--a-over-b``); errors raise UsageError."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
+
     def error(self, message: str) -> NoReturn:
         raise UsageError(message)
 
@@ -60,8 +105,8 @@ def _cells(text: str) -> int:
         n = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a whole number: {text!r}") from None
-    if n < 4 or n > 400:
-        raise argparse.ArgumentTypeError(f"--cells must lie in [4, 400], got {n}")
+    if n < 4 or n > MAX_CELLS:
+        raise argparse.ArgumentTypeError(f"--cells must lie in [4, {MAX_CELLS}], got {n}")
     return n
 
 
@@ -105,25 +150,152 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def read_patch(path: Path) -> areas.GridArea:
-    """Read a patch CSV (header ``x,y,pressure``; m, m, Pa) into a grid area."""
+# ---------------------------------------------------------------- patch files
+
+
+def _patch_lines(path: Path) -> list[str]:
+    """Return the lines of a patch file: at most MAX_PATCH_BYTES, UTF-8 (a BOM is dropped)."""
     try:
-        with open(path, newline="") as f:
-            rows = list(csv.reader(line for line in f if not line.lstrip().startswith("#")))
+        with open(path, "rb") as f:
+            raw = f.read(MAX_PATCH_BYTES + 1)
     except OSError as e:
         raise InvalidInputError(f"cannot read patch file {path}: {e.strerror}") from None
-    if not rows or [c.strip() for c in rows[0]] != ["x", "y", "pressure"]:
-        raise InvalidInputError(f"{path}: the header must be x,y,pressure")
-    body = [r for r in rows[1:] if any(c.strip() for c in r)]
-    if not body:
-        raise InvalidInputError(f"{path}: no cells")
+    if len(raw) > MAX_PATCH_BYTES:
+        raise InvalidInputError(f"{path}: larger than {MAX_PATCH_BYTES // 2**20} MiB, more "
+                                f"than a patch of {MAX_PATCH_CELLS:,} cells needs")
     try:
-        data = np.array([[float(c) for c in r] for r in body], dtype=float)
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise InvalidInputError(f"{path}: not UTF-8 text (byte 0x{raw[e.start]:02x} at "
+                                f"offset {e.start})") from None
+    if "\x00" in text:
+        raise InvalidInputError(f"{path}: a NUL byte: not a text file")
+    return text.splitlines()
+
+
+def _rows(path: Path, lines: list[str]) -> Iterator[tuple[int, list[str]]]:
+    """Yield ``(line number, fields)`` of the non-blank, non-comment lines."""
+    # comment lines become blank ones, so that the reader's line numbers stay the file's
+    reader = csv.reader("" if ln.lstrip().startswith("#") else ln for ln in lines)
+    try:
+        for fields in reader:
+            if any(c.strip() for c in fields):
+                yield reader.line_num, fields
+    except csv.Error as e:
+        raise InvalidInputError(f"{path}, line {reader.line_num}: {e}") from None
+
+
+def _value(path: Path, line: int, name: str, text: str) -> float:
+    try:
+        v = float(text)
     except ValueError:
-        raise InvalidInputError(f"{path}: a value that is not a number") from None
-    if data.ndim != 2 or data.shape[1] != 3:
-        raise InvalidInputError(f"{path}: every row needs three values x,y,pressure")
-    return areas.from_cells(data[:, 0], data[:, 1], data[:, 2])
+        shown = text.strip()[:30] or "an empty field"
+        raise InvalidInputError(f"{path}, line {line}: {name} is not a number: "
+                                f"{shown!r}") from None
+    if not math.isfinite(v):
+        raise InvalidInputError(f"{path}, line {line}: NaN or infinite {name} {text.strip()!r}")
+    return v
+
+
+def read_patch(path: Path, *, max_cells: int = MAX_PATCH_CELLS) -> areas.GridArea:
+    """Read a patch CSV (header ``x,y,pressure``; m, m, Pa) into a grid area.
+
+    Refused (:class:`InvalidInputError`, one line naming the file, the line
+    and the problem): a file that cannot be read, is larger than
+    :data:`MAX_PATCH_BYTES` or is not UTF-8 text (a UTF-8 BOM is fine), a
+    wrong header, a row without exactly three values, a value that is not a
+    finite number, a negative pressure, a coordinate beyond
+    ``LIMITS["coordinate"]``, cells off one regular grid, and cells whose grid
+    would span more than ``max_cells`` cells (checked before it is allocated).
+    """
+    rows = _rows(path, _patch_lines(path))
+    first = next(rows, None)
+    if first is None:
+        raise InvalidInputError(f"{path}: empty (no header x,y,pressure)")
+    if [c.strip() for c in first[1]] != ["x", "y", "pressure"]:
+        shown = ",".join(first[1])[:40]
+        raise InvalidInputError(f"{path}, line {first[0]}: the header must be x,y,pressure, "
+                                f"not {shown!r}")
+    values: list[tuple[float, float, float]] = []
+    coordinate_max = LIMITS["coordinate"][1]
+    for line, fields in rows:
+        if len(fields) != 3:
+            kind = "a short row" if len(fields) < 3 else "a long row"
+            raise InvalidInputError(f"{path}, line {line}: {kind}: {len(fields)} values where "
+                                    "x,y,pressure needs 3")
+        x, y, p = (_value(path, line, name, text)
+                   for name, text in zip(("x", "y", "pressure"), fields))
+        if p < 0.0:
+            raise InvalidInputError(f"{path}, line {line}: negative pressure {p:g} Pa")
+        if max(abs(x), abs(y)) > coordinate_max:
+            raise InvalidInputError(f"{path}, line {line}: coordinate ({x:g}, {y:g}) m beyond "
+                                    f"the {coordinate_max:g} m the command line accepts")
+        values.append((x, y, p))
+        if len(values) > max_cells:
+            raise InvalidInputError(f"{path}: more than {max_cells:,} cells")
+    if not values:
+        raise InvalidInputError(f"{path}: no cells")
+    data = np.array(values)
+    try:
+        patch = areas.from_cells(data[:, 0], data[:, 1], data[:, 2], max_cells=max_cells)
+    except ContactError as e:
+        raise type(e)(f"{path}: {e}") from None
+    lo, hi = LIMITS["length"]
+    if not (lo <= patch.dx <= hi and lo <= patch.dy <= hi):
+        raise InvalidInputError(f"{path}: cells of {patch.dx:.4g} m x {patch.dy:.4g} m: cell "
+                                f"sizes must lie in [{lo:g}, {hi:g}] m")
+    return patch
+
+
+# ---------------------------------------------------------------- checks
+
+
+def _in_range(name: str, value: float, key: str, unit: str = "", *,
+              magnitude: bool = False, open_low: bool = False) -> None:
+    """Refuse ``value`` (or its magnitude) outside ``LIMITS[key]``, naming ``name``."""
+    lo, hi = LIMITS[key]
+    if magnitude:
+        if not abs(value) <= hi:
+            raise InvalidInputError(f"|{name}| must be at most {hi:g}{unit}, got {value:g}")
+        return
+    if not ((value > lo if open_low else value >= lo) and value <= hi):
+        left = "(" if open_low else "["
+        raise InvalidInputError(f"{name} must lie in {left}{lo:g}, {hi:g}]{unit}, got {value:g}")
+
+
+def _check_material(nu: float, shear_modulus: float | None = None) -> None:
+    """Run the library's material check, then the command line's range of ``G``."""
+    from fastsim_ros.contact.exact import check_material
+    check_material(nu, 1.0 if shear_modulus is None else shear_modulus)
+    if shear_modulus is not None:
+        _in_range("--shear-modulus", shear_modulus, "shear_modulus", " Pa")
+
+
+def _check_exact_grid(area: areas.GridArea, *, forces: bool) -> None:
+    if area.nx > MAX_STRIP_CELLS:
+        raise InvalidInputError(f"the exact solver takes at most {MAX_STRIP_CELLS} cells along "
+                                f"x (its strips' operator blocks are dense), got {area.nx}")
+    n = int(np.count_nonzero(area.mask))
+    if forces and n > MAX_EXACT_FORCE_CELLS:
+        raise InvalidInputError(
+            f"forces --method exact takes at most {MAX_EXACT_FORCE_CELLS:,} cells in contact "
+            f"(its dense operator), got {n:,}: use fewer --cells or a coarser patch")
+
+
+def _finite_result(result: dict[str, Any], keys: Sequence[str]) -> None:
+    """Refuse to print a result with a non-finite number (a last guard: the limits prevent it)."""
+    for key in keys:
+        v = result.get(key)
+        if isinstance(v, float) and not math.isfinite(v):
+            raise InvalidInputError(f"the solve gave a non-finite {key}: the inputs are beyond "
+                                    "what the solver can represent")
+
+
+def _or_none(v: float) -> float | None:
+    return v if math.isfinite(v) else None
+
+
+# ---------------------------------------------------------------- coefficients
 
 
 def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridArea], str]:
@@ -139,12 +311,14 @@ def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridAr
     if args.shape == "ellipse":
         if g is None or len(g) != 1:
             raise UsageError("--shape ellipse takes one --a-over-b value")
-        a, b = areas.semi_ellipse_axes(g[0])
-        return (lambda n: areas.ellipse(a, b, nx=n, ny=n)), f"ellipse a/b={g[0]:g}"
-    if g is None or len(g) != 2:
+    elif g is None or len(g) != 2:
         raise UsageError("--shape semi-ellipses takes two --a-over-b values G1 G2")
     for v in g:
-        areas.semi_ellipse_axes(v)
+        areas.semi_ellipse_axes(v)  # refuses a/b <= 0 with the library's message
+        _in_range("a/b", v, "a_over_b")
+    if args.shape == "ellipse":
+        a, b = areas.semi_ellipse_axes(g[0])
+        return (lambda n: areas.ellipse(a, b, nx=n, ny=n)), f"ellipse a/b={g[0]:g}"
     return ((lambda n: areas.semi_ellipses(g[0], g[1], cells=n)),
             f"semi-ellipses a1/b1={g[0]:g}, a2/b2={g[1]:g}")
 
@@ -153,9 +327,16 @@ def _grid_sequence(finest: int) -> list[int]:
     return sorted({max(4, 2 * round(f * finest / 2)) for f in EXACT_GRIDS})
 
 
+COEFFICIENT_KEYS = ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33", "area")
+
+
 def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``coefficients``: a dict of the results."""
-    exact.check_material(args.nu)
+    from fastsim_ros.contact import exact
+    from fastsim_ros.contact.mae import mae_coefficients, mae_fastsim_coefficients, mae_geometry
+    from fastsim_ros.contact.tables import coefficient_table
+
+    _check_material(args.nu)
     make, what = _shape_maker(args)
     result: dict[str, Any]
     if args.method == "exact" and args.patch is None:
@@ -164,72 +345,120 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
         per = [exact.creep_coefficients(make(n), nu=args.nu) for n in grids]
         h = np.array([1.0 / n for n in grids])
         result = {}
-        for key in ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33"):
+        for key in COEFFICIENT_KEYS[:-1]:
             # first-order convergence in the cell size (METHOD.md 5)
             result[key] = float(np.polyfit(h, [getattr(c, key) for c in per], 1)[1])
         result.update(area=1.0, cells=grids, extrapolated=True)
     else:
         ar = make(args.cells or DEFAULT_CELLS[args.method])
         if args.method == "exact":
+            _check_exact_grid(ar, forces=False)
             c = exact.creep_coefficients(ar, nu=args.nu)
         elif args.method == "mae":
             c = mae_coefficients(mae_geometry(ar), coefficient_table(args.nu))
         else:
             c = mae_fastsim_coefficients(ar, coefficient_table(args.nu))
+        # MAE gives no C~3j: reported as null
         result = {k: (None if math.isnan(v) else v) for k, v in c.as_dict().items()}
         result.update(cells=[ar.nx, ar.ny], extrapolated=False)
+    _finite_result(result, COEFFICIENT_KEYS)
     result.update(method=args.method, nu=args.nu, area_description=what)
     return result
 
 
+# ---------------------------------------------------------------- forces
+
+
+#: the keys every ``forces`` result has, whatever the method
+FORCE_KEYS = ("Fx", "Fy", "Mz", "N", "slip_fraction")
+
+
 def forces(args: argparse.Namespace) -> dict[str, Any]:
-    """Run ``forces``: a dict of the results."""
-    exact.check_material(args.nu, args.shear_modulus)
+    """Run ``forces``: a dict of the results (the same keys for every method, and extras)."""
+    _check_material(args.nu, args.shear_modulus)
     if not args.mu > 0.0:
-        raise InvalidInputError(f"mu must be positive, got {args.mu}")
+        raise InvalidInputError(f"mu must be positive, got {args.mu:g}")
+    _in_range("mu", args.mu, "mu", open_low=True)
+    _in_range("xi", args.xi, "creepage", magnitude=True)
+    _in_range("eta", args.eta, "creepage", magnitude=True)
+    _in_range("phi", args.phi, "spin", " 1/m", magnitude=True)
     if args.load is not None and not args.load > 0.0:
-        raise InvalidInputError(f"--load must be positive, got {args.load}")
+        raise InvalidInputError(f"--load must be positive, got {args.load:g}")
+    if args.method == "exact" and args.bound == "parabolic":
+        raise UsageError("--method exact takes the pressure as given (--bound given)")
     patch = _force_area(args)
     result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound}
+    creepages = (args.xi, args.eta, args.phi)
     if args.method == "exact":
-        if args.bound == "parabolic":
-            raise UsageError("--method exact takes the pressure as given (--bound given)")
-        sol = exact.coulomb(patch, args.xi, args.eta, args.phi, mu=args.mu, nu=args.nu,
+        from fastsim_ros.contact import exact
+        _check_exact_grid(patch, forces=True)
+        sol = exact.coulomb(patch, *creepages, mu=args.mu, nu=args.nu,
                             shear_modulus=args.shear_modulus)
         result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
             np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
     elif args.method == "mae":
-        bound = traction_bound(patch, args.mu, bound=args.bound)
-        res = mae_fastsim(patch, args.xi, args.eta, args.phi, bound=bound,
-                          table=coefficient_table(args.nu), shear_modulus=args.shear_modulus)
-        g = res.geometry
-        result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=float(
-            np.count_nonzero(res.traction.slip)) / np.count_nonzero(patch.mask),
-            split_y=g.y_s, zones=[{"area": z.area, "a": z.a_eq, "b": z.b_eq}
-                                  for z in (g.zone1, g.zone2)])
+        from fastsim_ros.contact.compiled import MaeSolver
+        mae = MaeSolver(args.nu, args.shear_modulus)
+        res = mae.solve(patch, *creepages, mu=args.mu, bound=args.bound)
+        g = mae.geometry(patch)
+        result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
+                      split_y=g.y_s,
+                      # an empty zone (a one-sided split) has no semi-ellipse: null axes
+                      zones=[{"area": z.area, "a": _or_none(z.a_eq), "b": _or_none(z.b_eq)}
+                             for z in (g.zone1, g.zone2)])
     else:
-        eq = equivalent_fastsim(patch, args.xi, args.eta, args.phi, mu=args.mu,
-                                table=coefficient_table(args.nu),
-                                shear_modulus=args.shear_modulus, bound=args.bound)
-        result.update(Fx=eq.fx, Fy=eq.fy, Mz=eq.mz, ellipse={
-            "x_c": eq.ellipse.x_c, "y_c": eq.ellipse.y_c, "a": eq.ellipse.a, "b": eq.ellipse.b})
+        from fastsim_ros.contact.compiled import EquivalentEllipseSolver
+        eq = EquivalentEllipseSolver(args.nu, args.shear_modulus)
+        res = eq.solve(patch, *creepages, mu=args.mu, bound=args.bound)
+        e = eq.ellipse(patch)
+        result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
+                      ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
+    _finite_result(result, FORCE_KEYS)
     result["cells"] = [patch.nx, patch.ny]
     return result
 
 
 def _force_area(args: argparse.Namespace) -> areas.GridArea:
-    """Return the loaded area: a patch file, or an ellipse with Hertzian pressure."""
+    """Return the loaded area: a patch file, or an ellipse with Hertzian pressure.
+
+    The largest pressure is checked against ``LIMITS["pressure"]`` before a
+    load scales it (so that an absurd ``--load`` is named, not its overflow).
+    """
+    lo, hi = LIMITS["pressure"]
     if args.patch is not None:
         if args.shape is not None:
             raise UsageError("give either --shape or --patch, not both")
         patch = read_patch(args.patch)
-        return patch if args.load is None else patch.with_load(args.load)
+        if args.load is None:
+            p_max = float(patch.pressure.max())
+            if not lo <= p_max <= hi:
+                raise InvalidInputError(f"{args.patch}: largest pressure {p_max:.3g} Pa; "
+                                        f"pressures must lie in [{lo:g}, {hi:g}] Pa (or "
+                                        "rescale them with --load)")
+            return patch
+        _check_load(args.load, patch)
+        return patch.with_load(args.load)
     if args.shape != "ellipse" or args.a is None or args.b is None:
         raise UsageError("forces need --shape ellipse --a A --b B (with --load) or --patch FILE")
     if args.load is None:
         raise UsageError("--load is required with --shape ellipse --a A --b B")
+    _in_range("--a", args.a, "length", " m")
+    _in_range("--b", args.b, "length", " m")
     n = args.cells or DEFAULT_CELLS[args.method + "_forces"]
+    _check_load(args.load, areas.ellipse(args.a, args.b, nx=n, ny=n, load=1.0))
     return areas.ellipse(args.a, args.b, nx=n, ny=n, load=args.load)
+
+
+def _check_load(load: float, unit: areas.GridArea) -> None:
+    """Refuse a load that would put the largest pressure of ``unit`` outside the limits."""
+    lo, hi = LIMITS["pressure"]
+    peak = float(unit.pressure.max()) * (load / unit.load)  # floats: inf, not an error
+    if not lo <= peak <= hi:
+        raise InvalidInputError(f"--load {load:g} N gives a largest pressure of {peak:.3g} Pa; "
+                                f"pressures must lie in [{lo:g}, {hi:g}] Pa")
+
+
+# ---------------------------------------------------------------- output
 
 
 def _print_table(command: str, result: dict[str, Any]) -> None:
@@ -245,24 +474,46 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
     else:
         print(f"method {result['method']}, N = {result['N']:.6g} N")
         print(f"  Fx = {result['Fx']:.6g} N\n  Fy = {result['Fy']:.6g} N\n"
-              f"  Mz = {result['Mz']:.6g} N m")
+              f"  Mz = {result['Mz']:.6g} N m\n"
+              f"  slip fraction = {result['slip_fraction']:.4g}")
+
+
+def _run(argv: Sequence[str] | None) -> tuple[argparse.Namespace, dict[str, Any]]:
+    args = build_parser().parse_args(argv)
+    with np.errstate(all="ignore"):
+        result = coefficients(args) if args.command == "coefficients" else forces(args)
+    return args, result
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``fastsim_contact``: 0 on success, 2 on bad input."""
-    parser = build_parser()
+    """Entry point of ``fastsim_contact``: 0 on success, 2 on bad input, 1 on an internal error."""
     try:
-        args = parser.parse_args(argv)
-        result = coefficients(args) if args.command == "coefficients" else forces(args)
+        # a warning is never the answer: the checks and the finite-result guard are
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            args, result = _run(argv)
+        text = json.dumps(result, allow_nan=False) if args.json else None
     except (UsageError, ContactError) as e:
         print(f"fastsim_contact: error: {e}", file=sys.stderr)
         return 2
+    except SystemExit as e:  # --help
+        return int(e.code or 0)
     except KeyboardInterrupt:
         return 130
-    if args.json:
-        print(json.dumps(result))
-    else:
-        _print_table(args.command, result)
+    except MemoryError:
+        print("fastsim_contact: error: out of memory", file=sys.stderr)
+        return 2
+    except Exception as e:  # a bug, not bad input: still one line, no traceback
+        print(f"fastsim_contact: internal error: {type(e).__name__}: {e}", file=sys.stderr)
+        return 1
+    try:
+        if text is not None:
+            print(text)
+        else:
+            _print_table(args.command, result)
+        sys.stdout.flush()
+    except BrokenPipeError:  # e.g. piped into head
+        return 0
     return 0
 
 

@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from fastsim_ros.contact.errors import EmptyContactError, InvalidInputError, IrregularGridError
+from fastsim_ros.contact.errors import (EmptyContactError, GridTooLargeError,
+                                        InvalidInputError, IrregularGridError)
 
 FloatArray = NDArray[np.float64]
 
@@ -190,11 +191,14 @@ def semi_ellipses(g1: float, g2: float, *, cells: int) -> GridArea:
 
 
 def from_cells(x: FloatArray, y: FloatArray, pressure: FloatArray, *,
-               rtol: float = 1e-6) -> GridArea:
+               rtol: float = 1e-6, max_cells: int | None = None) -> GridArea:
     """Make a grid area from scattered cell centres ``(x, y)`` (m) and their pressure (Pa).
 
     The centres must lie on one regular grid (any subset of it; absent cells
     are outside the contact).  Raises :class:`IrregularGridError` otherwise.
+    ``max_cells``: the most cells the grid spanned by the centres may have;
+    a larger one (a stray cell far from the others) raises
+    :class:`GridTooLargeError` before anything of the grid's size is allocated.
     """
     x = np.asarray(x, dtype=float).ravel()
     y = np.asarray(y, dtype=float).ravel()
@@ -205,21 +209,34 @@ def from_cells(x: FloatArray, y: FloatArray, pressure: FloatArray, *,
         raise InvalidInputError("NaN or infinite value in the cells")
     if np.any(p < 0.0):
         raise InvalidInputError("negative pressure")
-    ix, dx, x0 = _grid_index(x, "x", rtol)
-    iy, dy, y0 = _grid_index(y, "y", rtol)
+    ux, dx = _spacing(x, "x", rtol)
+    uy, dy = _spacing(y, "y", rtol)
+    # the grid's size from the spacing alone: no index array yet, nothing allocated
+    nx = _span_cells(ux, dx)
+    ny = _span_cells(uy, dy)
+    limit = _INDEX_LIMIT if max_cells is None else min(int(max_cells), _INDEX_LIMIT)
+    if nx * ny > limit:
+        raise GridTooLargeError(
+            f"the cells span a grid of {nx:.4g} x {ny:.4g} cells of {dx:.4g} m x {dy:.4g} m, "
+            f"more than the {limit:,} allowed (a stray cell far from the others?)")
+    ix = _grid_index(x, ux, dx, "x", rtol)
+    iy = _grid_index(y, uy, dy, "y", rtol)
     grid = np.zeros((iy.max() + 1, ix.max() + 1))
     if np.unique(iy * grid.shape[1] + ix).size != ix.size:
         raise IrregularGridError("two cells share one grid position")
     grid[iy, ix] = p
-    return GridArea(x0, y0, dx, dy, grid)
+    return GridArea(float(ux[0]), float(uy[0]), dx, dy, grid)
 
 
-def _grid_index(v: FloatArray, name: str, rtol: float) -> tuple[NDArray[np.int_], float, float]:
-    """Integer grid indices of coordinates ``v``, with the spacing and the first centre.
+#: grid cells beyond which indices would not fit the integers numpy casts them to
+_INDEX_LIMIT = 2**40
+
+
+def _spacing(v: FloatArray, name: str, rtol: float) -> tuple[FloatArray, float]:
+    """Return the sorted distinct coordinates ``v`` and the grid spacing along them.
 
     The spacing is the most common gap between neighbouring coordinates (a
-    stray point must not make a fine phantom grid); every coordinate must
-    then lie on a multiple of it.
+    stray point must not make a fine phantom grid).
     """
     u = np.unique(v)
     if u.size == 1:
@@ -230,12 +247,32 @@ def _grid_index(v: FloatArray, name: str, rtol: float) -> tuple[NDArray[np.int_]
     candidates = np.unique(np.round(gaps / max(tol, 1e-300)))
     counts = [np.count_nonzero(np.abs(gaps - c * tol) <= tol) for c in candidates]
     h = float(np.median(gaps[np.abs(gaps - candidates[int(np.argmax(counts))] * tol) <= tol]))
+    return u, h
+
+
+def _span_cells(u: FloatArray, h: float) -> float:
+    """Return the cells along one axis of the grid spacing ``h`` through the coordinates ``u``.
+
+    A float, so that an absurd span (``inf`` included) compares with a
+    bound instead of overflowing an integer.
+    """
+    n = float(u[-1] - u[0]) / h
+    return math.floor(n + 0.5) + 1.0 if math.isfinite(n) else math.inf
+
+
+def _grid_index(v: FloatArray, u: FloatArray, h: float, name: str,
+                rtol: float) -> NDArray[np.int_]:
+    """Integer grid indices of coordinates ``v`` on the spacing ``h`` from ``u[0]``.
+
+    Every coordinate must lie on a multiple of the spacing.
+    """
+    tol = rtol * float(u[-1] - u[0])
     k = (v - u[0]) / h
     idx = np.rint(k).astype(int)
     if np.max(np.abs(k - idx)) * h > 10 * tol + 1e-12 * h:
         raise IrregularGridError(f"{name} coordinates are not on a regular grid "
                                  f"(spacing {h:.6g} m)")
-    return idx, h, float(u[0])
+    return idx
 
 
 def _check_positive(**values: float) -> None:

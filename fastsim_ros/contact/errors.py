@@ -17,6 +17,10 @@ class IrregularGridError(InvalidInputError):
     """Cell centres that do not lie on one regular grid."""
 
 
+class GridTooLargeError(InvalidInputError):
+    """Cells that would span a grid larger than a caller's bound (checked before allocation)."""
+
+
 class OutOfTableError(InvalidInputError):
     """A look-up outside the range a coefficient table covers."""
 

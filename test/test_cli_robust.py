@@ -1,0 +1,366 @@
+"""``fastsim_contact`` on any file and any flag (INTERFACE.md "Bad input", TARGETS.md robustness).
+
+The contract: a right answer, or one line on stderr naming the problem and exit
+status 2; never a traceback, never a non-finite number printed, no warning on
+stderr, and a bound on the grid checked before anything of its size is
+allocated.  One test per class of input, each class parametrised.
+"""
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fastsim_ros import cli
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact.errors import GridTooLargeError
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "fastsim_ros" / "data" / "example_patch.csv"
+CREEP = ["--xi", "1e-3", "--eta", "0", "--phi", "0.1", "--mu", "0.3"]
+ELLIPSE = ["--shape", "ellipse", "--a", "6e-3", "--b", "4e-3", "--load", "1e4"]
+
+
+def run(capsys, *argv):
+    rc = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def strict_json(text):
+    """Parse JSON that must hold finite numbers only (NaN and Infinity are not JSON)."""
+    def refuse(name):
+        raise AssertionError(f"non-finite number {name} in the output")
+    return json.loads(text, parse_constant=refuse)
+
+
+def assert_refused(rc, out, err, match):
+    assert rc == 2, err
+    assert out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    assert match in err, err
+
+
+def assert_answered(rc, out, err):
+    assert rc == 0, err
+    assert err == ""
+    return strict_json(out)
+
+
+def cell_rows(area, scale=1.0):
+    jj, ii = np.nonzero(area.mask)
+    x = [float(v) * scale for v in area.x]
+    y = [float(v) * scale for v in area.y]
+    p = np.asarray(area.pressure)
+    return [f"{x[i]!r},{y[j]!r},{float(p[j, i])!r}" for j, i in zip(jj, ii)]
+
+
+def hertz(n=20):
+    return areas.ellipse(6e-3, 4e-3, nx=n, load=1e4)
+
+
+def write(path, lines, *, encoding="utf-8"):
+    path.write_text("\n".join(lines) + "\n", encoding=encoding)
+    return path
+
+
+# ---------------------------------------------------------------- flags
+
+
+@pytest.mark.parametrize("argv, match", [
+    # prefix abbreviations are refused, not silently expanded
+    (["coefficients", "--shape", "ellipse", "--a", "0.5"], "unrecognized arguments: --a"),
+    (["coefficients", "--shape", "ellipse", "--a-over", "0.5"], "unrecognized arguments"),
+    (["forces", *ELLIPSE, *CREEP, "--shear", "1e10"], "unrecognized arguments: --shear"),
+    (["forces", *ELLIPSE, *CREEP, "--meth", "exact"], "unrecognized arguments: --meth"),
+    (["forces", *ELLIPSE, *CREEP, "--frobnicate"], "unrecognized arguments"),
+    ([], "required"),
+    (["solve"], "invalid choice"),
+    (["forces", *ELLIPSE, "--xi", "0", "--eta", "0", "--phi", "0"], "--mu"),
+    (["forces", *ELLIPSE, *CREEP, "--method", "fastsim"], "invalid choice"),
+    (["forces", *ELLIPSE, *CREEP, "--bound", "cubic"], "invalid choice"),
+    (["forces", *ELLIPSE, *CREEP, "--cells", "3"], "--cells must lie"),
+    (["forces", *ELLIPSE, *CREEP, "--cells", "1e3"], "not a whole number"),
+    (["forces", *ELLIPSE, "--xi", "abc", "--eta", "0", "--phi", "0", "--mu", "0.3"],
+     "not a number"),
+    (["forces", *ELLIPSE, "--xi", "-inf", "--eta", "0", "--phi", "0", "--mu", "0.3"],
+     "not a finite number"),
+    (["forces", *ELLIPSE, "--xi", "0", "--eta", "nan", "--phi", "0", "--mu", "0.3"],
+     "not a finite number"),
+    (["forces", "--patch", EXAMPLE, *ELLIPSE, *CREEP], "not both"),
+])
+def test_bad_flags(capsys, argv, match):
+    assert_refused(*run(capsys, *argv), match)
+
+
+@pytest.mark.parametrize("value", ["-1e-4", "-1E-4", "-1.0e-4", "-.1e-3", "-0.0001"])
+def test_negative_numbers_in_e_notation_are_values(capsys, value):
+    # argparse alone reads "-1e-4" as a flag ("expected one argument")
+    rc, out, err = run(capsys, "forces", *ELLIPSE, "--xi", value, "--eta", "-2e-4",
+                       "--phi", "-1e-1", "--mu", "0.3", "--json")
+    f = assert_answered(rc, out, err)
+    ref = assert_answered(*run(capsys, "forces", *ELLIPSE, "--xi=-0.0001", "--eta=-0.0002",
+                               "--phi=-0.1", "--mu", "0.3", "--json"))
+    assert (f["Fx"], f["Fy"], f["Mz"]) == (ref["Fx"], ref["Fy"], ref["Mz"])
+    assert f["Fx"] > 0.0  # xi < 0: the rail pushes the wheel forwards
+
+
+def test_help_is_an_answer(capsys):
+    rc, out, err = run(capsys, "forces", "--help")
+    assert rc == 0 and "--xi" in out and err == ""
+
+
+# ---------------------------------------------------------------- numbers out of range
+
+
+@pytest.mark.parametrize("extra, match", [
+    (["--xi", "1e300"], "|xi| must be at most"),
+    (["--eta", "-1e300"], "|eta| must be at most"),
+    (["--phi", "1e300"], "|phi| must be at most"),
+    (["--mu", "1e300"], "mu must lie"),
+    (["--mu", "-0.3"], "mu must be positive"),
+    (["--shear-modulus", "1e300"], "--shear-modulus must lie"),
+    (["--shear-modulus", "1e-300"], "--shear-modulus must lie"),
+    (["--shear-modulus", "0"], "shear modulus must be positive"),
+    (["--nu", "0.6"], "nu must lie"),
+    (["--load", "1e160"], "--load 1e+160 N gives a largest pressure"),
+    (["--load", "1e160", "--bound", "parabolic"], "--load 1e+160 N gives a largest pressure"),
+    (["--load", "1e-300", "--bound", "parabolic"], "--load 1e-300 N gives a largest pressure"),
+    (["--load", "0"], "--load must be positive"),
+    (["--a", "1e-200"], "--a must lie"),
+    (["--b", "1e200"], "--b must lie"),
+    (["--a", "-6e-3"], "--a must lie"),
+    (["--method", "exact", "--bound", "parabolic"], "--bound given"),
+    (["--method", "exact", "--cells", "100"], "cells in contact"),
+])
+def test_numbers_out_of_range_are_named(capsys, extra, match):
+    base = dict(zip(ELLIPSE[::2], ELLIPSE[1::2]))
+    base.update(zip(CREEP[::2], CREEP[1::2]))
+    base.update(zip(extra[::2], extra[1::2]))
+    argv = [v for kv in base.items() for v in kv]
+    assert_refused(*run(capsys, "forces", *argv), match)
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--shape", "ellipse", "--a-over-b", "1e300"], "a/b must lie"),
+    (["--shape", "ellipse", "--a-over-b", "1e-300"], "a/b must lie"),
+    (["--shape", "semi-ellipses", "--a-over-b", "1", "-2"], "a/b must be positive"),
+    (["--shape", "semi-ellipses", "--a-over-b", "1"], "two --a-over-b values"),
+    (["--shape", "ellipse", "--a-over-b", "1", "--nu", "nan"], "not a finite number"),
+])
+def test_coefficient_shapes_out_of_range(capsys, argv, match):
+    assert_refused(*run(capsys, "coefficients", *argv), match)
+
+
+@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse", "exact"])
+@pytest.mark.parametrize("extra", [["--xi", "100", "--eta", "-100", "--phi", "1e6"],
+                                   ["--mu", "100"], ["--mu", "1e-6"],
+                                   ["--load", "1e-2", "--a", "1", "--b", "1"]])
+def test_extreme_but_accepted_numbers_give_finite_answers(capsys, method, extra):
+    base = dict(zip(ELLIPSE[::2], ELLIPSE[1::2]))
+    base.update(zip(CREEP[::2], CREEP[1::2]))
+    base.update(zip(extra[::2], extra[1::2]))
+    argv = [v for kv in base.items() for v in kv]
+    f = assert_answered(*run(capsys, "forces", *argv, "--method", method, "--cells", "20",
+                             "--json"))
+    mu = float(base["--mu"])
+    # the creep force never exceeds mu N (to the solvers' rounding)
+    assert math.hypot(f["Fx"], f["Fy"]) <= mu * f["N"] * (1 + 1e-9)
+
+
+# ---------------------------------------------------------------- patch files
+
+
+def test_a_bom_is_accepted(tmp_path, capsys):
+    rows = ["x,y,pressure", *cell_rows(hertz())]
+    plain = write(tmp_path / "plain.csv", rows)
+    bom = write(tmp_path / "bom.csv", rows, encoding="utf-8-sig")
+    crlf = tmp_path / "crlf.csv"
+    crlf.write_bytes(("\r\n".join(["# saved on Windows", *rows]) + "\r\n").encode())
+    ref = assert_answered(*run(capsys, "forces", "--patch", plain, *CREEP, "--json"))
+    for path in (bom, crlf):
+        f = assert_answered(*run(capsys, "forces", "--patch", path, *CREEP, "--json"))
+        assert f["Fx"] == ref["Fx"] and f["N"] == ref["N"]
+
+
+@pytest.mark.parametrize("content, match", [
+    (b"x,y,pressure\n0,0,1\n# caf\xe9\n", "not UTF-8 text (byte 0xe9"),
+    (b"\xff\xfex\x00,\x00y\x00", "not UTF-8 text"),  # UTF-16
+    (b"x,y,pressure\n0,0,1\x00\n", "NUL byte"),
+    (b"", "empty"),
+    (b"# only a comment\n\n", "empty"),
+    (b"x;y;pressure\n0;0;1\n", "the header must be x,y,pressure"),
+    (b"x,y,p\n0,0,1\n", "the header must be x,y,pressure"),
+    (b"x,y,pressure\n", "no cells"),
+    (b"x,y,pressure\n0,0,1\n0.1,0\n", "line 3: a short row: 2 values"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,1,7\n", "line 3: a long row: 4 values"),
+    (b"x,y,pressure\n0,0,1\n0.1,,1\n", "line 3: y is not a number: 'an empty field'"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,abc\n", "line 3: pressure is not a number: 'abc'"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,nan\n", "line 3: NaN or infinite pressure"),
+    (b"x,y,pressure\n0,0,1\ninf,0,1\n", "line 3: NaN or infinite x"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,-1\n", "line 3: negative pressure"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,1\n0.1,0,2\n0,0.1,1\n", "two cells share one grid position"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,1\n0.25,0,1\n0,0.1,1\n", "not on a regular grid"),
+    (b"x,y,pressure\n0,0,1\n0,0.1,1\n0,0.2,1\n", "a single x coordinate"),
+    (b"x,y,pressure\n0,0,1\n", "a single x coordinate"),  # one cell: no cell size
+    (b"x,y,pressure\n0,0,0\n0.1,0,0\n0,0.1,0\n0.1,0.1,0\n", "no cell in contact"),
+    (b"x,y,pressure\n0,0,1\n0.1,0,1e999\n", "line 3: NaN or infinite pressure '1e999'"),
+])
+def test_bad_patch_files(tmp_path, capsys, content, match):
+    path = tmp_path / "p.csv"
+    path.write_bytes(content)
+    for command in (["coefficients", "--method", "mae"], ["forces", *CREEP]):
+        assert_refused(*run(capsys, *command, "--patch", path), match)
+
+
+def test_unreadable_patch_files(tmp_path, capsys, monkeypatch):
+    assert_refused(*run(capsys, "forces", "--patch", tmp_path / "none.csv", *CREEP),
+                   "cannot read patch file")
+    assert_refused(*run(capsys, "forces", "--patch", tmp_path, *CREEP), "cannot read patch file")
+    monkeypatch.setattr(cli, "MAX_PATCH_BYTES", 100)
+    path = write(tmp_path / "big.csv", ["x,y,pressure", *cell_rows(hertz())])
+    assert_refused(*run(capsys, "forces", "--patch", path, *CREEP), "larger than")
+
+
+@pytest.mark.parametrize("stray", [
+    "1000.0,0.0,1e6",           # 1 km away along x (used to take 6 s and 0.5 GB)
+    "2.0,1.5,1e6",              # a few metres away on both axes (used to need 48 GiB)
+    "0.0,1e5,1e6",              # 100 km away along y
+])
+def test_a_stray_cell_far_away_is_refused_by_the_grid_bound(tmp_path, capsys, monkeypatch,
+                                                            stray):
+    ar = hertz()
+    # a stray cell on the patch's grid: only its distance is wrong
+    x, y, p = stray.split(",")
+    i = round((float(x) - ar.x0) / ar.dx)
+    j = round((float(y) - ar.y0) / ar.dy)
+    row = f"{ar.x0 + i * ar.dx!r},{ar.y0 + j * ar.dy!r},{p}"
+    path = write(tmp_path / "stray.csv", ["x,y,pressure", *cell_rows(ar), row])
+
+    def no_big_arrays(shape, *args, **kwargs):
+        assert int(np.prod(shape)) <= cli.MAX_PATCH_CELLS, "allocated before the bound"
+        return real_zeros(shape, *args, **kwargs)
+
+    real_zeros = np.zeros
+    monkeypatch.setattr(areas.np, "zeros", no_big_arrays)
+    rc, out, err = run(capsys, "forces", "--patch", path, *CREEP)
+    assert_refused(rc, out, err, f"more than the {cli.MAX_PATCH_CELLS:,} allowed")
+
+
+def test_grid_bound_of_the_library_is_checked_before_allocation(monkeypatch):
+    def no_arrays(*args, **kwargs):
+        raise AssertionError("allocated before the bound")
+
+    x = np.array([0.0, 1e-3, 2e-3, 1e3])
+    monkeypatch.setattr(areas.np, "zeros", no_arrays)
+    with pytest.raises(GridTooLargeError, match="stray cell"):
+        areas.from_cells(x, np.array([0.0, 0.0, 1e-3, 0.0]), np.ones(4), max_cells=10**6)
+    with pytest.raises(GridTooLargeError):  # a span no integer index can hold
+        areas.from_cells(np.array([0.0, 1e-300, 1e300]), np.array([0.0, 1.0, 0.0]),
+                         np.ones(3))
+
+
+@pytest.mark.parametrize("scale, match", [(1e-200, "cell sizes must lie"),
+                                          (1e-12, "cell sizes must lie"),
+                                          (1e200, "beyond the"),
+                                          (1e9, "beyond the")])
+def test_tiny_or_huge_coordinates(tmp_path, capsys, scale, match):
+    path = write(tmp_path / "p.csv", ["x,y,pressure", *cell_rows(hertz(), scale)])
+    for command in (["coefficients"], ["coefficients", "--method", "mae"],
+                    ["coefficients", "--method", "fastsim"], ["forces", *CREEP]):
+        assert_refused(*run(capsys, *command, "--patch", path), match)
+
+
+def test_scaled_patch_inside_the_limits_gives_the_scaled_answer(tmp_path, capsys):
+    # lengths x 1e3 (metres read as millimetres): coefficients are scale-free
+    a = write(tmp_path / "a.csv", ["x,y,pressure", *cell_rows(hertz())])
+    b = write(tmp_path / "b.csv", ["x,y,pressure", *cell_rows(hertz(), 1e3)])
+    ca = assert_answered(*run(capsys, "coefficients", "--patch", a, "--method", "mae", "--json"))
+    cb = assert_answered(*run(capsys, "coefficients", "--patch", b, "--method", "mae", "--json"))
+    for key in ("C11", "C22", "C23"):
+        assert cb[key] == pytest.approx(ca[key], rel=1e-9)
+
+
+@pytest.mark.parametrize("pressures, match", [
+    (("1", "1", "1", "1e20"), "largest pressure 1e+20 Pa"),
+    (("1e-200",) * 4, "largest pressure 1e-200 Pa")])
+def test_patch_pressures_out_of_range_are_named(tmp_path, capsys, pressures, match):
+    cells = ("0,0", "0.001,0", "0,0.001", "0.001,0.001")
+    path = write(tmp_path / "p.csv",
+                 ["x,y,pressure", *(f"{c},{p}" for c, p in zip(cells, pressures))])
+    assert_refused(*run(capsys, "forces", "--patch", path, *CREEP), match)
+    # --load rescales into the range: an answer
+    assert_answered(*run(capsys, "forces", "--patch", path, *CREEP, "--load", "100", "--json"))
+
+
+@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse", "exact"])
+@pytest.mark.parametrize("bound", ["given", "parabolic"])
+def test_one_cell_in_contact_gives_valid_json(tmp_path, capsys, method, bound):
+    if method == "exact" and bound == "parabolic":
+        pytest.skip("the exact solver takes the pressure as given")
+    path = write(tmp_path / "one.csv", ["x,y,pressure", "0,0,1e9", "0.001,0,0", "0,0.001,0",
+                                        "0.001,0.001,0"])
+    f = assert_answered(*run(capsys, "forces", "--patch", path, *CREEP, "--method", method,
+                             "--bound", bound, "--json"))
+    assert f["N"] == pytest.approx(1e3)
+    assert math.hypot(f["Fx"], f["Fy"]) <= 0.3 * f["N"] * (1 + 1e-9)
+    c = assert_answered(*run(capsys, "coefficients", "--patch", path, "--method", "mae",
+                             "--json"))
+    assert c["C11"] > 0.0
+
+
+# ---------------------------------------------------------------- the answers
+
+
+@pytest.mark.parametrize("bound", ["given", "parabolic"])
+def test_every_method_gives_the_same_keys(capsys, bound):
+    keys = None
+    for method in ("mae", "fastsim_ellipse", "exact"):
+        if method == "exact" and bound == "parabolic":
+            continue
+        f = assert_answered(*run(capsys, "forces", "--patch", EXAMPLE, *CREEP, "--method",
+                                 method, "--bound", bound, "--json"))
+        common = set(cli.FORCE_KEYS) | {"method", "bound", "cells"}
+        assert common <= f.keys()
+        assert 0.0 <= f["slip_fraction"] <= 1.0
+        keys = common if keys is None else keys
+        assert common == keys
+
+
+@pytest.mark.parametrize("method, solver", [("mae", "MaeSolver"),
+                                            ("fastsim_ellipse", "EquivalentEllipseSolver")])
+def test_forces_run_the_compiled_path(capsys, method, solver):
+    from fastsim_ros.contact import compiled
+    ar = cli.read_patch(EXAMPLE)
+    ref = getattr(compiled, solver)(0.28, 8.0e10).solve(ar, 1e-3, 0.0, 0.1, mu=0.3)
+    f = assert_answered(*run(capsys, "forces", "--patch", EXAMPLE, *CREEP, "--method", method,
+                             "--json"))
+    assert (f["Fx"], f["Fy"], f["Mz"]) == (ref.fx, ref.fy, ref.mz)
+    assert f["slip_fraction"] == ref.slip_fraction
+
+
+def test_readable_table_never_prints_non_finite_numbers(capsys):
+    rc, out, err = run(capsys, "forces", *ELLIPSE, *CREEP)
+    assert rc == 0 and err == ""
+    assert "nan" not in out.lower() and "inf" not in out.lower()
+    assert "slip fraction" in out
+
+
+@pytest.mark.parametrize("argv", [
+    ["forces", *ELLIPSE, "--xi", "1e300", "--eta", "0", "--phi", "0", "--mu", "0.3"],
+    ["forces", *ELLIPSE, *CREEP, "--load", "1e160", "--bound", "parabolic"],
+    ["forces", "--patch", "/nonexistent.csv", *CREEP],
+    ["coefficients", "--shape", "ellipse", "--a", "0.5"],
+])
+def test_as_a_program_one_line_and_no_warning(argv):
+    done = subprocess.run([sys.executable, "-W", "default", "-m", "fastsim_ros.cli", *argv],
+                          capture_output=True, text=True)
+    assert done.returncode == 2
+    assert done.stdout == ""
+    assert len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert done.stderr.startswith("fastsim_contact: error: ")
