@@ -17,7 +17,7 @@ every subscriber), depth ``qos_depth``; both configurable at start.
 from __future__ import annotations
 
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import rclpy
@@ -110,8 +110,8 @@ class FastsimNode(Node):
         self.create_subscription(TwistStamped, RAIL_TWIST_TOPIC, self._on_rail_twist, qos_in,
                                  raw=True)
         for c in config.contacts:
-            self.create_subscription(PointCloud2, patch_topic(c),
-                                     lambda raw, c=c: self._on_patch(c, raw), qos_in, raw=True)
+            self.create_subscription(PointCloud2, patch_topic(c), self._patch_callback(c),
+                                     qos_in, raw=True)
         self.create_timer(1.0, self._publish_diagnostics)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.get_logger().info(
@@ -130,6 +130,11 @@ class FastsimNode(Node):
         if verdict != "ok":
             self.get_logger().warning(f"rail twist dropped: {verdict}",
                                       throttle_duration_sec=1.0)
+
+    def _patch_callback(self, contact: str) -> Callable[[bytes], None]:
+        def callback(raw: bytes) -> None:
+            self._on_patch(contact, raw)
+        return callback
 
     def _on_patch(self, contact: str, raw: bytes) -> None:
         outcome: Outcome = self.pipeline.on_patch(contact, raw)

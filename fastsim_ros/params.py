@@ -30,7 +30,7 @@ class ParameterError(ValueError):
 
 @dataclass(frozen=True)
 class ParameterSpec:
-    """One parameter: ``kind`` is ``double``, ``integer``, ``bool``, ``string`` or ``string_array``.
+    """One parameter; ``kind``: ``double``, ``integer``, ``bool``, ``string``, ``string_array``.
 
     ``low``/``high``: inclusive numeric range; ``choices``: allowed strings;
     ``dynamic``: may change while the node runs (else start-up only).

@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -459,8 +459,8 @@ class Pipeline:
         return msgs
 
     def diagnostics(self, stamp_ns: int) -> Any:
-        """Return the ``DiagnosticArray`` of every contact (and the kinematics), stamped ``stamp_ns``."""
-        statuses = []
+        """Return the ``DiagnosticArray`` of every contact and the kinematics at ``stamp_ns``."""
+        statuses: list[tuple[str, int, str, Sequence[tuple[str, str]]]] = []
         for c in self.config.contacts:
             r = self.report(c)
             statuses.append((r.name, r.level, r.message, r.values))

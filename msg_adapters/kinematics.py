@@ -33,7 +33,7 @@ REST = StampedTwist(0, "", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 @dataclass(frozen=True, slots=True)
 class Creepage:
-    """Creepages of one contact: ``xi``, ``eta`` (1), ``phi`` (1/m), rolling speed ``speed`` (m/s)."""
+    """Creepages of one contact: ``xi``, ``eta`` (1), ``phi`` (1/m), rolling speed (m/s)."""
 
     xi: float
     eta: float

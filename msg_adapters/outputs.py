@@ -29,6 +29,7 @@ from msg_adapters.patch import ContactFrame
 TRACTION_DTYPE = np.dtype({"names": ["x", "y", "z", "tau_x", "tau_y", "slip"],
                            "formats": ["<f4", "<f4", "<f4", "<f4", "<f4", "u1"],
                            "offsets": [0, 4, 8, 12, 16, 20], "itemsize": 24})
+_TRACTION_OFFSETS = (("x", 0), ("y", 4), ("z", 8), ("tau_x", 12), ("tau_y", 16), ("slip", 20))
 _UINT8, _FLOAT32 = 2, 7
 
 
@@ -63,7 +64,7 @@ def creepage_cdr(stamp_ns: int, contact: str, creepage: Creepage) -> bytes:
 
 
 def pose_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame) -> bytes:
-    """Return a serialized ``geometry_msgs/PoseStamped``: the contact frame in the wheelset frame."""
+    """Return a serialized ``PoseStamped``: the contact frame in the wheelset frame."""
     return stamped_doubles(stamp_ns, wheelset_frame, frame.origin + frame.quaternion())
 
 
@@ -90,9 +91,9 @@ def traction_cloud(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
     msg.header.stamp = stamp_msg(stamp_ns)
     msg.header.frame_id = wheelset_frame
     msg.height, msg.width = ny, nx
-    msg.fields = [PointField(name=name, offset=TRACTION_DTYPE.fields[name][1],
+    msg.fields = [PointField(name=name, offset=offset,
                              datatype=_UINT8 if name == "slip" else _FLOAT32, count=1)
-                  for name in TRACTION_DTYPE.names]
+                  for name, offset in _TRACTION_OFFSETS]
     msg.is_bigendian = False
     msg.point_step = TRACTION_DTYPE.itemsize
     msg.row_step = TRACTION_DTYPE.itemsize * nx

@@ -28,7 +28,7 @@ def convert(msg, max_cells=MAX):
 
 
 def assert_grid(patch, area, rtol=1e-6):
-    """The patch carries the area's pressure on its grid, about the pressure centroid."""
+    """Assert that the patch carries the area's pressure on its grid, about its centroid."""
     ref = in_plane_area(area)
     scale = max(area.dx, area.dy)
     assert patch.pressure.shape == area.pressure.shape

@@ -1,0 +1,296 @@
+"""The shared pipeline: library-equal wrenches, reverse running, kinematics rules, outputs."""
+
+import math
+
+import numpy as np
+import pytest
+from geometry_msgs.msg import PoseStamped, Vector3Stamped, WrenchStamped
+from rclpy.serialization import deserialize_message
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import samples
+from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.params import ParameterError
+from fastsim_ros.pipeline import Pipeline, PipelineConfig
+from ros_messages import WHEEL_RADIUS as R
+from ros_messages import cdr, cloud_msg, contact_normal, in_plane_area, rolling_twist, twist_msg
+
+MS = 1_000_000
+T0 = 1_700_000_000 * 1_000_000_000
+LEFT = (0.0, 0.75, -R)
+
+
+def egg():
+    """Return two semi-ellipses joined along y = 0: asymmetric in y, symmetric in x."""
+    return samples.semi_ellipses_patch(0.5, 2.0, cells=24, scale=8e-3, load=6e4)
+
+
+def fore_aft_egg():
+    """Return an egg-shaped patch: a leading half 7 mm long, a trailing half 4 mm long."""
+    x = np.linspace(-4.5e-3, 7.5e-3, 25)
+    y = np.linspace(-4.5e-3, 4.5e-3, 19)
+    a = np.where(x > 0.0, 7e-3, 4e-3)
+    p = np.sqrt(np.clip(1.0 - (x[None, :] / a[None, :]) ** 2 - (y[:, None] / 4e-3) ** 2,
+                        0.0, None))
+    return areas.GridArea(x[0], y[0], x[1] - x[0], y[1] - y[0], p).with_load(6e4)
+
+
+def make(**values):
+    values.setdefault("contacts", ["left"])
+    return Pipeline(PipelineConfig.from_values(values))
+
+
+def solve(pipe, area, *, stamp=T0 + 10 * MS, contact="left", **cloud):
+    cloud.setdefault("dtype", "<f8")
+    return pipe.on_patch(contact, cdr(cloud_msg(area, stamp_ns=stamp, **cloud)))
+
+
+def library(method, area, xi, eta, phi, mu=0.3):
+    solver = MaeSolver(0.28, 8e10) if method == "mae" else EquivalentEllipseSolver(0.28, 8e10)
+    a = in_plane_area(area)
+    return solver.solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy, xi, eta, phi, mu)
+
+
+@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse"])
+@pytest.mark.parametrize("xi", [2e-4, 3e-3])
+def test_wrench_equals_the_library(method, xi):
+    pipe = make(method=method)
+    assert pipe.on_wheel_twist(cdr(rolling_twist(xi, stamp_ns=T0))) == "ok"
+    out = solve(pipe, egg())
+    assert out.status == "solved"
+    ref = library(method, egg(), xi, 0.0, 0.0)
+    assert out.creepage.xi == pytest.approx(xi, rel=1e-12)
+    for got, want in ((out.forces.fx, ref.fx), (out.forces.fy, ref.fy),
+                      (out.forces.mz, ref.mz), (out.forces.n, ref.n)):
+        assert got == pytest.approx(want, rel=1e-9, abs=1e-9 * abs(ref.n))
+    assert out.forces.fx < 0  # braked: the rail pulls the wheel back
+
+
+def test_spin_from_the_contact_angle_reaches_the_solver():
+    gamma = 0.3
+    pipe = make()
+    pipe.on_wheel_twist(cdr(twist_msg((20.0, 0, 0), (0, 20.0 / R, 0), stamp_ns=T0)))
+    out = solve(pipe, egg(), normal=contact_normal(gamma, "left"))
+    # phi = e_z . w / V, e_z = (0, -sin g, cos g), w = (0, omega, 0)
+    phi = -(20.0 / R) * math.sin(gamma) / out.creepage.speed
+    assert out.creepage.phi == pytest.approx(phi, rel=1e-9)
+    c = out.creepage
+    ref = library("mae", egg(), c.xi, c.eta, c.phi)
+    assert out.forces.fx == pytest.approx(ref.fx, rel=1e-9)
+    assert out.forces.fy == pytest.approx(ref.fy, rel=1e-9)
+    assert abs(out.forces.fx) > 100.0  # spin alone gives Fx on this asymmetric area
+
+
+def turned(area):
+    """Return the area turned by 180 degrees about z (x, y -> -x, -y)."""
+    return areas.GridArea(-(area.x0 + (area.nx - 1) * area.dx),
+                          -(area.y0 + (area.ny - 1) * area.dy), area.dx, area.dy,
+                          area.pressure[::-1, ::-1])
+
+
+@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse"])
+def test_reverse_running_solves_the_turned_patch_and_opposes_the_slip(method):
+    # backing up at 20 m/s, braked (|omega R| < |v0|), with spin from a contact angle
+    v0, omega_r, gamma = -20.0, -19.96, 0.2
+    pipe = make(method=method)
+    pipe.on_wheel_twist(cdr(twist_msg((v0, 0, 0), (0, omega_r / R, 0), stamp_ns=T0)))
+    out = solve(pipe, fore_aft_egg(), normal=contact_normal(gamma, "left"))
+    c = out.creepage
+    assert c.speed < 0 and c.xi > 0
+    # INTERFACE.md: solve on the turned cells with (xi, eta, -phi); report (-Fx', -Fy', Mz')
+    a = in_plane_area(fore_aft_egg())
+    solver = MaeSolver(0.28, 8e10) if method == "mae" else EquivalentEllipseSolver(0.28, 8e10)
+    t = turned(a)
+    ref = solver.solve_arrays(t.pressure, t.x0, t.y0, t.dx, t.dy, c.xi, c.eta, -c.phi, 0.3)
+    assert out.forces.fx == pytest.approx(-ref.fx, rel=1e-9)
+    assert out.forces.fy == pytest.approx(-ref.fy, rel=1e-9)
+    assert out.forces.mz == pytest.approx(ref.mz, rel=1e-9)
+    # the wheel slides towards -x relative to the rail: the rail pushes it towards +x
+    slip_x = v0 - omega_r
+    assert slip_x < 0 and out.forces.fx > 0
+    # and the leading edge is the other one: on a patch with a long front and a
+    # short back, running backwards is not the forward solve negated
+    fwd = make(method=method)
+    fwd.on_wheel_twist(cdr(twist_msg((-v0, 0, 0), (0, -omega_r / R, 0), stamp_ns=T0)))
+    forward = solve(fwd, fore_aft_egg(), normal=contact_normal(gamma, "left"))
+    assert forward.forces.fx < 0
+    if method == "mae":  # the equivalent ellipse is symmetric whatever the patch
+        assert abs(forward.forces.fx + out.forces.fx) > 1e-3 * abs(out.forces.fx)
+
+
+def test_reverse_running_on_a_symmetric_patch_mirrors_the_forward_force():
+    area = areas.ellipse(6e-3, 4e-3, nx=24, ny=24).with_load(6e4)
+    forces = []
+    for sign in (1.0, -1.0):
+        pipe = make()
+        pipe.on_wheel_twist(cdr(twist_msg((sign * 20.0, 0, 0), (0, sign * 19.98 / R, 0),
+                                          stamp_ns=T0)))
+        forces.append(solve(pipe, area).forces)
+    assert forces[1].fx == pytest.approx(-forces[0].fx, rel=1e-9)
+    assert forces[0].fx < 0 < forces[1].fx
+
+
+def test_kinematics_matching_by_stamp():
+    pipe = make(max_kinematics_age=0.05)
+    assert solve(pipe, egg(), stamp=T0).status == "no_kinematics"
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0 + 100 * MS)))
+    # a twist newer than the patch is never used for it
+    assert solve(pipe, egg(), stamp=T0 + 90 * MS).status == "stale_kinematics"
+    assert solve(pipe, egg(), stamp=T0 + 140 * MS).status == "solved"
+    assert solve(pipe, egg(), stamp=T0 + 150 * MS).status == "solved"  # exactly max age
+    assert solve(pipe, egg(), stamp=T0 + 151 * MS).status == "stale_kinematics"
+    # the newest twist not after the patch is the one used
+    pipe.on_wheel_twist(cdr(rolling_twist(2e-3, stamp_ns=T0 + 160 * MS)))
+    pipe.on_wheel_twist(cdr(rolling_twist(4e-3, stamp_ns=T0 + 180 * MS)))
+    out = solve(pipe, egg(), stamp=T0 + 170 * MS)
+    assert out.creepage.xi == pytest.approx(2e-3, rel=1e-9)
+    counts = pipe.counts("left")
+    assert counts["no_kinematics"] == 1 and counts["stale_kinematics"] == 2
+    assert counts["solved"] == 3
+
+
+def test_twists_that_are_dropped():
+    pipe = make()
+    assert pipe.on_wheel_twist(cdr(twist_msg((math.nan, 0, 0), stamp_ns=T0))) == "nonfinite"
+    assert pipe.on_wheel_twist(cdr(twist_msg(stamp_ns=T0, frame_id="map"))) == "wrong_frame"
+    assert pipe.on_wheel_twist(cdr(rolling_twist(0.0, stamp_ns=T0 + 5 * MS))) == "ok"
+    assert pipe.on_wheel_twist(cdr(rolling_twist(0.0, stamp_ns=T0))) == "old_stamp"
+    assert pipe.on_wheel_twist(b"\x00\x01\x00\x00\x01") == "malformed"
+
+
+def test_rail_twist_required():
+    pipe = make(rail_twist_required=True)
+    pipe.on_wheel_twist(cdr(twist_msg((0, 0, 0), (0, 15.0 / R, 0), stamp_ns=T0)))
+    assert solve(pipe, egg()).status == "stale_kinematics"
+    # a roller of radius 0.7 m turning at -omega_r below the wheel: v_r = w_r x (0 - c_r)
+    rr, omega_r = 0.7, 15.0 / 0.7
+    pipe.on_rail_twist(cdr(twist_msg((-omega_r * (R + rr), 0, 0), (0, -omega_r, 0),
+                                     stamp_ns=T0 + 5 * MS)))
+    out = solve(pipe, egg(), stamp=T0 + 20 * MS, origin=(0.0, 0.0, -R))
+    assert out.status == "solved"
+    assert out.creepage.speed == pytest.approx(15.0, rel=1e-6)
+    assert out.creepage.xi == pytest.approx(0.0, abs=1e-9)
+
+
+def test_standstill_and_min_rolling_speed():
+    pipe = make(min_rolling_speed=0.1)
+    pipe.on_wheel_twist(cdr(twist_msg((0.05, 0, 0), (0, 0.05 / R, 0), stamp_ns=T0)))
+    assert solve(pipe, egg()).status == "standstill"
+    pipe.on_wheel_twist(cdr(twist_msg((0.5, 0, 0), (0, 0.5 / R, 0), stamp_ns=T0 + 20 * MS)))
+    assert solve(pipe, egg(), stamp=T0 + 30 * MS).status == "solved"
+
+
+def test_patch_rejections_then_the_next_good_patch_is_served():
+    pipe = make()
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    assert solve(pipe, egg(), frame_id="map").status == "wrong_frame"
+    assert solve(pipe, egg(), stamp=T0 + 20 * MS).status == "solved"
+    assert solve(pipe, egg(), stamp=T0 + 15 * MS).status == "old_stamp"
+    assert pipe.on_patch("left", b"garbage!").status == "missing_field"
+    p = egg().pressure.copy()
+    p[3, 3] = -5.0
+    assert solve(pipe, egg(), stamp=T0 + 25 * MS, pressure=p).status == "negative_pressure"
+    assert solve(pipe, egg(), stamp=T0 + 30 * MS).status == "solved"
+
+
+def test_out_of_table_patch():
+    # a strip 101 cells long and 2 wide: MAE zones of a/b about 50, beyond the tables' 20
+    area = areas.GridArea(-50e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 101)) * 1e9)
+    pipe = make()
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    out = solve(pipe, area)
+    assert out.status == "out_of_table"
+    assert pipe.messages(out) == []
+
+
+def test_empty_patch_gives_a_zero_wrench_without_kinematics():
+    pipe = make()
+    out = solve(pipe, egg(), pressure=np.zeros_like(egg().pressure))
+    assert out.status == "no_contact"
+    topics = [t for t, _ in pipe.messages(out)]
+    assert topics[0] == "contact/left/wrench"
+    w = deserialize_message(pipe.messages(out)[0][1], WrenchStamped)
+    assert (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z) == (0.0, 0.0, 0.0)
+    assert pipe.counts("left")["no_contact"] == 1
+
+
+def test_messages_of_a_solve():
+    pipe = make(publish_traction=True)
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    out = solve(pipe, egg(), stamp=T0 + 7 * MS)
+    msgs = dict(pipe.messages(out))
+    w = deserialize_message(msgs["contact/left/wrench"], WrenchStamped)
+    assert w.header.frame_id == "left_contact"
+    assert w.header.stamp.sec * 10**9 + w.header.stamp.nanosec == T0 + 7 * MS
+    assert (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z, w.wrench.torque.z) == (
+        out.forces.fx, out.forces.fy, out.forces.n, out.forces.mz)
+    v = deserialize_message(msgs["contact/left/creepage"], Vector3Stamped)
+    assert (v.vector.x, v.vector.y, v.vector.z) == (out.creepage.xi, out.creepage.eta,
+                                                    out.creepage.phi)
+    pose = deserialize_message(msgs["contact/left/frame"], PoseStamped)
+    assert pose.header.frame_id == "wheelset"
+    assert (pose.pose.position.x, pose.pose.position.y,
+            pose.pose.position.z) == pytest.approx(out.frame.origin)
+    cloud = msgs["contact/left/traction"]
+    tau = np.frombuffer(bytes(cloud.data), dtype=np.dtype(
+        {"names": ["tau_x"], "formats": ["<f4"], "offsets": [12], "itemsize": 24}))
+    # the traction integrates to the force
+    assert float(tau["tau_x"].astype(float).sum()) * out.patch.dx * out.patch.dy == \
+        pytest.approx(out.forces.fx, rel=1e-5)
+    assert "contact/markers" in msgs and "wheelset/wrench" in msgs
+    # the same frame again is not republished
+    again = solve(pipe, egg(), stamp=T0 + 17 * MS)
+    assert "contact/left/frame" not in dict(pipe.messages(again))
+
+
+def test_wheelset_wrench_sums_the_contacts_once_per_cycle():
+    pipe = make(contacts=["left", "right"])
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    gamma = 0.1
+    left = solve(pipe, egg(), origin=(0.0, 0.75, -R), normal=contact_normal(gamma, "left"))
+    assert left.wheelset is None
+    right = solve(pipe, egg().mirrored_y(), contact="right", stamp=T0 + 11 * MS,
+                  origin=(0.0, -0.75, -R), normal=contact_normal(gamma, "right"))
+    ws = right.wheelset
+    assert ws is not None and ws.stamp_ns == T0 + 11 * MS
+    force = np.zeros(3)
+    torque = np.zeros(3)
+    for out in (left, right):
+        axes = np.array(out.frame.axes)  # rows e_x, e_y, e_z
+        f = axes.T @ [out.forces.fx, out.forces.fy, out.forces.n]
+        force += f
+        torque += np.cross(out.frame.origin, f) + axes.T @ [0.0, 0.0, out.forces.mz]
+    np.testing.assert_allclose(ws.force, force, rtol=1e-12, atol=1e-9)
+    np.testing.assert_allclose(ws.torque, torque, rtol=1e-12, atol=1e-9)
+    # a second left patch alone does not complete a cycle
+    assert solve(pipe, egg(), stamp=T0 + 20 * MS).wheelset is None
+
+
+def test_update_friction_and_method_while_running():
+    pipe = make()
+    pipe.on_wheel_twist(cdr(rolling_twist(2e-2, stamp_ns=T0)))
+    saturated = solve(pipe, egg(), stamp=T0 + 1 * MS).forces
+    assert math.hypot(saturated.fx, saturated.fy) == pytest.approx(0.3 * saturated.n, rel=0.05)
+    pipe.update({"friction_coefficient": 0.4, "method": "fastsim_ellipse"})
+    after = solve(pipe, egg(), stamp=T0 + 2 * MS).forces
+    assert math.hypot(after.fx, after.fy) == pytest.approx(0.4 * after.n, rel=0.05)
+    with pytest.raises(ParameterError, match="start only"):
+        pipe.update({"poisson_ratio": 0.3})
+    with pytest.raises(ParameterError, match="friction_coefficient"):
+        pipe.update({"friction_coefficient": -1.0})
+    assert pipe.config["friction_coefficient"] == 0.4
+
+
+def test_diagnostics_name_every_reason():
+    pipe = make(contacts=["left", "right"])
+    solve(pipe, egg())  # no kinematics yet
+    diag = pipe.diagnostics(T0)
+    names = [s.name for s in diag.status]
+    assert names[:2] == ["fastsim: left", "fastsim: right"]
+    values = {kv.key: kv.value for kv in diag.status[0].values}
+    assert values["rejected/no_kinematics"] == "1"
+    assert values["method"] == "mae" and values["friction_law"] == "constant"
+    for key in ("solve_time_p50_us", "solve_time_p99_us", "input_rate_hz", "no_contact",
+                "rejected/too_large", "rejected/out_of_table", "rejected/standstill"):
+        assert key in values
+    assert diag.status[0].level == b"\x01"
