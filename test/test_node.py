@@ -1,0 +1,287 @@
+"""fastsim_node over real DDS on loopback: started from its installed script, driven by a client.
+
+Wrenches must equal the library's for the same inputs; every bad input of
+INTERFACE.md gives no wrench, a diagnostic naming its reason, and the next
+good input is served; refused parameters leave the node running; SIGTERM
+ends it cleanly.
+"""
+
+import math
+import signal
+import subprocess
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import samples
+from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver
+from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
+from ros_messages import WHEEL_RADIUS as R
+from ros_messages import cloud_msg, in_plane_area, rolling_twist, twist_msg
+
+MS = 1_000_000
+T0 = 1_700_000_000 * 1_000_000_000
+
+pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
+                                reason="fastsim_node is not installed (run colcon build)")
+
+
+def egg(scale=8e-3):
+    return samples.semi_ellipses_patch(0.5, 2.0, cells=24, scale=scale, load=6e4)
+
+
+def ellipse():
+    return areas.ellipse(6e-3, 4e-3, nx=20, ny=20).with_load(5e4)
+
+
+def library(method, area, xi, eta, phi, mu=0.3):
+    solver = MaeSolver(0.28, 8e10) if method == "mae" else EquivalentEllipseSolver(0.28, 8e10)
+    a = in_plane_area(area)
+    return solver.solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy, xi, eta, phi, mu)
+
+
+@pytest.fixture
+def run_node(tmp_path):
+    """Start fastsim_node with ROS arguments and a client for its contacts; stop both after."""
+    started = []
+
+    def start(*ros_args, contacts=("left", "right")):
+        proc = NodeProcess(*ros_args, log_dir=tmp_path)
+        client = Client(tuple(contacts))
+        started.append((proc, client))
+        client.wait_connected(proc)
+        return proc, client
+
+    yield start
+    for proc, client in started:
+        client.close()
+        proc.stop()
+
+
+def exchange(client, contact, msg, *, count=1, timeout=5.0):
+    """Publish a patch and return the wrenches that arrive for it (by stamp)."""
+    stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
+    client.patch[contact].publish(msg)
+    client.wait_for(lambda: sum(stamp_ns(w) == stamp for w in client.wrenches[contact])
+                    >= count, timeout)
+    return [w for w in client.wrenches[contact] if stamp_ns(w) == stamp]
+
+
+def send_twist(client, msg, rail=False):
+    (client.rail if rail else client.twist).publish(msg)
+    client.spin(0.15)  # twists and patches travel on different topics: let it land first
+
+
+def force(w):
+    return (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z, w.wrench.torque.z)
+
+
+def assert_library_equal(w, ref):
+    got = force(w)
+    want = (ref.fx, ref.fy, ref.n, ref.mz)
+    for g, e in zip(got, want):
+        assert g == pytest.approx(e, rel=1e-9, abs=1e-9 * ref.n)
+
+
+@pytest.mark.parametrize("contacts", [("left",), ("left", "right"), ("a", "b", "c", "d")])
+def test_wrenches_equal_the_library_for_both_methods(run_node, contacts):
+    names = "[" + ", ".join(f'"{c}"' for c in contacts) + "]"
+    _, client = run_node("-p", f"contacts:={names}", contacts=contacts)
+    xi = 1.5e-3
+    send_twist(client, rolling_twist(xi, stamp_ns=T0))
+    shapes = [egg(), ellipse(), egg(6e-3).mirrored_y(), egg(1e-2)]
+    stamp = T0 + MS
+    for method in ("mae", "fastsim_ellipse"):
+        if method != "mae":
+            (result,) = client.set_parameters(method=method)
+            assert result.successful, result.reason
+        for k, c in enumerate(contacts):
+            # treads side by side; flat normal: the centroid lies at z = -R, so xi is exact
+            origin = (0.0, 0.75 - 0.5 * k, -R)
+            stamp += MS
+            got = exchange(client, c, cloud_msg(shapes[k], origin=origin, stamp_ns=stamp,
+                                                dtype="<f8"))
+            assert len(got) == 1, f"{c}: no wrench for {method}"
+            assert got[0].header.frame_id == f"{c}_contact"
+            assert_library_equal(got[0], library(method, shapes[k], xi, 0.0, 0.0))
+    # one wheelset wrench per rig cycle: the sum once every contact had a new wrench
+    client.spin(0.2)
+    assert len(client.wheelset) == 2
+    assert client.wheelset[-1].header.frame_id == "wheelset"
+    assert client.wheelset[-1].wrench.force.z == pytest.approx(
+        sum(w[-1].wrench.force.z for w in client.wrenches.values()), rel=1e-12)
+
+
+def test_roller_rig_config(run_node):
+    _, client = run_node("--params-file", str(PACKAGE_ROOT / "config" / "roller_rig.yaml"),
+                         contacts=("wheel",))
+    # wheel at rest in translation, spinning; roller of radius 0.7 m below it, 0.2% faster
+    rr = 0.7
+    omega_w, omega_r = 15.0 / R, 15.03 / rr
+    origin = (0.0, 0.0, -R)
+    send_twist(client, twist_msg((0, 0, 0), (0, omega_w, 0), stamp_ns=T0))
+    assert exchange(client, "wheel", cloud_msg(ellipse(), origin=origin, stamp_ns=T0 + MS,
+                                               dtype="<f8"), timeout=1.0) == []
+    # v_r = w_r x (0 - c_r), c_r = (0, 0, -(R + rr)), w_r = (0, -omega_r, 0)
+    send_twist(client, twist_msg((-omega_r * (R + rr), 0, 0), (0, -omega_r, 0),
+                                 stamp_ns=T0 + 2 * MS), rail=True)
+    got = exchange(client, "wheel", cloud_msg(ellipse(), origin=origin, stamp_ns=T0 + 3 * MS,
+                                              dtype="<f8"))
+    assert len(got) == 1
+    speed = (15.0 + 15.03) / 2
+    xi = (15.03 - 15.0) / speed  # the roller's surface is faster: as a braked wheel
+    assert_library_equal(got[0], library("mae", ellipse(), xi, 0.0, 0.0))
+    assert got[0].wrench.force.x < 0
+    client.wait_for(lambda: client.diagnostic_values("wheel").get(
+        "rejected/stale_kinematics") == "1", 3.0)
+    assert client.diagnostic_values("wheel")["rejected/stale_kinematics"] == "1"
+
+
+def bad_inputs():
+    """Return (reason, patch message builder) for every bad input of INTERFACE.md."""
+    area = egg()
+
+    def values(msg):
+        return np.frombuffer(bytes(msg.data), dtype="<f8").reshape(area.ny, area.nx, 7).copy()
+
+    def nonfinite(stamp):
+        msg = cloud_msg(area, stamp_ns=stamp, dtype="<f8")
+        v = values(msg)
+        v[4, 4, 6] = math.nan
+        msg.data = v.tobytes()
+        return msg
+
+    def negative(stamp):
+        p = area.pressure.copy()
+        p[3, 3] = -1.0
+        return cloud_msg(area, stamp_ns=stamp, pressure=p)
+
+    def irregular(stamp):
+        msg = cloud_msg(area, stamp_ns=stamp, dtype="<f8")
+        v = values(msg)
+        v[6, :, 0] += 0.4 * area.dx
+        msg.data = v.tobytes()
+        return msg
+
+    def missing(stamp):
+        msg = cloud_msg(area, stamp_ns=stamp)
+        msg.fields = [f for f in msg.fields if f.name != "normal_z"]
+        return msg
+
+    def huge(stamp):  # 130 x 130 cells, above max_patch_cells = 10000
+        p = np.zeros((130, 130))
+        p[60:70, 60:70] = 1e9
+        return cloud_msg(areas.GridArea(0.0, 0.0, 1e-3, 1e-3, p), stamp_ns=stamp)
+
+    def stray(stamp):
+        msg = cloud_msg(area, stamp_ns=stamp, dtype="<f8")
+        v = values(msg)
+        v[0, 0, 0] += 100.0
+        msg.data = v.tobytes()
+        return msg
+
+    def degenerate(stamp):
+        p = np.zeros_like(area.pressure)
+        p[5, 5:8] = 1e9
+        return cloud_msg(area, stamp_ns=stamp, pressure=p)
+
+    def tiny(stamp):
+        return cloud_msg(area.scaled(1e-200), origin=(0.0, 0.0, 0.0), stamp_ns=stamp,
+                         dtype="<f8")
+
+    return [("nonfinite", nonfinite), ("negative_pressure", negative),
+            ("irregular_grid", irregular), ("irregular_grid", stray),
+            ("missing_field", missing),
+            ("wrong_frame", lambda s: cloud_msg(area, stamp_ns=s, frame_id="base_link")),
+            ("too_large", huge), ("degenerate", degenerate), ("degenerate", tiny)]
+
+
+def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
+    _, client = run_node("-p", "max_patch_cells:=10000", contacts=("left",))
+    send_twist(client, rolling_twist(1e-3, stamp_ns=T0))
+    stamp = T0 + MS
+    expected = {}
+    for reason, build in bad_inputs():
+        stamp += MS
+        assert exchange(client, "left", build(stamp), timeout=0.5) == [], reason
+        expected[reason] = expected.get(reason, 0) + 1
+        stamp += MS
+        good = exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp, dtype="<f8"))
+        assert len(good) == 1, f"no wrench after {reason}"
+    # a stamp older than the last one
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp - MS // 2),
+                    timeout=0.5) == []
+    expected["old_stamp"] = 1
+    # kinematics too old by stamp, then standstill
+    stamp += 60 * MS
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp), timeout=0.5) == []
+    expected["stale_kinematics"] = 1
+    send_twist(client, twist_msg((0.01, 0, 0), (0, 0.01 / R, 0), stamp_ns=stamp + MS))
+    stamp += 2 * MS
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp), timeout=0.5) == []
+    expected["standstill"] = 1
+    # an empty patch is no rejection: a zero wrench, counted as no_contact
+    stamp += MS
+    zero = exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp,
+                                              pressure=np.zeros_like(egg().pressure)))
+    assert len(zero) == 1 and force(zero[0]) == (0.0, 0.0, 0.0, 0.0)
+
+    def counted():
+        values = client.diagnostic_values("left")
+        return values and all(values[f"rejected/{r}"] == str(n) for r, n in expected.items())
+    assert client.wait_for(counted, 4.0), client.diagnostic_values("left")
+    values = client.diagnostic_values("left")
+    assert values["no_contact"] == "1"
+    assert values["solved"] == str(len(bad_inputs()))
+
+
+def test_refused_parameter_keeps_the_node_and_its_value(run_node):
+    proc, client = run_node(contacts=("left",))
+    (result,) = client.set_parameters(friction_coefficient=-0.2)
+    assert not result.successful
+    assert "friction_coefficient" in result.reason and "0.001" in result.reason  # the range
+    (result,) = client.set_parameters(method="exact_please")
+    assert not result.successful and "method" in result.reason
+    (result,) = client.set_parameters(poisson_ratio=0.3)
+    assert not result.successful  # the material is set at start only
+    assert client.get_parameter("friction_coefficient") == 0.3
+    assert proc.proc.poll() is None
+    # and it still serves, with the friction it kept: saturated at 0.3 N
+    send_twist(client, rolling_twist(3e-2, stamp_ns=T0))
+    (w,) = exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 + MS, dtype="<f8"))
+    fx, fy, n, _ = force(w)
+    assert math.hypot(fx, fy) == pytest.approx(0.3 * n, rel=0.03)
+    (result,) = client.set_parameters(friction_coefficient=0.4)
+    assert result.successful
+    (w,) = exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 + 2 * MS, dtype="<f8"))
+    fx, fy, n, _ = force(w)
+    assert math.hypot(fx, fy) == pytest.approx(0.4 * n, rel=0.03)
+
+
+def test_sigterm_and_sigint_end_cleanly(tmp_path):
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        proc = NodeProcess("--params-file", str(PACKAGE_ROOT / "config" / "fastsim.yaml"),
+                           log_dir=tmp_path)
+        client = Client(("left",), name="probe")
+        try:
+            client.wait_connected(proc)
+        finally:
+            client.close()
+        assert proc.stop(sig) == 0
+        out = proc.output()
+        assert "Traceback" not in out and "solving left, right with mae" in out
+
+
+@pytest.mark.parametrize("args, name", [
+    (["-p", "friction_coefficient:=-1.0"], "friction_coefficient"),
+    (["-p", "method:=exact_please"], "method"),
+    (["-p", "poisson_ratio:=0.7"], "poisson_ratio"),
+    (["-p", "contacts:=[\"left\", \"left\"]"], "contacts"),
+])
+def test_bad_start_parameters_exit_2_with_one_line(args, name):
+    done = subprocess.run([str(NODE_SCRIPT), "--ros-args", *args], capture_output=True,
+                          text=True, timeout=60)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and name in lines[0], done.stderr
