@@ -35,6 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import exact  # noqa: E402
+from fastsim_ros.contact.coefficients import coefficients_from_unit_solutions  # noqa: E402
 
 # Kalker's 19 published ratios, points in between (in log(a/b)), and a margin
 # beyond both ends: MAE's zones of real patches may measure a little outside 0.1..10.
@@ -60,7 +61,7 @@ def solve_grid(g: float, nu: float, n: int, shape: float = 1.0) -> dict[str, flo
     ny = 2 * round(n / shape / 2)
     ar = areas.ellipse(a, b, nx=nx, ny=ny)
     sols = exact.unit_solutions(ar, nu=nu)
-    full = exact.coefficients_from_unit_solutions(
+    full = coefficients_from_unit_solutions(
         ar.area, tuple((s.fx, s.fy, s.mz) for s in sols))
     c = math.sqrt(ar.area / math.pi)
     upper = (ar.y > 0.0)[:, None]

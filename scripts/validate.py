@@ -36,6 +36,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import exact, samples  # noqa: E402
+from fastsim_ros.contact.coefficients import CreepCoefficients  # noqa: E402
 from fastsim_ros.contact.equivalent import (equivalent_coefficients,  # noqa: E402
                                             equivalent_fastsim)
 from fastsim_ros.contact.fastsim import traction_bound  # noqa: E402
@@ -169,7 +170,7 @@ def _extrapolated(make: AreaMaker, nu: float) -> dict[str, float]:
     return out
 
 
-def _as_dict(c: exact.CreepCoefficients) -> dict[str, float]:
+def _as_dict(c: CreepCoefficients) -> dict[str, float]:
     return {k: getattr(c, k) for k in ("C11", "C12", "C13", "C21", "C22", "C23")}
 
 

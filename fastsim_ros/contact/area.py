@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from fastsim_ros.contact.checks import check_positive
 from fastsim_ros.contact.errors import (EmptyContactError, GridTooLargeError,
                                         InvalidInputError, IrregularGridError)
 
@@ -141,7 +142,7 @@ def ellipse(a: float, b: float, *, nx: int, ny: int | None = None,
     and ``"parabolic"`` Kalker's ``1 - x^2/a^2 - y^2/b^2`` profile, both
     rescaled so that the discrete sum equals the load.
     """
-    _check_positive(a=a, b=b)
+    check_positive(a=a, b=b)
     ny = nx if ny is None else ny
     _check_cells(nx, ny)
     x = _cell_centres(-a, a, nx)
@@ -162,7 +163,7 @@ def ellipse(a: float, b: float, *, nx: int, ny: int | None = None,
 
 def semi_ellipse_axes(a_over_b: float) -> tuple[float, float]:
     """Semi-axes ``(a, b)`` (m) of the ellipse with ratio ``a/b`` and ``a b = 1/pi`` (area 1)."""
-    _check_positive(a_over_b=a_over_b)
+    check_positive(a_over_b=a_over_b)
     return math.sqrt(a_over_b / math.pi), 1.0 / math.sqrt(a_over_b * math.pi)
 
 
@@ -273,13 +274,6 @@ def _grid_index(v: FloatArray, u: FloatArray, h: float, name: str,
         raise IrregularGridError(f"{name} coordinates are not on a regular grid "
                                  f"(spacing {h:.6g} m)")
     return idx
-
-
-def _check_positive(**values: float) -> None:
-    for name, v in values.items():
-        if not (math.isfinite(v) and v > 0.0):
-            raise InvalidInputError(f"{name.replace('_over_', '/')} must be positive and "
-                                    f"finite, got {v}")
 
 
 def _check_cells(nx: int, ny: int) -> None:

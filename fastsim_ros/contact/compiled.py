@@ -23,24 +23,24 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal, NoReturn
+from typing import Any, NoReturn
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fastsim_ros.contact import kernels as k
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.errors import EmptyContactError, InvalidInputError, OutOfTableError
+from fastsim_ros.contact.checks import (Bound, SplitRule, check_bound, check_shear_modulus,
+                                        check_split_rule)
+from fastsim_ros.contact.equivalent import EquivalentEllipse
+from fastsim_ros.contact.errors import (ContactError, EmptyContactError, InvalidInputError,
+                                        OutOfTableError)
+from fastsim_ros.contact.mae import MaeGeometry, Zone, ZoneFlexibility
 from fastsim_ros.contact.tables import coefficient_table
-
-if TYPE_CHECKING:  # the reference modules pull in the exact solver (scipy): not on the hot path
-    from fastsim_ros.contact.equivalent import EquivalentEllipse
-    from fastsim_ros.contact.mae import MaeGeometry, ZoneFlexibility
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
-Bound = Literal["given", "parabolic"]
-Rule = Literal["auto", "widest_strip", "centroid"]
+Rule = SplitRule
 
 _RULES = {"auto": k.RULE_AUTO, "widest_strip": k.RULE_WIDEST_STRIP,
           "centroid": k.RULE_CENTROID}
@@ -98,7 +98,7 @@ def _raise(status: int, info: float, knots: FloatArray, where: str = "") -> NoRe
         k.E_CELLS: (InvalidInputError,
                     "the equivalent ellipse needs at least 2 cells along each axis"),
     }
-    error, text = messages.get(status, (RuntimeError, f"unknown kernel status {status}"))
+    error, text = messages.get(status, (ContactError, f"unknown kernel status {status}"))
     raise error(where + text)
 
 
@@ -123,13 +123,7 @@ def _pressure(pressure: ArrayLike, ndim: int) -> FloatArray:
     return _readonly(p)
 
 
-def _bound(bound: str) -> bool:
-    """Return whether the bound is the parabolic one."""
-    if bound == "given":
-        return False
-    if bound == "parabolic":
-        return True
-    raise InvalidInputError(f"unknown traction bound {bound!r}: given or parabolic")
+_bound = check_bound
 
 
 def _per_item(value: ArrayLike, size: int, name: str) -> FloatArray:
@@ -167,12 +161,13 @@ class _Solver:
     """What both solvers share: the material and the packed coefficient tables."""
 
     def __init__(self, nu: float, shear_modulus: float) -> None:
-        if not (math.isfinite(shear_modulus) and shear_modulus > 0.0):
-            raise InvalidInputError(f"shear modulus must be positive, got {shear_modulus}")
+        check_shear_modulus(shear_modulus)
         table = coefficient_table(float(nu))  # refuses nu outside the tables
         self.nu = float(nu)
         self.shear_modulus = float(shear_modulus)
-        self._knots = np.ascontiguousarray(table.knots, dtype=np.float64)
+        # a private, writeable copy: the kernels' argument types stay those they were
+        # compiled for (the table's own arrays are read-only)
+        self._knots = np.array(table.knots, dtype=np.float64)
         self._polys = np.ascontiguousarray(np.stack([table.poly[name]
                                                      for name in k.TABLE_NAMES]))
 
@@ -233,9 +228,7 @@ class MaeSolver(_Solver):
     def __init__(self, nu: float, shear_modulus: float, *,
                  rule: Rule = "auto") -> None:
         super().__init__(nu, shear_modulus)
-        if rule not in _RULES:
-            raise InvalidInputError(f"unknown split rule {rule!r}: auto, widest_strip or centroid")
-        self.rule: Rule = rule
+        self.rule: Rule = check_split_rule(rule)
         self._rule = _RULES[rule]
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
@@ -281,7 +274,6 @@ class MaeSolver(_Solver):
 
     def geometry(self, area: GridArea) -> MaeGeometry:
         """Return MAE steps 1-3 (centroid, split line, zones) as the reference's dataclass."""
-        from fastsim_ros.contact.mae import MaeGeometry, Zone
         status, info, geo = self._prepare(area)
         if status not in (k.OK, k.E_TABLE_ZONE1, k.E_TABLE_ZONE2):  # no table needed here
             _raise(status, info, self._knots)
@@ -293,7 +285,6 @@ class MaeSolver(_Solver):
     def flexibility(self, area: GridArea) -> tuple[ZoneFlexibility | None,
                                                    ZoneFlexibility | None]:
         """Return each zone's ``L1 .. L4`` (m/Pa), ``None`` for an empty zone."""
-        from fastsim_ros.contact.mae import ZoneFlexibility
         status, info, geo = self._prepare(area)
         if status:
             _raise(status, info, self._knots)
@@ -356,7 +347,6 @@ class EquivalentEllipseSolver(_Solver):
 
     def _ellipse(self, p: FloatArray, x0: float, y0: float, dx: float,
                  dy: float) -> EquivalentEllipse:
-        from fastsim_ros.contact.equivalent import EquivalentEllipse
         ell = np.empty(k.ELL_SIZE)
         status, info = k.equivalent_prepare(p, float(x0), float(y0), float(dx), float(dy),
                                             self.shear_modulus, self._knots, self._polys, ell)

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from fastsim_ros.contact.area import GridArea, ellipse
-from fastsim_ros.contact.exact import (UNIT_CREEPAGES, CreepCoefficients,
-                                       coefficients_from_unit_solutions)
+from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
+                                              coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
                                          traction_bound)
 from fastsim_ros.contact.traction import Tractions

@@ -25,5 +25,9 @@ class OutOfTableError(InvalidInputError):
     """A look-up outside the range a coefficient table covers."""
 
 
+class DataError(ContactError):
+    """The package's own data (the shipped coefficient tables) is inconsistent or unreadable."""
+
+
 class ConvergenceError(ContactError, RuntimeError):
     """An iterative solver that did not reach its tolerance."""

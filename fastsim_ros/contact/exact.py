@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, NamedTuple
 
 import numpy as np
 import scipy.fft
@@ -37,20 +37,15 @@ import scipy.sparse.linalg
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.checks import check_creepages, check_friction, check_material
+from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
+                                              coefficients_from_unit_solutions)
 from fastsim_ros.contact.errors import ConvergenceError, InvalidInputError
 from fastsim_ros.contact.influence import influence_kernel
 from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
 
 FloatArray = NDArray[np.float64]
 SolverKind = Literal["fft", "dense"]
-
-
-def check_material(nu: float, shear_modulus: float = 1.0) -> None:
-    """Refuse a Poisson ratio outside [0, 0.5] or a non-positive shear modulus."""
-    if not (math.isfinite(nu) and 0.0 <= nu <= 0.5):
-        raise InvalidInputError(f"nu must lie in [0, 0.5], got {nu}")
-    if not (math.isfinite(shear_modulus) and shear_modulus > 0.0):
-        raise InvalidInputError(f"shear modulus must be positive, got {shear_modulus}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -70,8 +65,8 @@ class SteadyRollingOperator:
     kernel_xy: FloatArray
 
     @classmethod
-    def of(cls, area: GridArea, *, nu: float, shear_modulus: float = 1.0) -> SteadyRollingOperator:
-        """Build the operator of ``area``'s grid."""
+    def of(cls, area: GridArea, *, nu: float, shear_modulus: float) -> SteadyRollingOperator:
+        """Build the operator of ``area``'s grid; ``shear_modulus``: combined ``G`` (Pa)."""
         check_material(nu, shear_modulus)
         nx, ny = area.nx, area.ny
         k = influence_kernel(area.dx, area.dy, nx, ny - 1, shear_modulus=shear_modulus, nu=nu)
@@ -98,13 +93,14 @@ class SteadyRollingOperator:
         bxy = self.kernel_xy[dj, di]
         return np.block([[bxx, bxy], [bxy, byy]])
 
-    def strip_blocks(self) -> list[tuple[NDArray[np.int_], FloatArray, FloatArray]]:
+    def strip_blocks(self) -> list[StripBlock]:
         """Return each lateral strip's own block of the operator, strip by strip.
 
-        Per strip with cells in contact: their indices among the contact cells
-        (row-major, as :meth:`dense` orders them), and the ``xx`` and ``yy``
-        blocks between them (``K_xy`` vanishes within a strip, ``dj = 0``).
-        Strips with the same pattern of cells share their block arrays.
+        Per strip with cells in contact (:class:`StripBlock`): their indices
+        among the contact cells (row-major, as :meth:`dense` orders them), the
+        ``xx`` and ``yy`` blocks between them (``K_xy`` vanishes within a
+        strip, ``dj = 0``), and the strip's pattern of cells (bytes), which
+        strips of one pattern share along with their block arrays.
         """
         mask = self.area.mask
         flat = np.cumsum(mask.ravel()).reshape(mask.shape) - 1
@@ -120,12 +116,39 @@ class SteadyRollingOperator:
             if key not in cache:
                 d = cols[:, None] - cols[None, :] + self.area.nx - 1
                 cache[key] = (row_x[d], row_y[d])
-            blocks.append((flat[j, cols], *cache[key]))
+            blocks.append(StripBlock(flat[j, cols], *cache[key], key))
         return blocks
+
+    def check_matches(self, area: GridArea, nu: float, shear_modulus: float) -> None:
+        """Refuse to serve ``area`` and the material if this operator was built for others."""
+        mine = self.area
+        if mine is not area and not (
+                (mine.nx, mine.ny, mine.dx, mine.dy) == (area.nx, area.ny, area.dx, area.dy)
+                and np.array_equal(mine.mask, area.mask)):
+            raise InvalidInputError("the operator was built for another grid or set of cells "
+                                    "in contact than the area's")
+        if (self.nu, self.shear_modulus) != (nu, shear_modulus):
+            raise InvalidInputError(f"the operator was built for nu = {self.nu}, G = "
+                                    f"{self.shear_modulus} Pa, not nu = {nu}, G = "
+                                    f"{shear_modulus} Pa")
 
     def fft_product(self) -> _FFTProduct:
         """FFT-based product with tractions on the whole grid."""
         return _FFTProduct(self)
+
+
+class StripBlock(NamedTuple):
+    """One lateral strip's own block of the operator (:meth:`SteadyRollingOperator.strip_blocks`).
+
+    ``idx``: the strip's cells among the contact cells; ``xx``, ``yy``: the
+    blocks (1/Pa); ``pattern``: the strip's cells relative to its first (the
+    key under which strips of one pattern share ``xx`` and ``yy``).
+    """
+
+    idx: NDArray[np.int_]
+    xx: FloatArray
+    yy: FloatArray
+    pattern: bytes
 
 
 class _FFTProduct:
@@ -171,11 +194,11 @@ class _StripPreconditioner:
         self.n = int(np.count_nonzero(op.area.mask))
         self.blocks = []
         # strips of one pattern share their block arrays: factor each once
-        factored: dict[int, tuple[object, object]] = {}
-        for idx, bxx, byy in op.strip_blocks():
-            if id(bxx) not in factored:
-                factored[id(bxx)] = (scipy.linalg.lu_factor(bxx), scipy.linalg.lu_factor(byy))
-            self.blocks.append((idx, *factored[id(bxx)]))
+        factored: dict[bytes, tuple[object, object]] = {}
+        for idx, bxx, byy, pattern in op.strip_blocks():
+            if pattern not in factored:
+                factored[pattern] = (scipy.linalg.lu_factor(bxx), scipy.linalg.lu_factor(byy))
+            self.blocks.append((idx, *factored[pattern]))
 
     def solve(self, v: FloatArray) -> FloatArray:
         out = np.empty_like(v)
@@ -202,8 +225,18 @@ class TractionSolution(Tractions):
     iterations: int
 
 
+def _operator(operator: SteadyRollingOperator | None, area: GridArea, nu: float,
+              shear_modulus: float) -> SteadyRollingOperator:
+    """Return ``operator`` once checked against the area and material, else build it."""
+    if operator is None:
+        return SteadyRollingOperator.of(area, nu=nu, shear_modulus=shear_modulus)
+    check_material(nu, shear_modulus)
+    operator.check_matches(area, nu, shear_modulus)
+    return operator
+
+
 def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: float,
-                  shear_modulus: float = 1.0, reference: tuple[float, float] = (0.0, 0.0),
+                  shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                   solver: SolverKind = "fft", rtol: float = 1e-10,
                   operator: SteadyRollingOperator | None = None) -> TractionSolution:
     """Tractions in full adhesion (``mu`` infinite) for creepages about ``reference``.
@@ -211,8 +244,11 @@ def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: floa
     ``xi``, ``eta`` dimensionless, ``phi`` in 1/m; ``shear_modulus`` combined
     ``G`` (Pa).  ``solver="fft"``: GMRES with FFT products; ``"dense"``: LU of
     the dense operator (the reference, for a few thousand cells at most).
+    ``operator``: the area's :class:`SteadyRollingOperator` for this
+    material, if already built (checked against the area and the material).
     """
-    op = operator or SteadyRollingOperator.of(area, nu=nu, shear_modulus=shear_modulus)
+    check_creepages(xi, eta, phi)
+    op = _operator(operator, area, nu, shear_modulus)
     wx, wy = rigid_slip(area, xi, eta, phi, reference)
     mask = area.mask
     n = int(np.count_nonzero(mask))
@@ -335,12 +371,9 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
     terms of the difference kernel amplify).  Stops when the largest traction
     change of a sweep is below ``tol * mu * max(p)``.
     """
-    if not (math.isfinite(mu) and mu > 0.0):
-        raise InvalidInputError(f"mu must be positive, got {mu}")
-    for name, v in (("xi", xi), ("eta", eta), ("phi", phi)):
-        if not math.isfinite(v):
-            raise InvalidInputError(f"{name} must be finite")
-    op = operator or SteadyRollingOperator.of(area, nu=nu, shear_modulus=shear_modulus)
+    check_friction(mu)
+    check_creepages(xi, eta, phi)
+    op = _operator(operator, area, nu, shear_modulus)
     mask = area.mask
     n = int(np.count_nonzero(mask))
     # rows of B's transpose are contiguous: the update of all slips by one
@@ -355,14 +388,14 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
     strips = []
     # each strip's block, negated (positive diagonal) and x/y interleaved; shared
     # by strips of one pattern
-    interleaved: dict[int, FloatArray] = {}
-    for idx, bxx, byy in op.strip_blocks():
-        if id(bxx) not in interleaved:
+    interleaved: dict[bytes, FloatArray] = {}
+    for idx, bxx, byy, pattern in op.strip_blocks():
+        if pattern not in interleaved:
             bp = np.zeros((2 * idx.size, 2 * idx.size))
             bp[0::2, 0::2] = -bxx
             bp[1::2, 1::2] = -byy
-            interleaved[id(bxx)] = bp
-        strips.append((idx, interleaved[id(bxx)]))
+            interleaved[pattern] = bp
+        strips.append((idx, interleaved[pattern]))
     scale = mu * float(area.pressure.max())
     slip = np.zeros(n, dtype=bool)
     for sweep in range(1, max_sweeps + 1):
@@ -390,59 +423,12 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
     return TractionSolution(tau_x, tau_y, slip_map, fx, fy, mz, area, sweep)
 
 
-@dataclass(frozen=True)
-class CreepCoefficients:
-    """Generalised creepage coefficients of an area (METHOD.md section 1, paper eq. 3).
-
-    ``Fx = -G (A/pi) C11 xi - G (A/pi) C12 eta - G (A/pi)^1.5 C13 phi``,
-    ``Fy = -G (A/pi) C21 xi - G (A/pi) C22 eta - G (A/pi)^1.5 C23 phi``,
-    ``Mz = G (A/pi)^1.5 C31 xi + G (A/pi)^1.5 C32 eta - G (A/pi)^2 C33 phi``
-    (Kalker's signs: ``C32 = C23`` on an ellipse), about ``reference`` (m).
-    ``area`` is ``A`` (m^2), the discrete area of the cells in contact.
-    """
-
-    C11: float
-    C12: float
-    C13: float
-    C21: float
-    C22: float
-    C23: float
-    C31: float
-    C32: float
-    C33: float
-    area: float
-    reference: tuple[float, float] = (0.0, 0.0)
-
-    def as_dict(self) -> dict[str, float]:
-        """Return the coefficients and the area by name."""
-        names = ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33", "area")
-        return {k: getattr(self, k) for k in names}
-
-
-def coefficients_from_unit_solutions(
-    area: float, unit: tuple[tuple[float, float, float], ...], *, shear_modulus: float = 1.0,
-    reference: tuple[float, float] = (0.0, 0.0)
-) -> CreepCoefficients:
-    """Coefficients from ``(Fx, Fy, Mz)`` at unit ``xi``, unit ``eta`` and unit ``phi``."""
-    c = math.sqrt(area / math.pi)
-    g = shear_modulus
-    (fx1, fy1, mz1), (fx2, fy2, mz2), (fx3, fy3, mz3) = unit
-    return CreepCoefficients(
-        C11=-fx1 / (g * c**2), C12=-fx2 / (g * c**2), C13=-fx3 / (g * c**3),
-        C21=-fy1 / (g * c**2), C22=-fy2 / (g * c**2), C23=-fy3 / (g * c**3),
-        C31=mz1 / (g * c**3), C32=mz2 / (g * c**3), C33=-mz3 / (g * c**4),
-        area=area, reference=reference)
-
-
-#: unit xi, eta and phi (1/m): the creepages whose forces define the coefficients
-UNIT_CREEPAGES = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-
-
 def unit_solutions(area: GridArea, *, nu: float, reference: tuple[float, float] = (0.0, 0.0),
                    solver: SolverKind = "fft") -> tuple[TractionSolution, ...]:
     """Full-adhesion solutions for unit ``xi``, unit ``eta`` and unit ``phi`` (G = 1 Pa)."""
-    op = SteadyRollingOperator.of(area, nu=nu)
-    return tuple(full_adhesion(area, *cr, nu=nu, reference=reference, solver=solver, operator=op)
+    op = SteadyRollingOperator.of(area, nu=nu, shear_modulus=1.0)
+    return tuple(full_adhesion(area, *cr, nu=nu, shear_modulus=1.0, reference=reference,
+                               solver=solver, operator=op)
                  for cr in UNIT_CREEPAGES)
 
 

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.contact.checks import check_bound, check_creepages, check_friction
 from fastsim_ros.contact.traction import Tractions, resultants
 
 FloatArray = NDArray[np.float64]
@@ -72,13 +72,10 @@ def traction_bound(area: GridArea, mu: float, *, bound: str = "given") -> FloatA
     non-Hertzian patch it keeps every cell in contact and the shape of the
     given pressure.
     """
-    if not (math.isfinite(mu) and mu > 0.0):
-        raise InvalidInputError(f"mu must be positive, got {mu}")
+    check_friction(mu)
     p = np.asarray(area.pressure)
-    if bound == "given":
+    if not check_bound(bound):
         return mu * p
-    if bound != "parabolic":
-        raise InvalidInputError(f"unknown traction bound {bound!r}: given or parabolic")
     p2 = p * p
     return mu * area.load * p2 / (float(p2.sum()) * area.cell_area)
 
@@ -134,9 +131,7 @@ def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatAr
     (the reference point itself in plain FastSim, MAE's ``S``); creepages are
     moved to it by the rigid-slip identity.  ``Mz`` is about ``reference``.
     """
-    for name, v in (("xi", xi), ("eta", eta), ("phi", phi)):
-        if not math.isfinite(v):
-            raise InvalidInputError(f"{name} must be finite")
+    check_creepages(xi, eta, phi)
     xc, ys = sweep_point
     xp, yp = reference
     xi_s = xi + phi * (yp - ys)

@@ -19,21 +19,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.errors import InvalidInputError
-from fastsim_ros.contact.exact import (UNIT_CREEPAGES, CreepCoefficients,
-                                       coefficients_from_unit_solutions)
+from fastsim_ros.contact.checks import SplitRule, check_split_rule
+from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
+                                              coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
 
 FloatArray = NDArray[np.float64]
-SplitRule = Literal["auto", "widest_strip", "centroid"]
 DEFAULT_SPLIT: SplitRule = "auto"
 #: the smallest share of the area a ``widest_strip`` zone may have under ``auto``
 MIN_ZONE_SHARE = 0.15
@@ -118,8 +116,7 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
         rows = np.flatnonzero(count)
         yc = float((count * np.arange(area.ny)).sum() / count.sum())
         return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1))
-    if rule != "widest_strip":
-        raise InvalidInputError(f"unknown split rule {rule!r}: auto, widest_strip or centroid")
+    check_split_rule(rule)
     # the band of strips sharing the longest chord (a staircase ellipse has several)
     j0 = int(np.argmax(count))
     j1 = j0

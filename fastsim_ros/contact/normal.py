@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import ConvergenceError, EmptyContactError, InvalidInputError
-from fastsim_ros.contact.exact import check_material
+from fastsim_ros.contact.checks import check_material, check_positive
 from fastsim_ros.contact.influence import influence_kernel
 
 FloatArray = NDArray[np.float64]
@@ -104,7 +104,7 @@ def ellipsoid_gap(x: FloatArray, y: FloatArray, rx: float, ry: float) -> FloatAr
     e.g. ``GridArea.x`` and ``GridArea.y``; ``rx``, ``ry`` the principal
     relative radii of curvature (m) along ``x`` and ``y``.
     """
-    _check_positive(rx=rx, ry=ry)
+    check_positive(rx=rx, ry=ry)
     xa = np.asarray(x, dtype=float).ravel()
     ya = np.asarray(y, dtype=float).ravel()
     return xa[None, :] ** 2 / (2.0 * rx) + ya[:, None] ** 2 / (2.0 * ry)
@@ -144,7 +144,7 @@ def hertz_ellipse(rx: float, ry: float, load: float, *, shear_modulus: float,
     ``a = b = (3 N_load R/(4 E*))^(1/3)``, ``p0 = 3 N_load/(2 pi a^2)``,
     ``delta = a^2/R``.
     """
-    _check_positive(rx=rx, ry=ry, load=load)
+    check_positive(rx=rx, ry=ry, load=load)
     check_material(nu, shear_modulus)
     e_star = shear_modulus / (1.0 - nu)
     r_major, r_minor = max(rx, ry), min(rx, ry)
@@ -235,7 +235,7 @@ def solve_normal(x0: float, y0: float, dx: float, dy: float, gap: FloatArray, *,
     product = _NormalProduct(dx, dy, h0.shape[0], h0.shape[1], shear_modulus=shear_modulus,
                              nu=nu)
     if load is not None:
-        _check_positive(load=load)
+        check_positive(load=load)
         p, iterations = _given_load(product, h0, load / (dx * dy), tol, max_iter)
     else:
         assert approach is not None
@@ -348,15 +348,9 @@ def _given_approach(product: _NormalProduct, h0: FloatArray, delta: float, tol: 
 def _check_grid(x0: float, y0: float, dx: float, dy: float, h0: FloatArray) -> None:
     if not all(math.isfinite(v) for v in (x0, y0)):
         raise InvalidInputError("x0 and y0 must be finite")
-    _check_positive(dx=dx, dy=dy)
+    check_positive(dx=dx, dy=dy)
     if h0.ndim != 2 or h0.shape[0] < 2 or h0.shape[1] < 2:
         raise InvalidInputError(f"gap must be a 2-D array of at least 2 x 2 cells, got shape "
                                 f"{h0.shape}")
     if not np.all(np.isfinite(h0)):
         raise InvalidInputError("gap has NaN or infinite values")
-
-
-def _check_positive(**values: float) -> None:
-    for name, v in values.items():
-        if not (math.isfinite(v) and v > 0.0):
-            raise InvalidInputError(f"{name} must be positive and finite, got {v}")

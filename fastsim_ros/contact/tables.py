@@ -8,13 +8,19 @@ as ``C11/2, C22/2, C23/2`` of that same table (exact by symmetry), and only
 ``c12, c13, c21`` are read from ``half_ellipse_coefficients.csv``.  So plain
 FastSim and MAE read one set of numbers.
 
-Interpolation: in ``log(a/b)`` by a cubic spline (the coefficients are smooth
-in it over two decades), and in ``nu`` by a quadratic through the three
+Interpolation: in ``log(a/b)`` by a cubic spline (not-a-knot end conditions,
+as SciPy's ``CubicSpline``, computed here with numpy alone so that the fast
+path does not import SciPy; the coefficients are smooth in ``log(a/b)`` over
+two decades), and in ``nu`` by a quadratic through the three
 tabulated values of ``C (1 - nu)``, which removes the ``1/(1 - nu)`` of
 Kalker's asymptotic formulas.  The tables span ``0.05 <= a/b <= 20`` (a
 margin beyond Kalker's 0.1..10: MAE's zones of real patches may measure a
 little outside it) and ``0 <= nu <= 0.5``; outside, a look-up is refused
 (:class:`OutOfTableError`).
+
+Everything handed out is read-only (arrays not writeable, mappings
+``MappingProxyType``): the tables are cached and shared by every solve, so
+no caller can change what a later solve reads.
 """
 
 from __future__ import annotations
@@ -22,13 +28,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from collections.abc import Mapping
 from importlib import resources
+from types import MappingProxyType
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.interpolate import CubicSpline
 
-from fastsim_ros.contact.errors import InvalidInputError, OutOfTableError
+from fastsim_ros.contact.errors import DataError, InvalidInputError, OutOfTableError
 
 FloatArray = NDArray[np.float64]
 
@@ -52,13 +59,13 @@ class TableData:
 
     a_over_b: FloatArray
     nus: FloatArray
-    values: dict[str, FloatArray]
-    errors: dict[str, FloatArray]
+    values: Mapping[str, FloatArray]
+    errors: Mapping[str, FloatArray]
 
 
 @lru_cache(maxsize=1)
 def table_data() -> TableData:
-    """Load the shipped tables (cached)."""
+    """Load the shipped tables (cached; read-only arrays and mappings)."""
     values: dict[str, FloatArray] = {}
     errors: dict[str, FloatArray] = {}
     grids = []
@@ -75,11 +82,60 @@ def table_data() -> TableData:
             errors[name] = data[:, header.index(name + "_err")].reshape(nus.size, g.size)
     (g0, n0), (g1, n1) = grids
     if not (np.array_equal(g0, g1) and np.array_equal(n0, n1)):
-        raise RuntimeError("the shipped coefficient tables do not share one grid")
+        raise DataError("the shipped coefficient tables do not share one grid")
     for half, full in HALF_FROM_FULL.items():
         errors[half] = errors[full] / 2.0
         values[half] = values[full] / 2.0
-    return TableData(g0, n0, values, errors)
+    return TableData(_frozen(g0), _frozen(n0), _frozen_map(values), _frozen_map(errors))
+
+
+def _frozen(a: FloatArray) -> FloatArray:
+    """Return ``a`` made read-only (it is not copied: nobody else holds it)."""
+    a.setflags(write=False)
+    return a
+
+
+def _frozen_map(d: dict[str, FloatArray]) -> Mapping[str, FloatArray]:
+    return MappingProxyType({k: _frozen(v) for k, v in d.items()})
+
+
+def not_a_knot_spline(x: FloatArray, y: FloatArray) -> FloatArray:
+    """Return the coefficients ``(4, n - 1)`` of the not-a-knot cubic spline through ``(x, y)``.
+
+    The spline of SciPy's ``CubicSpline(x, y)`` (``bc_type="not-a-knot"``),
+    same equations for the slopes ``s`` (the third derivative continuous at
+    the second and the last-but-one knot), solved densely (a few dozen
+    knots); highest power first, in ``x - x[k]`` on interval ``k``.  Needs at
+    least 4 knots.
+    """
+    n = x.size
+    if n < 4:
+        raise DataError(f"a coefficient table needs at least 4 knots, has {n}")
+    dx = np.diff(x)
+    slope = np.diff(y) / dx
+    a = np.zeros((n, n))
+    b = np.empty(n)
+    i = np.arange(1, n - 1)
+    a[i, i] = 2.0 * (dx[:-1] + dx[1:])
+    a[i, i + 1] = dx[:-1]
+    a[i, i - 1] = dx[1:]
+    b[1:-1] = 3.0 * (dx[1:] * slope[:-1] + dx[:-1] * slope[1:])
+    d = x[2] - x[0]
+    a[0, 0] = dx[1]
+    a[0, 1] = d
+    b[0] = ((dx[0] + 2.0 * d) * dx[1] * slope[0] + dx[0] ** 2 * slope[1]) / d
+    d = x[-1] - x[-3]
+    a[-1, -1] = dx[-2]
+    a[-1, -2] = d
+    b[-1] = (dx[-1] ** 2 * slope[-2] + (2.0 * d + dx[-1]) * dx[-2] * slope[-1]) / d
+    s = np.linalg.solve(a, b)
+    t = (s[:-1] + s[1:] - 2.0 * slope) / dx
+    c = np.empty((4, n - 1))
+    c[0] = t / dx
+    c[1] = (slope - s[:-1]) / dx - t
+    c[2] = s[:-1]
+    c[3] = y[:-1]
+    return c
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,7 +149,7 @@ class CoefficientTable:
 
     nu: float
     knots: FloatArray
-    poly: dict[str, FloatArray]
+    poly: Mapping[str, FloatArray]
 
     def __call__(self, name: str, a_over_b: float) -> float:
         """Return coefficient ``name`` (``"C11"`` ... ``"c23"``) at ``a/b``."""
@@ -129,7 +185,7 @@ class CoefficientTable:
 
 @lru_cache(maxsize=16)
 def coefficient_table(nu: float) -> CoefficientTable:
-    """Return the tables interpolated to Poisson ratio ``nu`` (cached per ``nu``)."""
+    """Return the tables interpolated to Poisson ratio ``nu`` (cached per ``nu``; read-only)."""
     data = table_data()
     if not (math.isfinite(nu) and data.nus[0] <= nu <= data.nus[-1]):
         raise OutOfTableError(f"nu = {nu} lies outside the tables' range "
@@ -144,5 +200,5 @@ def coefficient_table(nu: float) -> CoefficientTable:
     poly = {}
     for name, v in data.values.items():
         at_nu = (weights @ (v * (1.0 - nodes)[:, None])) / (1.0 - nu)
-        poly[name] = np.ascontiguousarray(CubicSpline(knots, at_nu).c)
-    return CoefficientTable(float(nu), knots, poly)
+        poly[name] = np.ascontiguousarray(not_a_knot_spline(knots, at_nu))
+    return CoefficientTable(float(nu), _frozen(knots), _frozen_map(poly))
