@@ -1,0 +1,593 @@
+"""``fastsim_replay`` on the bundled bags: golden outputs, physics, output bags, bad inputs.
+
+The golden outputs ``bags/golden/<name>.csv.gz`` are the replay's own CSV
+(``fastsim_replay bags/<name> --params bags/<name>.params.yaml --csv``),
+gzipped without a time stamp.  Regenerate them, after a deliberate change of
+the physics, with::
+
+    .venv/bin/python test/test_replay.py --write-golden
+
+and say in the commit why they moved.
+"""
+
+from __future__ import annotations
+
+import csv
+import gzip
+import io
+import json
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from rosbags.interfaces import QosHistory, QosReliability
+from rosbags.rosbag2 import Reader, Writer
+from rosbags.rosbag2.enums import StoragePlugin
+from rosbags.typesys import Stores, get_typestore
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from fastsim_ros import replay  # noqa: E402
+from fastsim_ros.contact.compiled import MaeSolver  # noqa: E402
+from fastsim_ros.contact.normal import hertz_ellipse  # noqa: E402
+from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
+from fastsim_ros.params import load_params_file  # noqa: E402
+from msg_adapters.cdr import read_cloud  # noqa: E402
+from msg_adapters.errors import REJECTION_REASONS  # noqa: E402
+from msg_adapters.patch import patch_from_cloud  # noqa: E402
+
+BAGS = ROOT / "bags"
+GOLDEN = BAGS / "golden"
+NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_inputs")
+TYPES = get_typestore(Stores.ROS2_JAZZY)
+WRENCH, VECTOR = "geometry_msgs/msg/WrenchStamped", "geometry_msgs/msg/Vector3Stamped"
+POSE, DIAG = "geometry_msgs/msg/PoseStamped", "diagnostic_msgs/msg/DiagnosticArray"
+MARKERS = "visualization_msgs/msg/MarkerArray"
+G, NU, MU = 8.0e10, 0.28, 0.3
+
+# Tolerance of the golden comparison.  On one machine the replay is
+# deterministic (compiled kernels, fixed input order, no clock in any
+# output), so any difference at all is a change of the physics.  Across
+# machines or numba/LLVM versions, float reassociation (vectorised sums in
+# the kernels) moves results by about 1e-12 relative; a change of method,
+# friction law, grid or table moves them by 1e-4 or more.  So: rtol 1e-9,
+# plus an absolute floor of 1e-9 of the column's physical scale (mu N for
+# forces, mu N x 1 cm for Mz, 1e-9 for creepages (whose float32 inputs give
+# ~1e-8 of noise on a zero creepage, identical on every machine) and
+# 1e-9 1/m for spin), so that a value that should be zero may differ by
+# rounding.  slip_fraction is a share of cells: any change is at least
+# 1/(cells in contact) > 1e-4, far above 1e-9.
+RTOL = 1e-9
+ATOL = {"xi": 1e-9 * 1e-3, "eta": 1e-9 * 1e-3, "phi": 1e-9, "V": 1e-9, "N": 1e-9 * MU * 6e4,
+        "Fx": 1e-9 * MU * 6e4, "Fy": 1e-9 * MU * 6e4, "Mz": 1e-9 * MU * 6e4 * 0.01,
+        "slip_fraction": 1e-9}
+
+
+# ------------------------------------------------------------------------ helpers
+
+def run(args, capsys=None):
+    """Run ``fastsim_replay`` in-process; return ``(status, stdout, stderr)``."""
+    status = replay.main([str(a) for a in args])
+    if capsys is None:
+        return status, "", ""
+    cap = capsys.readouterr()
+    return status, cap.out, cap.err
+
+
+def read_csv_text(text):
+    """Return the rows of a replay CSV as dicts (header checked)."""
+    reader = csv.reader(io.StringIO(text))
+    header = next(reader)
+    assert tuple(header) == replay.CSV_HEADER
+    return [dict(zip(header, row)) for row in reader]
+
+
+def golden_rows(name):
+    """Return the golden rows of a bag."""
+    with gzip.open(GOLDEN / f"{name}.csv.gz", "rt", encoding="utf-8", newline="") as f:
+        return read_csv_text(f.read())
+
+
+def rows_of(path, contact=None):
+    """Return the rows of an output CSV (of one contact)."""
+    rows = read_csv_text(Path(path).read_text(encoding="utf-8"))
+    return [r for r in rows if contact is None or r["contact"] == contact]
+
+
+def column(rows, name):
+    """Return one column as floats (blank: NaN)."""
+    return np.array([float(r[name]) if r[name] != "" else math.nan for r in rows])
+
+
+def plain(msg):
+    """Return a rosbags message as nested plain values (for equality)."""
+    if hasattr(msg, "__dataclass_fields__"):
+        return {k: plain(getattr(msg, k)) for k in msg.__dataclass_fields__}
+    if isinstance(msg, np.ndarray):
+        return msg.tolist()
+    if isinstance(msg, (list, tuple)):
+        return [plain(m) for m in msg]
+    return msg
+
+
+def bag_contents(path):
+    """Return ``{topic: (type, [(log_ns, message), ...])}``, the connections and custom data."""
+    out = {}
+    with Reader(path) as reader:
+        conns = {c.topic: c for c in reader.connections}
+        for conn, log_ns, raw in reader.messages():
+            msg = TYPES.deserialize_cdr(raw, conn.msgtype)
+            out.setdefault(conn.topic, (conn.msgtype, []))[1].append((log_ns, msg))
+        meta = yaml.safe_load((Path(path) / "metadata.yaml").read_text())
+    return out, conns, meta["rosbag2_bagfile_information"]
+
+
+def final_counts(contents, contact):
+    """Return the counts of a contact in the bag's last diagnostics array."""
+    _, diags = contents["/diagnostics"]
+    status = next(s for s in diags[-1][1].status if s.name == f"fastsim: {contact}")
+    return {kv.key: kv.value for kv in status.values}
+
+
+def decoded_without_timing(contents):
+    """Return decoded contents minus the wall-clock solve times of the diagnostics."""
+    result = {}
+    for topic, (msgtype, items) in contents.items():
+        values = []
+        for log_ns, msg in items:
+            d = plain(msg)
+            if msgtype == DIAG:
+                for s in d["status"]:
+                    s["values"] = [kv for kv in s["values"]
+                                   if not kv["key"].startswith("solve_time")]
+            values.append((log_ns, d))
+        result[topic] = (msgtype, values)
+    return result
+
+
+# ------------------------------------------------------------------------ fixtures
+
+@pytest.fixture(scope="module")
+def replayed(tmp_path_factory):
+    """Replay every bundled bag with its params file (CSV on); return the output directory."""
+    out = tmp_path_factory.mktemp("replayed")
+    for name in NAMES:
+        status, _, _ = run([BAGS / name, "-o", out, "--params", BAGS / f"{name}.params.yaml",
+                            "--csv"])
+        assert status == 0, name
+    return out
+
+
+@pytest.fixture(scope="module")
+def contents(replayed):
+    """Return the decoded output bag of each bundled bag."""
+    return {name: bag_contents(replayed / name) for name in NAMES}
+
+
+# ------------------------------------------------------------------------ (a) golden
+
+@pytest.mark.parametrize("name", NAMES)
+def test_replay_matches_golden(replayed, name):
+    got, want = rows_of(replayed / f"{name}.csv"), golden_rows(name)
+    assert len(got) == len(want)
+    for g, w in zip(got, want):
+        for key in ("stamp_ns", "contact", "method", "friction_law"):
+            assert g[key] == w[key]
+        for key, atol in ATOL.items():
+            assert (g[key] == "") == (w[key] == ""), (key, g, w)
+            if w[key] != "":
+                assert float(g[key]) == pytest.approx(float(w[key]), rel=RTOL, abs=atol), \
+                    (key, g["stamp_ns"], g["contact"])
+
+
+# ------------------------------------------------------------------------ (a) physics
+
+def test_hertz_ramp_linear_limit_is_kalkers_c11(replayed):
+    # Fx = -G a b C11 xi in full adhesion (Kalker's linear theory, the patch's
+    # Hertzian semi-axes).  FastSim on the 24 x 24 grid of this bag sits 3.8%
+    # below C11 (its discretisation error along x, ~1/n); 5% is the bound.
+    hz = hertz_ellipse(0.46, 0.3, 6e4, shear_modulus=G, nu=NU)
+    c11 = coefficient_table(NU)("C11", hz.a / hz.b)
+    for contact in ("left", "right"):
+        rows = rows_of(replayed / "hertz_ramp.csv", contact)
+        xi, fx, slip = column(rows, "xi"), column(rows, "Fx"), column(rows, "slip_fraction")
+        linear = (xi > 1e-5) & (slip == 0.0)
+        assert linear.sum() >= 5
+        ratio = fx[linear] / (-G * hz.a * hz.b * c11 * xi[linear])
+        assert np.all(np.abs(ratio - 1.0) < 0.05), ratio
+        assert np.ptp(ratio) < 1e-3  # linear: one slope over the whole range
+
+
+def test_hertz_ramp_saturates_at_mu_n_and_brakes(replayed):
+    for contact in ("left", "right"):
+        rows = rows_of(replayed / "hertz_ramp.csv", contact)
+        xi, fx, fy, n = (column(rows, k) for k in ("xi", "Fx", "Fy", "N"))
+        assert n == pytest.approx(6e4, rel=1e-5)
+        # the bound: never above mu N (traction bound "given": |tau| <= mu p)
+        assert np.all(np.hypot(fx, fy) <= MU * n * (1 + 1e-9))
+        # braking (xi > 0) gives Fx < 0, the force grows with xi and saturates
+        braking = xi > 1e-6
+        assert np.all(fx[braking] < 0.0)
+        assert np.all(np.diff(-fx[braking]) >= -1e-6 * MU * 6e4)
+        held = xi > 0.99e-2
+        assert held.sum() >= 40
+        assert np.all(-fx[held] / (MU * n[held]) > 0.98)
+        assert np.abs(fy).max() < 1e-6 * MU * 6e4  # no lateral creepage, no lateral force
+
+
+def test_semi_ellipses_spin_gives_fx_mirrored_on_the_two_wheels(replayed):
+    left = rows_of(replayed / "semi_ellipses_spin.csv", "left")
+    right = rows_of(replayed / "semi_ellipses_spin.csv", "right")
+    phi_l, phi_r = column(left, "phi"), column(right, "phi")
+    fx_l, fx_r = column(left, "Fx"), column(right, "Fx")
+    fy_l, fy_r = column(left, "Fy"), column(right, "Fy")
+    assert np.abs(column(left, "xi")).max() < 1e-6 and np.abs(column(left, "eta")).max() < 1e-6
+    spinning = np.abs(phi_l) > 0.05
+    assert spinning.sum() > 200
+    assert phi_l.min() == pytest.approx(-0.847, abs=2e-3)
+    assert phi_r == pytest.approx(-phi_l, abs=1e-9)
+    # spin alone gives Fx on this asymmetric area (it is ~0.2 N at phi = 0)
+    assert np.all(np.abs(fx_l[spinning]) > 0.01 * MU * 6e4)
+    # mirrored patch (y -> -y) under mirrored spin (phi -> -phi): Fx is the same, Fy and
+    # Mz change sign.  (Opposite Fx comes with opposite spin on the same patch: below.)
+    assert fx_r == pytest.approx(fx_l, rel=1e-9, abs=1e-6)
+    assert fy_r == pytest.approx(-fy_l, rel=1e-9, abs=1e-6)
+    # |Fx| grows with |phi| until the lateral force takes the adhesion (Fx peaks near
+    # |phi| = 0.3 1/m, then falls to 0.6 of its peak at 0.85 1/m as Fy nears 0.45 mu N)
+    order = np.argsort(np.abs(phi_l))
+    small = order[np.abs(phi_l[order]) < 0.25]
+    assert np.all(np.diff(np.abs(fx_l[small])) >= -1e-6)
+    assert np.abs(fx_l[small[-1]]) > 2.5 * np.abs(fx_l[small[np.abs(phi_l[small]) > 0.05][0]])
+    assert np.all(np.hypot(fx_l, fy_l) <= MU * column(left, "N") * (1 + 1e-9))
+
+
+def test_spin_induced_fx_is_odd_in_phi_on_one_patch():
+    # the same (left) patch of the bag, solved at +-phi: Fx changes sign
+    with Reader(BAGS / "semi_ellipses_spin") as reader:
+        conn = next(c for c in reader.connections if c.topic == "/contact/left/patch")
+        raw = next(r for _, _, r in reader.messages([conn]))
+    patch = patch_from_cloud(read_cloud(raw), max_cells=16384)
+    solver = MaeSolver(NU, G)
+    fx = [solver.solve_arrays(patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy,
+                              0.0, 0.0, phi, MU).fx for phi in (-0.4, 0.4)]
+    assert abs(fx[0]) > 0.03 * MU * 6e4
+    assert fx[1] == pytest.approx(-fx[0], rel=1e-9)
+
+
+def test_flange_shift_two_point_contact(replayed):
+    rows = rows_of(replayed / "flange_shift.csv")
+    t0 = int(rows[0]["stamp_ns"])
+    by = {c: [r for r in rows if r["contact"] == c] for c in ("left", "right", "left_flange")}
+    assert all(len(v) == 400 for v in by.values())
+    flange = by["left_flange"]
+    t = (np.array([int(r["stamp_ns"]) for r in flange]) - t0) * 1e-9
+    n_flange = column(flange, "N")
+    two_point = t >= 2.8
+    assert two_point.sum() == 120
+    # before 2.8 s: empty patches, zero wrenches, undefined creepages
+    assert np.all(n_flange[~two_point] == 0.0) and np.all(column(flange, "Fx")[~two_point] == 0)
+    assert np.all(np.isnan(column(flange, "xi")[~two_point]))
+    # in the stretch: both patches of the left wheel served, loads 45/15, 30/30, 15/45 kN
+    n_left = column(by["left"], "N")
+    for k, (tread, flank) in enumerate(((45e3, 15e3), (30e3, 30e3), (15e3, 45e3))):
+        stretch = (t >= 2.8 + 0.4 * k) & (t < 3.2 + 0.4 * k)
+        assert stretch.sum() == 40
+        assert n_left[stretch] == pytest.approx(tread, rel=1e-4)
+        assert n_flange[stretch] == pytest.approx(flank, rel=1e-4)
+    fx_flange = column(flange, "Fx")[two_point]
+    xi_flange = column(flange, "xi")[two_point]
+    assert xi_flange == pytest.approx(-2.8e-2, rel=0.05)
+    assert np.all(fx_flange > 0.0)  # traction: xi < 0 gives Fx > 0
+    assert np.all(np.abs(fx_flange) <= MU * n_flange[two_point] * (1 + 1e-9))
+    # the right tread: opposite creepage and force to the left tread's
+    assert np.all(column(by["right"], "Fx")[t > 0.5] < 0) and np.all(
+        column(by["left"], "Fx")[t > 0.5] > 0)
+
+
+def test_roller_rig_is_served_with_its_rail_twist(replayed):
+    rows = rows_of(replayed / "roller_rig.csv", "wheel")
+    assert len(rows) == 400
+    xi, fx, v = column(rows, "xi"), column(rows, "Fx"), column(rows, "V")
+    assert np.all(np.isfinite(xi))
+    assert v == pytest.approx(15.0, rel=0.01)  # the roller's surface speed, not 0 (no rail)
+    assert xi.min() == pytest.approx(-5e-3, rel=1e-3) and xi.max() == pytest.approx(5e-3,
+                                                                                    rel=1e-3)
+    moving = np.abs(xi) > 1e-5
+    assert np.all(np.sign(fx[moving]) == -np.sign(xi[moving]))
+    assert np.abs(fx[np.abs(xi) < 1e-7]).max() < 1.0  # passes zero at xi = 0
+
+
+def test_roller_rig_without_its_params_solves_nothing_and_warns(tmp_path, capsys):
+    status, out, err = run([BAGS / "roller_rig", "-o", tmp_path], capsys)
+    assert status == 0
+    assert "no patch topic of the configured contacts (left, right)" in err
+    assert "left: 0 patches" in out
+
+
+# ------------------------------------------------------------------------ (b) bad inputs
+
+def test_bad_inputs_rejections_by_reason(contents, replayed):
+    expected = yaml.safe_load((BAGS / "bad_inputs.expected.yaml").read_text())["contacts"]
+    topics, _, _ = contents["bad_inputs"]
+    for contact, want in expected.items():
+        counts = final_counts(topics, contact)
+        assert int(counts["solved"]) == want["served"]
+        assert int(counts["no_contact"]) == want["no_contact"]
+        for reason in REJECTION_REASONS:
+            assert int(counts[f"rejected/{reason}"]) == want["rejected"][reason], reason
+        # a wrench for each served or empty patch, none for a rejected one
+        _, wrenches = topics[f"/contact/{contact}/wrench"]
+        assert len(wrenches) == want["served"] + want["no_contact"]
+        assert len(topics[f"/contact/{contact}/creepage"][1]) == want["served"]
+        stamps = [m.header.stamp.sec * 10**9 + m.header.stamp.nanosec for _, m in wrenches]
+        assert stamps == sorted(set(stamps))  # no wrench for the old_stamp patches
+        forces = np.array([[m.wrench.force.x, m.wrench.force.y, m.wrench.force.z,
+                            m.wrench.torque.z] for _, m in wrenches])
+        assert np.all(np.isfinite(forces))
+        assert len(rows_of(replayed / "bad_inputs.csv", contact)) == len(wrenches)
+
+
+def test_summary_reports_rejections(tmp_path, capsys):
+    status, out, _ = run([BAGS / "bad_inputs", "-o", tmp_path, "--params",
+                          BAGS / "bad_inputs.params.yaml"], capsys)
+    assert status == 0
+    assert "bad_inputs: 1140 messages in" in out
+    assert ("left: 300 patches, 238 wrenches (228 solved, 10 no_contact), rejected 62 "
+            "(nonfinite 3, negative_pressure 2, irregular_grid 2, missing_field 2, "
+            "wrong_frame 2, old_stamp 2, no_kinematics 10, stale_kinematics 15, "
+            "standstill 20, too_large 2, degenerate 2)") in out
+    assert "x real time" in out and "solve p50" in out
+
+
+# ------------------------------------------------------------------------ (d) output bags
+
+@pytest.mark.parametrize("name", NAMES)
+def test_output_bag_opens_with_types_and_counts(contents, name):
+    topics, conns, meta = contents[name]
+    params = load_params_file(BAGS / f"{name}.params.yaml")
+    stored = json.loads(meta["custom_data"][replay.PARAMETERS_KEY])
+    assert stored == json.loads(json.dumps(params))
+    assert meta["version"] == 9 and meta["storage_identifier"] == "mcap"
+    # the inputs, copied with their types and counts
+    with Reader(BAGS / name) as reader:
+        for conn in reader.connections:
+            msgtype, items = topics[conn.topic]
+            assert msgtype == conn.msgtype and len(items) == conn.msgcount
+    types = replay.output_topics(tuple(params["contacts"]))
+    for contact in params["contacts"]:
+        counts = final_counts(topics, contact)
+        solved, empty = int(counts["solved"]), int(counts["no_contact"])
+        assert topics[f"/contact/{contact}/wrench"][0] == WRENCH
+        assert len(topics[f"/contact/{contact}/wrench"][1]) == solved + empty
+        if solved:
+            assert topics[f"/contact/{contact}/creepage"][0] == VECTOR
+            assert len(topics[f"/contact/{contact}/creepage"][1]) == solved
+            assert topics[f"/contact/{contact}/frame"][0] == POSE
+            assert 1 <= len(topics[f"/contact/{contact}/frame"][1]) <= solved
+        assert f"/contact/{contact}/traction" not in topics  # publish_traction: false
+    for topic, (msgtype, _) in topics.items():
+        rel = topic if topic == "/diagnostics" else topic[1:]
+        if rel in types:
+            assert types[rel] == msgtype
+            # what the node offers: reliable, keep last 10
+            qos = conns[topic].ext.offered_qos_profiles[0]
+            assert qos.reliability == QosReliability.RELIABLE
+            assert qos.history == QosHistory.KEEP_LAST and qos.depth == 10
+    assert topics["/contact/markers"][0] == MARKERS
+    assert topics["/wheelset/wrench"][0] == WRENCH
+    # diagnostics each whole second of log time, and one at the end
+    duration = meta["duration"]["nanoseconds"] * 1e-9
+    assert len(topics["/diagnostics"][1]) == math.floor(duration) + 1
+    # every output is logged at its patch's log time = its header stamp here
+    for _, m in topics[f"/contact/{params['contacts'][0]}/wrench"][1][:5]:
+        assert m.header.frame_id == f"{params['contacts'][0]}_contact"
+
+
+def test_wrench_messages_equal_the_csv(contents, replayed):
+    topics, _, _ = contents["hertz_ramp"]
+    rows = rows_of(replayed / "hertz_ramp.csv", "left")
+    wrenches = topics["/contact/left/wrench"][1]
+    for (log_ns, m), r in zip(wrenches, rows):
+        assert log_ns == int(r["stamp_ns"])
+        assert (m.wrench.force.x, m.wrench.force.y, m.wrench.force.z, m.wrench.torque.z) == \
+            (float(r["Fx"]), float(r["Fy"]), float(r["N"]), float(r["Mz"]))
+
+
+def test_no_contact_rows_are_zero_wrench_and_blank_creepage(replayed):
+    rows = [r for r in rows_of(replayed / "bad_inputs.csv") if r["N"] == "0.0"]
+    assert len(rows) == 14
+    for r in rows:
+        assert (r["Fx"], r["Fy"], r["Mz"]) == ("0.0", "0.0", "0.0")
+        assert r["xi"] == r["eta"] == r["phi"] == r["V"] == r["slip_fraction"] == ""
+
+
+def test_lone_mcap_replays_like_its_directory(tmp_path, replayed):
+    status, _, _ = run([BAGS / "hertz_ramp" / "hertz_ramp.mcap", "-o", tmp_path, "--csv",
+                        "--params", BAGS / "hertz_ramp.params.yaml"])
+    assert status == 0
+    assert (tmp_path / "hertz_ramp.csv").read_text() == (replayed / "hertz_ramp.csv").read_text()
+    got, _, _ = bag_contents(tmp_path / "hertz_ramp")
+    want, _, _ = bag_contents(replayed / "hertz_ramp")
+    assert decoded_without_timing(got) == decoded_without_timing(want)
+
+
+def test_plot_is_written(tmp_path):
+    status, _, _ = run([BAGS / "flange_shift", "-o", tmp_path, "--plot", "--params",
+                        BAGS / "flange_shift.params.yaml"])
+    assert status == 0
+    png = (tmp_path / "flange_shift.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 20_000
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["flange_shift", "flange_shift.png"]
+
+
+def test_jobs_2_equals_jobs_1(tmp_path):
+    inputs = [BAGS / n for n in ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")]
+    for jobs in (1, 2):
+        assert run(inputs + ["-o", tmp_path / f"j{jobs}", "--csv", "--jobs", jobs])[0] == 0
+    for path in inputs:
+        a, b = tmp_path / "j1", tmp_path / "j2"
+        assert (a / f"{path.name}.csv").read_text() == (b / f"{path.name}.csv").read_text()
+        assert decoded_without_timing(bag_contents(a / path.name)[0]) == \
+            decoded_without_timing(bag_contents(b / path.name)[0])
+
+
+# ------------------------------------------------------------------------ (e) bad inputs
+
+def _bad_inputs(tmp_path):
+    src = tmp_path / "src"
+    src.mkdir()
+    truncated = src / "truncated"
+    shutil.copytree(BAGS / "hertz_ramp", truncated)
+    (truncated / "hertz_ramp.mcap").rename(truncated / "truncated.mcap")
+    meta = (truncated / "metadata.yaml").read_text().replace("hertz_ramp.mcap",
+                                                             "truncated.mcap")
+    (truncated / "metadata.yaml").write_text(meta)
+    mcap = truncated / "truncated.mcap"
+    data = mcap.read_bytes()
+    mcap.write_bytes(data[:len(data) // 2])
+    lone = src / "cut.mcap"
+    lone.write_bytes((BAGS / "roller_rig" / "roller_rig.mcap").read_bytes()[:30_000])
+    garbage = src / "garbage.mcap"
+    garbage.write_bytes(bytes(range(256)) * 40)
+    empty_file = src / "nothing.mcap"
+    empty_file.write_bytes(b"")
+    not_a_bag = src / "notabag"
+    not_a_bag.mkdir()
+    (not_a_bag / "notes.txt").write_text("hello")
+    empty_bag = src / "emptybag"
+    with Writer(empty_bag, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        w.add_connection("/wheelset/twist", "geometry_msgs/msg/TwistStamped", typestore=TYPES)
+    return [truncated, lone, garbage, empty_file, not_a_bag, empty_bag, src / "missing"]
+
+
+def test_bad_inputs_exit_2_and_leave_nothing_while_a_good_one_completes(tmp_path, capsys):
+    bad = _bad_inputs(tmp_path)
+    out = tmp_path / "out"
+    status, stdout, err = run(bad[:3] + [BAGS / "hertz_ramp"] + bad[3:] +
+                              ["-o", out, "--csv", "--plot"], capsys)
+    assert status == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == len(bad)
+    for path, line in zip(bad, lines):
+        assert line.startswith(f"fastsim_replay: {path}"), line
+    assert "Traceback" not in err
+    assert "empty bag" in lines[5] and "no such file" in lines[6]
+    assert sorted(p.name for p in out.iterdir()) == ["hertz_ramp", "hertz_ramp.csv",
+                                                     "hertz_ramp.png"]
+    assert "hertz_ramp: 1600 messages in" in stdout
+
+
+def test_truncated_bag_from_the_console_script(tmp_path):
+    truncated = _bad_inputs(tmp_path)[0]
+    out = tmp_path / "out"
+    proc = subprocess.run([sys.executable, "-m", "fastsim_ros.replay", str(truncated), "-o",
+                           str(out)], capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and str(truncated) in proc.stderr
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    assert list(out.iterdir()) == []
+
+
+def test_interrupt_leaves_nothing(tmp_path, monkeypatch, capsys):
+    calls = {"n": 0}
+    original = replay.Pipeline.on_patch
+
+    def on_patch(self, contact, raw):
+        calls["n"] += 1
+        if calls["n"] == 300:
+            raise KeyboardInterrupt
+        return original(self, contact, raw)
+
+    monkeypatch.setattr(replay.Pipeline, "on_patch", on_patch)
+    out = tmp_path / "out"
+    status, _, err = run([BAGS / "hertz_ramp", BAGS / "semi_ellipses_spin", "-o", out, "--csv",
+                          "--plot"], capsys)
+    assert status == 130 and "interrupted" in err
+    assert list(out.iterdir()) == []
+
+
+# ------------------------------------------------------------------------ before any work
+
+def test_duplicate_name_exits_before_work(tmp_path, capsys):
+    other = tmp_path / "elsewhere" / "hertz_ramp"
+    shutil.copytree(BAGS / "hertz_ramp", other)
+    out = tmp_path / "out"
+    status, _, err = run([BAGS / "hertz_ramp", other, "-o", out], capsys)
+    assert status == 2 and "same name 'hertz_ramp'" in err and err.count("\n") == 1
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("existing, flags", [("hertz_ramp", []), ("hertz_ramp.csv", ["--csv"]),
+                                             ("hertz_ramp.png", ["--plot"])])
+def test_existing_target_exits_before_work(tmp_path, capsys, existing, flags):
+    target = tmp_path / existing
+    target.write_text("keep me")
+    status, _, err = run([BAGS / "roller_rig", BAGS / "hertz_ramp", "-o", tmp_path] + flags,
+                         capsys)
+    assert status == 2 and f"{target}: exists already" in err and err.count("\n") == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == [existing]
+    assert target.read_text() == "keep me"
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--jobs", "0"], "argument --jobs: 0 is outside"),
+    (["--jobs", "two"], "argument --jobs: 'two' is not a whole number"),
+    (["--par", "x.yaml"], "unrecognized arguments: --par"),
+    (["--bogus"], "unrecognized arguments: --bogus"),
+    (["-o"], "argument -o/--output: expected one argument"),
+])
+def test_bad_flags_one_line_exit_2(tmp_path, capsys, args, message):
+    with pytest.raises(SystemExit) as e:
+        replay.main([str(BAGS / "hertz_ramp"), "-o", str(tmp_path / "out")] + args)
+    assert e.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_no_input_or_no_output_is_a_usage_error(capsys):
+    for args in ([], ["-o", "somewhere"], [str(BAGS / "hertz_ramp")]):
+        with pytest.raises(SystemExit, match="2"):
+            replay.main(args)
+        assert capsys.readouterr().err.count("\n") == 1
+
+
+def test_bad_params_file_exits_before_work(tmp_path, capsys):
+    params = tmp_path / "bad.yaml"
+    params.write_text("fastsim:\n  ros__parameters:\n    friction_coefficient: -1.0\n")
+    status, _, err = run([BAGS / "hertz_ramp", "-o", tmp_path / "out", "--params", params],
+                         capsys)
+    assert status == 2 and err.count("\n") == 1
+    assert str(params) in err and "friction_coefficient" in err
+    assert not (tmp_path / "out").exists()
+
+
+# ------------------------------------------------------------------------ golden files
+
+def write_golden() -> None:
+    """Regenerate ``bags/golden/<name>.csv.gz`` from the replay's own CSV output."""
+    import tempfile
+    GOLDEN.mkdir(exist_ok=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in NAMES:
+            status = replay.main([str(BAGS / name), "-o", tmp, "--csv", "--params",
+                                  str(BAGS / f"{name}.params.yaml")])
+            if status != 0:
+                raise SystemExit(f"replay of {name} failed")
+            data = (Path(tmp) / f"{name}.csv").read_bytes()
+            with open(GOLDEN / f"{name}.csv.gz", "wb") as f:
+                with gzip.GzipFile(filename="", mode="wb", fileobj=f, mtime=0) as z:
+                    z.write(data)
+            print(f"wrote {GOLDEN / name}.csv.gz ({len(data)} bytes of CSV)")
+
+
+if __name__ == "__main__":
+    if sys.argv[1:] != ["--write-golden"]:
+        raise SystemExit("usage: python test/test_replay.py --write-golden")
+    write_golden()
