@@ -36,6 +36,7 @@ from fastsim_ros.contact.equivalent import EquivalentEllipse
 from fastsim_ros.contact.errors import (ContactError, EmptyContactError, InvalidInputError,
                                         OutOfTableError)
 from fastsim_ros.contact.mae import MaeGeometry, Zone, ZoneFlexibility
+from fastsim_ros.contact.rules import ellipse_grid
 from fastsim_ros.contact.tables import coefficient_table
 
 FloatArray = NDArray[np.float64]
@@ -325,9 +326,7 @@ class EquivalentEllipseSolver(_Solver):
         grid = (math.nan,) * 4
         if tractions and result[0] == k.OK:
             e = self._ellipse(p, x0, y0, dx, dy)
-            # exactly the grid of area.ellipse(a, b, nx=n, ny=n).shifted(x_c, y_c)
-            grid = (-e.a + (e.a - -e.a) / n * 0.5 + e.x_c, -e.b + (e.b - -e.b) / n * 0.5 + e.y_c,
-                    2 * e.a / n, 2 * e.b / n)
+            grid = ellipse_grid(e.a, e.b, n, e.x_c, e.y_c)  # the kernel's grid, one formula
         return self._forces(result, grid, out, tractions)  # type: ignore[arg-type]
 
     def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
@@ -352,7 +351,7 @@ class EquivalentEllipseSolver(_Solver):
                                             self.shear_modulus, self._knots, self._polys, ell)
         if status not in (k.OK, k.E_TABLE_ELLIPSE):  # no table needed for the ellipse
             _raise(status, info, self._knots)
-        return EquivalentEllipse(*(float(v) for v in ell[k.E_XC:k.E_B + 1]))
+        return EquivalentEllipse(*(float(v) for v in ell[k.ELL_XC:k.ELL_B + 1]))
 
     def ellipse(self, area: GridArea) -> EquivalentEllipse:
         """Return the area's equivalent ellipse: centre and semi-axes (m)."""

@@ -22,6 +22,7 @@ from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
                                          traction_bound)
+from fastsim_ros.contact.rules import ellipse_cells
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
 
@@ -34,16 +35,6 @@ class EquivalentEllipse:
     y_c: float
     a: float
     b: float
-
-
-def ellipse_cells(cells_in_contact: int) -> int:
-    """Return the cells across the ellipse's box giving as many cells in contact as the patch.
-
-    An ellipse covers ``pi/4`` of its bounding box, so ``n = sqrt(4 N/pi)``:
-    the baseline then sweeps as many cells as MAE does, at the same
-    resolution, and neither is cheaper or finer than the other.
-    """
-    return max(2, round(math.sqrt(4.0 * cells_in_contact / math.pi)))
 
 
 def equivalent_ellipse(area: GridArea) -> EquivalentEllipse:

@@ -37,6 +37,8 @@ import math
 import numpy as np
 from numba import njit
 
+from fastsim_ros.contact import rules
+
 #: order of the coefficients in the ``polys`` array
 TABLE_NAMES = ("C11", "C22", "C23", "C33", "c11", "c12", "c13", "c21", "c22", "c23")
 I_C11, I_C22, I_C23 = 0, 1, 2
@@ -44,10 +46,10 @@ I_H11, I_H13, I_H22, I_H23 = 4, 6, 8, 9
 
 #: split rules of :func:`fastsim_ros.contact.mae.split_face`
 RULE_WIDEST_STRIP, RULE_CENTROID, RULE_AUTO = 0, 1, 2
-#: as fastsim_ros.contact.mae.MIN_ZONE_SHARE
-MIN_ZONE_SHARE = 0.15
+#: :data:`fastsim_ros.contact.rules.MIN_ZONE_SHARE` (a global: frozen into the kernels)
+MIN_ZONE_SHARE = rules.MIN_ZONE_SHARE
 
-#: status codes of the kernels
+#: status codes of the kernels (``E_*``; the result slots below have other prefixes)
 OK = 0
 E_GRID_NONFINITE = 1      # x0, y0, dx or dy is NaN or infinite
 E_CELL_SIZE = 2           # dx or dy not positive
@@ -70,7 +72,7 @@ G_ELLIPSE = 27              # the patch's equivalent ellipse x_c, y_c, a, b
 GEO_SIZE = 31
 
 #: layout of the equivalent-ellipse vector ``ell`` (see :func:`equivalent_prepare`)
-E_XC, E_YC, E_A, E_B, E_LOAD, E_L1, E_L2, E_L3, E_NCELLS = 0, 1, 2, 3, 4, 5, 6, 7, 8
+ELL_XC, ELL_YC, ELL_A, ELL_B, ELL_LOAD, ELL_L1, ELL_L2, ELL_L3, ELL_NCELLS = range(9)
 ELL_SIZE = 9
 
 # |tau|^2 <= (1 - 1e-12) g^2 proves |tau| < g without a square root: the
@@ -374,16 +376,6 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
 
 
 @njit(cache=True, error_model="numpy")
-def _round_half_even(v):
-    """Python's ``round(v)`` of a float: halves go to the even neighbour."""
-    r = math.floor(v)
-    d = v - r
-    if d > 0.5 or (d == 0.5 and r % 2.0 != 0.0):
-        r += 1.0
-    return int(r)
-
-
-@njit(cache=True, error_model="numpy")
 def split_face(count, rule):
     """Index ``f`` of the cell face the MAE split runs along, from the strips' counts.
 
@@ -420,7 +412,7 @@ def _centroid_face(count, yc):
     r1 = ny - 1
     while count[r1] == 0:
         r1 -= 1
-    return min(max(_round_half_even(yc + 0.5), r0), r1 + 1)
+    return min(max(round(yc + 0.5), r0), r1 + 1)  # Python's round: half to even
 
 
 @njit(cache=True, error_model="numpy")
@@ -716,12 +708,12 @@ def equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell):
     if status != OK:
         return status, 0.0
     x_c, y_c, a, b = ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy)
-    ell[E_XC] = x_c
-    ell[E_YC] = y_c
-    ell[E_A] = a
-    ell[E_B] = b
-    ell[E_LOAD] = total * (dx * dy)
-    ell[E_NCELLS] = n
+    ell[ELL_XC] = x_c
+    ell[ELL_YC] = y_c
+    ell[ELL_A] = a
+    ell[ELL_B] = b
+    ell[ELL_LOAD] = total * (dx * dy)
+    ell[ELL_NCELLS] = n
     ratio = a / b
     if not in_table(knots, ratio):
         return E_TABLE_ELLIPSE, ratio
@@ -729,9 +721,9 @@ def equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell):
     l1, l2, l3 = kalker_flexibility(a, b, spline(knots, polys[I_C11], t),
                                     spline(knots, polys[I_C22], t),
                                     spline(knots, polys[I_C23], t), shear_modulus)
-    ell[E_L1] = l1
-    ell[E_L2] = l2
-    ell[E_L3] = l3
+    ell[ELL_L1] = l1
+    ell[ELL_L2] = l2
+    ell[ELL_L3] = l3
     return OK, 0.0
 
 
@@ -745,21 +737,20 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, out_x, ou
     ellipse's centre.  Return as :func:`sweep`.
     """
     n = shape.shape[0]
-    x_c = ell[E_XC]
-    y_c = ell[E_YC]
-    a = ell[E_A]
-    b = ell[E_B]
-    gx0 = -a + (a - -a) / n * 0.5 + x_c
-    gy0 = -b + (b - -b) / n * 0.5 + y_c
+    x_c = ell[ELL_XC]
+    y_c = ell[ELL_YC]
+    a = ell[ELL_A]
+    b = ell[ELL_B]
+    gx0, gy0, gdx, gdy = ellipse_grid(a, b, n, x_c, y_c)
     flex = np.empty((4, n))
     for j in range(n):
-        flex[0, j] = ell[E_L1]
-        flex[1, j] = ell[E_L2]
-        flex[2, j] = ell[E_L3]
-        flex[3, j] = ell[E_L3]
+        flex[0, j] = ell[ELL_L1]
+        flex[1, j] = ell[ELL_L2]
+        flex[2, j] = ell[ELL_L3]
+        flex[3, j] = ell[ELL_L3]
     xi_s = xi + phi * (yp - y_c)
     eta_s = eta - phi * (xp - x_c)
-    return sweep(shape, mu, scale, env, gx0, gy0, 2 * a / n, 2 * b / n, xi_s, eta_s, phi,
+    return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi,
                  flex, x_c, y_c, xp, yp, out_x, out_y, slip, store)
 
 
@@ -815,18 +806,10 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT])
 
 
-@njit(cache=True, error_model="numpy")
-def ellipse_cells(cells_in_contact):
-    """Cells across the ellipse's box for as many cells in contact as the patch (``>= 2``).
-
-    As :func:`fastsim_ros.contact.equivalent.ellipse_cells` (Python's round: half to even).
-    """
-    v = math.sqrt(4.0 * cells_in_contact / math.pi)
-    r = math.floor(v)
-    frac = v - r
-    if frac > 0.5 or (frac == 0.5 and r % 2 == 1):
-        r += 1
-    return max(2, int(r))
+#: :func:`fastsim_ros.contact.rules.ellipse_cells` and
+#: :func:`~fastsim_ros.contact.rules.ellipse_grid`, compiled: the reference's formulas, no copies
+ellipse_cells = njit(cache=True, error_model="numpy")(rules.ellipse_cells)
+ellipse_grid = njit(cache=True, error_model="numpy")(rules.ellipse_grid)
 
 
 @njit(cache=True, error_model="numpy")
@@ -848,18 +831,18 @@ def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
     if n <= 0:
-        n = ellipse_cells(ell[E_NCELLS])
+        n = ellipse_cells(ell[ELL_NCELLS])
     if n < 2:
         return E_CELLS, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
     shape = np.empty((n, n))
     env = np.empty((2, n), dtype=np.int64)
-    a = ell[E_A]
-    b = ell[E_B]
+    a = ell[ELL_A]
+    b = ell[ELL_B]
     total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
-    scale = ell[E_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
+    scale = ell[ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
     fx, fy, mz, nslip, ncontact = equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi,
                                                    xp, yp, out_x, out_y, slip, store)
-    return OK, 0.0, fx, fy, mz, ell[E_LOAD], nslip, ncontact
+    return OK, 0.0, fx, fy, mz, ell[ELL_LOAD], nslip, ncontact
 
 
 # ---------------------------------------------------------------- batches
@@ -952,13 +935,13 @@ def equivalent_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, parabolic, n, shear_
                                               shear_modulus, knots, polys, ell)
             if status != OK:
                 return status, b, info
-            nb_cells = n if n > 0 else ellipse_cells(ell[E_NCELLS])
+            nb_cells = n if n > 0 else ellipse_cells(ell[ELL_NCELLS])
             shape = shape_all[:nb_cells, :nb_cells]
             env = env_all[:, :nb_cells]
-            a = ell[E_A]
-            bb = ell[E_B]
+            a = ell[ELL_A]
+            bb = ell[ELL_B]
             total, _ = ellipse_shape(nb_cells, a, bb, not parabolic, shape, env)
-            scale = ell[E_LOAD] / (total * ((2 * a / nb_cells) * (2 * bb / nb_cells)))
+            scale = ell[ELL_LOAD] / (total * ((2 * a / nb_cells) * (2 * bb / nb_cells)))
         prev_pb = pb
         fx, fy, mz, _, _ = equivalent_sweep(ell, shape, scale, mu[b], env, xi, eta, phi, xp,
                                             yp, empty_f, empty_f, empty_b, False)

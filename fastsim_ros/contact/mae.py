@@ -28,13 +28,12 @@ from fastsim_ros.contact.checks import SplitRule, check_split_rule
 from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
+from fastsim_ros.contact.rules import MIN_ZONE_SHARE
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
 
 FloatArray = NDArray[np.float64]
 DEFAULT_SPLIT: SplitRule = "auto"
-#: the smallest share of the area a ``widest_strip`` zone may have under ``auto``
-MIN_ZONE_SHARE = 0.15
 
 
 @dataclass(frozen=True)
