@@ -23,7 +23,9 @@ from typing import Any
 import rclpy
 from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
                               ParameterException)
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
+from rclpy.experimental import EventsExecutor
+from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -180,6 +182,19 @@ def _one_line(error: Exception, spec: parameters.ParameterSpec) -> str:
             f"{spec.allowed()}")
 
 
+def make_executor(kind: str) -> Executor:
+    """Return the executor ``kind`` names (``events`` or ``single_threaded``).
+
+    The events executor (C++, rclpy.experimental) costs a few microseconds per
+    callback where the Python executor rebuilds its wait set each time: at
+    several kHz of patches that is the difference between keeping up or not
+    (benchmarks/bench_node.py).
+    """
+    if kind == "events":
+        return EventsExecutor()
+    return SingleThreadedExecutor()
+
+
 def main(args: Sequence[str] | None = None) -> int:
     """Run the node until SIGINT or SIGTERM; return the exit status (2: bad parameters)."""
     rclpy.init(args=list(args) if args is not None else None)
@@ -187,11 +202,18 @@ def main(args: Sequence[str] | None = None) -> int:
     status = 0
     try:
         node = FastsimNode()
-        executor = SingleThreadedExecutor()
+        executor = make_executor(node.pipeline.config["executor"])
         executor.add_node(node)
-        executor.spin()
+        # spin_once in a loop, not spin(): the events executor's spin() neither
+        # runs Python timers nor returns on SIGTERM in this rclpy; spin_once
+        # raises ExternalShutdownException once the signal shut the context down
+        while rclpy.ok():
+            executor.spin_once(timeout_sec=0.25)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except _rclpy.RCLError:
+        if rclpy.ok():  # not a signal arriving while the node was being built
+            raise
     except StartupError as e:
         print(f"fastsim_node: {e}", file=sys.stderr)
         status = 2

@@ -149,6 +149,10 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("output_reliability", "string", "reliable",
                   "QoS reliability of the publishers (reliable matches every subscriber)",
                   choices=("reliable", "best_effort")),
+    ParameterSpec("executor", "string", "events",
+                  "rclpy executor: events (rclpy.experimental.EventsExecutor, C++: a few us "
+                  "per callback) or single_threaded (the classic Python executor)",
+                  choices=("events", "single_threaded")),
     ParameterSpec("qos_depth", "integer", 10, "history depth of every subscription and "
                   "publisher", low=1, high=10000),
 )

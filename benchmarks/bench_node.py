@@ -1,0 +1,282 @@
+"""Benchmark fastsim_node over DDS on loopback: drops, latency, CPU, memory.
+
+The node runs from its installed console script in its own process (its own
+DDS domain, localhost only); this driver publishes, for each of ``--contacts``
+contacts, a 30 x 30-cell patch at ``--rate`` Hz (pre-serialised CDR with the
+stamp patched in, so the driver's own cost stays small) plus the wheelset
+twist at the same rate, and collects the wrenches (raw, stamp read from the
+bytes).  It prints inputs sent, wrenches received, drops, latency (patch
+published -> wrench received, wall clock of this process) p50/p99/max, the
+node's CPU share (from /proc), and with ``--soak MINUTES`` the node's
+resident memory sampled every 10 s.  ``--profile`` first times the node's
+per-message path in this process (decode + adapt + solve + encode, and an
+rclpy publish) to show where the time goes.
+
+    .venv/bin/python benchmarks/bench_node.py --contacts 2 4 --seconds 20
+    .venv/bin/python benchmarks/bench_node.py --contacts 4 --soak 10
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import signal
+import statistics
+import struct
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+os.environ.setdefault("ROS_DOMAIN_ID", str(150 + os.getpid() % 50))
+os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
+
+import rclpy  # noqa: E402
+from rclpy.context import Context  # noqa: E402
+from rclpy.executors import SingleThreadedExecutor  # noqa: E402
+from rclpy.node import Node  # noqa: E402
+from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
+from rclpy.serialization import serialize_message  # noqa: E402
+
+from geometry_msgs.msg import TwistStamped, WrenchStamped  # noqa: E402
+from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
+
+from fastsim_ros.contact import samples  # noqa: E402
+from msg_adapters import patch as pa  # noqa: E402
+
+NODE = ROOT / "install" / "fastsim_ros" / "lib" / "fastsim_ros" / "fastsim_node"
+RADIUS = 0.46
+_STAMP = struct.Struct("<iI")
+
+
+def machine() -> str:
+    """Return a one-line description of this machine."""
+    cpu = "unknown cpu"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return (f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, "
+            f"numpy {np.__version__}")
+
+
+def patch_cdr(k: int) -> bytearray:
+    """Return the CDR of contact ``k``'s 30 x 30-cell patch (two semi-ellipses, 60 kN)."""
+    area = samples.semi_ellipses_patch(0.5, 2.0, cells=30, scale=8e-3, load=6e4)
+    frame = pa.frame_from_normal((0.0, 0.0, 1.0))
+    pts = pa.planar_points((0.0, 0.75 - 0.5 * k, -RADIUS), frame, area.x0, area.y0, area.dx,
+                           area.dy, area.ny, area.nx)
+    fields, step, data = pa.cloud_bytes(pts, np.array([0.0, 0.0, 1.0]), area.pressure)
+    m = PointCloud2()
+    m.header.frame_id = "wheelset"
+    m.height, m.width = area.pressure.shape
+    m.fields = [PointField(name=n, offset=o, datatype=7, count=1) for n, o in fields]
+    m.point_step, m.row_step = step, step * area.nx
+    m.data = data
+    m.is_dense = True
+    return bytearray(serialize_message(m))
+
+
+def twist_cdr(xi: float = 1e-3, speed: float = 20.0) -> bytearray:
+    """Return the CDR of a wheelset twist on track with creepage ``xi``."""
+    t = TwistStamped()
+    t.header.frame_id = "wheelset"
+    t.twist.linear.x = speed
+    t.twist.angular.y = speed * (1 - xi / 2) / (1 + xi / 2) / RADIUS
+    return bytearray(serialize_message(t))
+
+
+def set_stamp(buf: bytearray, stamp_ns: int) -> bytes:
+    """Write a header stamp into a CDR message (bytes 4..12) and return the bytes."""
+    _STAMP.pack_into(buf, 4, *divmod(stamp_ns, 1_000_000_000))
+    return bytes(buf)
+
+
+def cpu_seconds(pid: int) -> float:
+    """Return user + system CPU seconds of a process."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def rss_mib(pid: int) -> float:
+    """Return a process's resident memory (MiB)."""
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def profile(calls: int) -> None:
+    """Time the node's per-message path in this process, step by step."""
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from msg_adapters import cdr
+    from fastsim_ros.contact import compiled
+    compiled.warm_up()
+    pipe = Pipeline(PipelineConfig.from_values({"contacts": ["left"],
+                                                "publish_markers": False}))
+    patch = patch_cdr(0)
+    twist = twist_cdr()
+    pipe.on_wheel_twist(set_stamp(twist, 1))
+    steps: dict[str, list[float]] = {"decode (CDR view)": [], "adapt (frame, grid)": [],
+                                     "whole on_patch": [], "messages (encode)": []}
+    for i in range(calls):
+        raw = set_stamp(patch, 1 + i)
+        t0 = time.perf_counter()
+        c = cdr.read_cloud(raw)
+        t1 = time.perf_counter()
+        pa.patch_from_cloud(c, max_cells=16384)
+        t2 = time.perf_counter()
+        out = pipe.on_patch("left", raw)
+        t3 = time.perf_counter()
+        pipe.messages(out)
+        t4 = time.perf_counter()
+        for key, dt in zip(steps, (t1 - t0, t2 - t1, t3 - t2, t4 - t3)):
+            steps[key].append(dt * 1e6)
+    p50, p99 = pipe.report("left").values[4:6]
+    print(f"per-message path, {calls} calls (us): median / p99")
+    for key, v in steps.items():
+        print(f"  {key:22s} {statistics.median(v):7.1f} / {np.percentile(v, 99):7.1f}")
+    print(f"  solve alone (pipeline stats) {p50[1]} / {p99[1]}")
+    ctx = Context()
+    rclpy.init(context=ctx)
+    node = Node("bench_publish", context=ctx)
+    pub = node.create_publisher(WrenchStamped, "bench/wrench", 10)
+    data = pipe.messages(out)[0][1]
+    msg = WrenchStamped()
+    for label, item in (("publish(bytes)", data), ("publish(WrenchStamped)", msg)):
+        times = []
+        for _ in range(calls):
+            t0 = time.perf_counter()
+            pub.publish(item)
+            times.append((time.perf_counter() - t0) * 1e6)
+        print(f"  {label:22s} {statistics.median(times):7.1f} / {np.percentile(times, 99):7.1f}")
+    node.destroy_node()
+    rclpy.shutdown(context=ctx)
+
+
+def run(contacts: int, rate: float, seconds: float, soak: float, executor: str) -> None:
+    """Drive one node with ``contacts`` contacts at ``rate`` Hz each and print the figures."""
+    names = [f"c{k}" for k in range(contacts)]
+    proc = subprocess.Popen([str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",
+                             "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    ctx = Context()
+    rclpy.init(context=ctx)
+    node = Node("bench_driver", context=ctx)
+    ex = SingleThreadedExecutor(context=ctx)
+    ex.add_node(node)
+    qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
+    sent: dict[tuple[int, int], float] = {}
+    latency: list[float] = []
+    received = [0] * contacts
+
+    def on_wrench(k: int):
+        def callback(raw: bytes) -> None:
+            now = time.perf_counter()
+            sec, nanosec = _STAMP.unpack_from(raw, 4)
+            t = sent.pop((k, sec * 1_000_000_000 + nanosec), None)
+            if t is not None:
+                latency.append(now - t)
+                received[k] += 1
+        return callback
+
+    pubs = [node.create_publisher(PointCloud2, f"contact/{n}/patch", qos) for n in names]
+    twist_pub = node.create_publisher(TwistStamped, "wheelset/twist", qos)
+    for k, n in enumerate(names):
+        node.create_subscription(WrenchStamped, f"contact/{n}/wrench", on_wrench(k), qos,
+                                 raw=True)
+    patches = [patch_cdr(k) for k in range(contacts)]
+    twist = twist_cdr()
+    start = time.monotonic()
+    while not (all(p.get_subscription_count() for p in pubs)
+               and node.count_publishers(f"/contact/{names[-1]}/wrench")):
+        ex.spin_once(timeout_sec=0.05)
+        if time.monotonic() - start > 30 or proc.poll() is not None:
+            raise SystemExit("the node did not come up")
+    for _ in range(50):
+        ex.spin_once(timeout_sec=0.01)
+    duration = soak * 60.0 if soak else seconds
+    period = 1.0 / rate
+    rss = [(0.0, rss_mib(proc.pid))]
+    cpu0, wall0 = cpu_seconds(proc.pid), time.perf_counter()
+    t_next = wall0
+    stamp = 1_700_000_000 * 1_000_000_000
+    inputs = 0
+    late = 0
+    last_rss = wall0
+    while True:
+        now = time.perf_counter()
+        if now - wall0 >= duration:
+            break
+        if now >= t_next:
+            stamp += round(period * 1e9)
+            twist_pub.publish(set_stamp(twist, stamp - 1000))
+            for k, p in enumerate(pubs):
+                sent[(k, stamp)] = time.perf_counter()
+                p.publish(set_stamp(patches[k], stamp))
+                inputs += 1
+            t_next += period
+            if now - t_next > 10 * period:  # the driver itself fell behind: re-anchor
+                late += 1
+                t_next = now + period
+        ex.spin_once(timeout_sec=max(0.0, min(t_next - time.perf_counter(), period)))
+        if soak and now - last_rss >= 10.0:
+            last_rss = now
+            rss.append((now - wall0, rss_mib(proc.pid)))
+    wall = time.perf_counter() - wall0
+    cpu = cpu_seconds(proc.pid) - cpu0
+    drain = time.perf_counter()
+    while time.perf_counter() - drain < 1.0:
+        ex.spin_once(timeout_sec=0.01)
+    rss.append((time.perf_counter() - wall0, rss_mib(proc.pid)))
+    proc.send_signal(signal.SIGTERM)
+    status = proc.wait(10)
+    node.destroy_node()
+    rclpy.shutdown(context=ctx)
+    got = sum(received)
+    lat = np.array(latency) * 1e3 if latency else np.array([np.nan])
+    print(f"{executor:15s} {contacts} contacts x {rate:g} Hz for {wall:.1f} s: sent {inputs}, "
+          f"wrenches {got}, dropped {inputs - got} ({100.0 * (inputs - got) / inputs:.2f}%), "
+          f"latency p50 {np.median(lat):.3f} ms, p99 {np.percentile(lat, 99):.3f} ms, "
+          f"max {lat.max():.3f} ms; node CPU {100.0 * cpu / wall:.0f}% of one core; "
+          f"driver re-anchored {late} times; node exit {status}")
+    if soak:
+        first = rss[1][1] if len(rss) > 2 else rss[0][1]
+        samples_text = ", ".join(f"{t:.0f}: {m:.1f}" for t, m in rss)
+        print(f"  node RSS (MiB) over time (s): {samples_text}")
+        print(f"  growth after the first 10 s: {100.0 * (rss[-1][1] - first) / first:+.1f}%")
+
+
+def main() -> None:
+    """Run the benchmark."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    parser.add_argument("--contacts", type=int, nargs="+", default=[2, 4])
+    parser.add_argument("--rate", type=float, default=1000.0, help="patches per second each")
+    parser.add_argument("--seconds", type=float, default=20.0)
+    parser.add_argument("--soak", type=float, default=0.0, metavar="MINUTES")
+    parser.add_argument("--executors", nargs="+", default=["events"],
+                        choices=["events", "single_threaded"],
+                        help="the node's executor parameter; several: side by side")
+    parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
+                        help="first time the per-message path in-process")
+    args = parser.parse_args()
+    print(f"machine: {machine()}")
+    if not NODE.exists():
+        raise SystemExit(f"{NODE} is missing: run scripts/setup_env.sh")
+    if args.profile:
+        profile(args.profile)
+    for n in args.contacts:
+        for executor in args.executors:
+            run(n, args.rate, args.seconds, args.soak, executor)
+
+
+if __name__ == "__main__":
+    main()
