@@ -32,7 +32,10 @@ directory's name, or the file's without ``.mcap``) gives:
 Messages are fed to :class:`~fastsim_ros.pipeline.Pipeline` in the bag's
 log-time order, raw CDR as read.  Without ``--params`` every parameter has
 its default.  Everything is written under a temporary name inside ``OUT``
-and renamed at the end; on failure, Ctrl-C or SIGTERM nothing is left.
+and renamed at the end; on failure, Ctrl-C or SIGTERM nothing is left of
+an unfinished input (inputs already done, whose summaries were printed, stay).
+A progress bar (tqdm, on stderr) appears when stderr is a terminal, ``--jobs``
+is 1 and a bag takes more than a second.
 
 Exit status: 0 all done; 2 bad flags, a bad params file, two inputs with the
 same NAME or a target that exists (all before any work), or a bad, corrupt,
@@ -613,8 +616,10 @@ def _fail(message: str) -> int:
     return 2
 
 
-def _ignore_sigint() -> None:
+def _worker_signals() -> None:
+    """Let a worker ignore Ctrl-C and die of SIGTERM: the main process stops it and cleans up."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 def _terminate(signum: int, frame: Any) -> None:
@@ -666,7 +671,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                                          for name, src in names.items())
         else:
             pool = cf.ProcessPoolExecutor(jobs, mp_context=multiprocessing.get_context("fork"),
-                                          initializer=_ignore_sigint)
+                                          initializer=_worker_signals)
             futures = [pool.submit(replay_bag, src, name, out, values, **kwargs)
                        for name, src in names.items()]
             results = (f.result() for f in futures)
@@ -700,6 +705,9 @@ def _stop(pool: cf.ProcessPoolExecutor | None) -> None:
         proc.terminate()
     for proc in processes:
         proc.join(timeout=5)
+        if proc.is_alive():
+            proc.kill()
+            proc.join(timeout=5)
     pool.shutdown(wait=False, cancel_futures=True)
 
 

@@ -18,8 +18,10 @@ import io
 import json
 import math
 import shutil
+import signal
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -510,6 +512,31 @@ def test_interrupt_leaves_nothing(tmp_path, monkeypatch, capsys):
                           "--plot"], capsys)
     assert status == 130 and "interrupted" in err
     assert list(out.iterdir()) == []
+
+
+def test_sigterm_with_jobs_2_stops_the_workers_and_leaves_no_partial_output(tmp_path):
+    src = tmp_path / "in"
+    src.mkdir()
+    for k in range(6):
+        (src / f"f{k}").symlink_to(BAGS / "flange_shift", target_is_directory=True)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "fastsim_ros.replay", *sorted(map(str, src.iterdir())), "-o",
+         str(out), "--jobs", "2", "--csv", "--params", str(BAGS / "flange_shift.params.yaml")],
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 60
+    while not (out.is_dir() and any(p.name.endswith(".replay-tmp") for p in out.iterdir())):
+        assert time.monotonic() < deadline and proc.poll() is None
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGTERM)
+    # the workers die with the main process: nothing keeps the pipes open
+    stdout, stderr = proc.communicate(timeout=30)
+    assert proc.returncode == 130 and "interrupted" in stderr and "Traceback" not in stderr
+    left = sorted(p.name for p in out.iterdir())
+    done = [line.split(":")[0] for line in stdout.splitlines() if "messages in" in line]
+    assert left == sorted([n for n in done] + [f"{n}.csv" for n in done])
+    time.sleep(1.0)  # no orphan still writing
+    assert sorted(p.name for p in out.iterdir()) == left
 
 
 # ------------------------------------------------------------------------ before any work
