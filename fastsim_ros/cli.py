@@ -35,7 +35,6 @@ import numpy as np
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 
-EXACT_GRIDS = (0.4, 0.6, 0.8, 1.0)
 #: cells across the bounding box of a shape, per method: exact coefficients are
 #: extrapolated from grids up to this; FastSim's discretisation error at 60
 #: cells is 0.1% on ellipses (docs/validation.md).
@@ -323,10 +322,6 @@ def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridAr
             f"semi-ellipses a1/b1={g[0]:g}, a2/b2={g[1]:g}")
 
 
-def _grid_sequence(finest: int) -> list[int]:
-    return sorted({max(4, 2 * round(f * finest / 2)) for f in EXACT_GRIDS})
-
-
 COEFFICIENT_KEYS = ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33", "area")
 
 
@@ -341,14 +336,11 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     result: dict[str, Any]
     if args.method == "exact" and args.patch is None:
         finest = args.cells or DEFAULT_CELLS["exact"]
-        grids = _grid_sequence(finest)
-        per = [exact.creep_coefficients(make(n), nu=args.nu) for n in grids]
-        h = np.array([1.0 / n for n in grids])
-        result = {}
-        for key in COEFFICIENT_KEYS[:-1]:
-            # first-order convergence in the cell size (METHOD.md 5)
-            result[key] = float(np.polyfit(h, [getattr(c, key) for c in per], 1)[1])
-        result.update(area=1.0, cells=grids, extrapolated=True)
+        # first-order extrapolation to zero cell size (METHOD.md 5)
+        ext = exact.extrapolated_coefficients(args.shape, tuple(args.a_over_b), nu=args.nu,
+                                              finest=finest)
+        result = dict(ext.as_dict())
+        result.update(cells=exact.extrapolation_grids(finest), extrapolated=True)
     else:
         ar = make(args.cells or DEFAULT_CELLS[args.method])
         if args.method == "exact":

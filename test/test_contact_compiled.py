@@ -58,7 +58,7 @@ def random_patch() -> GridArea:
     return GridArea(ar.x0 + 1e-3, ar.y0 - 2e-3, ar.dx, ar.dy, p)
 
 
-# name: (area, reference point (m), size for the Mz scale (m))
+# name: (a function making the area, reference point (m))
 AREAS = {
     "hertz_ellipse": (lambda: areas.ellipse(6e-3, 4e-3, nx=30, load=5e4), (0.0, 0.0)),
     "parabolic_ellipse": (lambda: areas.ellipse(4e-3, 6e-3, nx=24, ny=20, load=5e4,
@@ -414,7 +414,9 @@ def test_bad_input_is_refused(solver_type, change, error, match):
     args.update({k: v for k, v in change.items() if k in args})
     kwargs = {k: v for k, v in change.items() if k in ("reference", "bound")}
     with pytest.raises(error, match=match):
-        solver_type(NU, G).solve_arrays(p, *args.values(), **kwargs)
+        solver_type(NU, G).solve_arrays(p, args["x0"], args["y0"], args["dx"], args["dy"],
+                                        args["xi"], args["eta"], args["phi"], args["mu"],
+                                        **kwargs)
 
 
 def test_zone_outside_the_table_is_refused(table):

@@ -45,14 +45,23 @@ def test_eta_coefficient_of_mz_equals_c23_on_every_grid(g, n):
 
 
 def test_circle_converges_to_kalker():
-    # First-order extrapolation in the cell size (METHOD.md 5) over four grids.
-    a, b = areas.semi_ellipse_axes(1.0)
-    grids = (40, 60, 80, 100)
-    values = [exact.creep_coefficients(areas.ellipse(a, b, nx=n), nu=0.25) for n in grids]
-    h = [1.0 / n for n in grids]
+    # First-order extrapolation in the cell size (METHOD.md 5) over four grids, 40 .. 100
+    # cells across; cached, so the command line's test of the same circle reuses it.
+    assert exact.extrapolation_grids(100) == [40, 60, 80, 100]
+    c = exact.extrapolated_coefficients("ellipse", (1.0,), nu=0.25)
     for key, published in KALKER_NU025_CIRCLE.items():
-        c0 = np.polyfit(h, [getattr(v, key) for v in values], 1)[1]
-        assert c0 == pytest.approx(published, rel=0.01), key
+        assert getattr(c, key) == pytest.approx(published, rel=0.01), key
+
+
+def test_extrapolation_is_the_first_order_fit_over_its_grids():
+    c = exact.extrapolated_coefficients("semi-ellipses", (0.5, 2.0), nu=0.25, finest=20)
+    grids = exact.extrapolation_grids(20)
+    per = [exact.creep_coefficients(areas.semi_ellipses(0.5, 2.0, cells=n), nu=0.25)
+           for n in grids]
+    fit = np.polyfit([1.0 / n for n in grids], [v.C13 for v in per], 1)[1]
+    assert c.C13 == fit and c.area == 1.0
+    with pytest.raises(InvalidInputError, match="unknown shape"):
+        exact.extrapolated_coefficients("ellipse", (1.0, 2.0), nu=0.25)
 
 
 def test_mirror_in_y_flips_c13_only():

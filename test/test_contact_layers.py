@@ -35,7 +35,7 @@ ALLOWED = {
     "exact": {"numpy", "scipy", "area", "checks", "coefficients", "errors", "influence",
               "traction"},
     "normal": {"numpy", "scipy", "area", "checks", "errors", "influence"},
-    "samples": {"numpy", "area", "normal"},
+    "samples": {"numpy", "area", "errors", "normal"},
 }
 
 

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -36,8 +37,9 @@ import scipy.linalg
 import scipy.sparse.linalg
 from numpy.typing import NDArray
 
-from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.checks import check_creepages, check_friction, check_material
+from fastsim_ros.contact.area import GridArea, ellipse, semi_ellipse_axes, semi_ellipses
+from fastsim_ros.contact.checks import (check_creepages, check_friction, check_material,
+                                        check_poisson_ratio)
 from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
 from fastsim_ros.contact.errors import ConvergenceError, InvalidInputError
@@ -46,6 +48,7 @@ from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
 
 FloatArray = NDArray[np.float64]
 SolverKind = Literal["fft", "dense"]
+ShapeName = Literal["ellipse", "semi-ellipses"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -443,3 +446,54 @@ def creep_coefficients(area: GridArea, *, nu: float,
     sols = unit_solutions(area, nu=nu, reference=reference, solver=solver)
     return coefficients_from_unit_solutions(
         area.area, tuple((s.fx, s.fy, s.mz) for s in sols), reference=reference)
+
+
+#: the grids of an extrapolation, as fractions of the finest (METHOD.md 5: at least four)
+EXTRAPOLATION_GRIDS = (0.4, 0.6, 0.8, 1.0)
+
+
+def extrapolation_grids(finest: int) -> list[int]:
+    """Return the even cell counts of an extrapolation up to ``finest`` cells across."""
+    return sorted({max(4, 2 * round(f * finest / 2)) for f in EXTRAPOLATION_GRIDS})
+
+
+def extrapolated_coefficients(shape: ShapeName, ratios: tuple[float, ...], *, nu: float,
+                              finest: int = 100) -> CreepCoefficients:
+    """Return the exact coefficients of a unit-area shape extrapolated to zero cell size.
+
+    ``shape``: ``"ellipse"`` (``ratios = (a/b,)``) or ``"semi-ellipses"``
+    (``ratios = (a1/b1, a2/b2)``), area 1 m^2, about the centre (the join
+    line's middle); solved on :func:`extrapolation_grids` ``(finest)`` cells
+    across and fitted by ``C(h) = C0 + k h`` in the cell size ``h = 1/n``
+    (first-order convergence, METHOD.md 5); ``area`` is 1.  Cached: the
+    extrapolation takes seconds and its result is immutable.
+    """
+    # one cache key however the call spells its arguments
+    return _extrapolated(str(shape), tuple(float(g) for g in ratios), float(nu), int(finest))
+
+
+@lru_cache(maxsize=32)
+def _extrapolated(shape: str, ratios: tuple[float, ...], nu: float,
+                  finest: int) -> CreepCoefficients:
+    check_poisson_ratio(nu)
+    if shape == "ellipse" and len(ratios) == 1:
+        a, b = semi_ellipse_axes(ratios[0])
+
+        def make(n: int) -> GridArea:
+            return ellipse(a, b, nx=n, ny=n)
+    elif shape == "semi-ellipses" and len(ratios) == 2:
+        semi_ellipse_axes(ratios[0])
+        semi_ellipse_axes(ratios[1])
+
+        def make(n: int) -> GridArea:
+            return semi_ellipses(ratios[0], ratios[1], cells=n)
+    else:
+        raise InvalidInputError(f"unknown shape {shape!r} with a/b {ratios}: an ellipse takes "
+                                "one ratio, semi-ellipses two")
+    grids = extrapolation_grids(finest)
+    per = [creep_coefficients(make(n), nu=nu) for n in grids]
+    h = np.array([1.0 / n for n in grids])
+    fit = {key: float(np.polyfit(h, [getattr(c, key) for c in per], 1)[1])
+           for key in ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33")}
+    return CreepCoefficients(fit["C11"], fit["C12"], fit["C13"], fit["C21"], fit["C22"],
+                             fit["C23"], fit["C31"], fit["C32"], fit["C33"], area=1.0)

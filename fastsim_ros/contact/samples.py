@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from fastsim_ros.contact.area import GridArea, semi_ellipse_axes, semi_ellipses
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.normal import solve_normal
 
 #: wheel-rail values used by the samples (Pa, -, m)
@@ -119,7 +120,7 @@ def flange_root_patch(*, cells: int, load: float = 5.0e4) -> GridArea:
     sol = solve_normal(float(x[0]), float(y[0]), dx, dy, gap, load=load,
                        shear_modulus=STEEL_G, nu=STEEL_NU)
     if sol.touches_edge:
-        raise RuntimeError("the flange-root box is too small for the load")
+        raise InvalidInputError(f"the flange-root box is too small for a load of {load:g} N")
     return sol.area.cropped()
 
 
