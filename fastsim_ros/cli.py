@@ -33,6 +33,8 @@ from typing import Any, NoReturn
 import numpy as np
 
 from fastsim_ros.contact import area as areas
+from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
+                                        check_poisson_ratio)
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 
 #: cells across the bounding box of a shape, per method: exact coefficients are
@@ -143,7 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
     fo.add_argument("--method", choices=("mae", "fastsim_ellipse", "exact"), default="mae")
-    fo.add_argument("--bound", choices=("given", "parabolic"), default="given",
+    fo.add_argument("--bound", choices=BOUNDS, default="given",
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch)")
     return parser
@@ -263,11 +265,12 @@ def _in_range(name: str, value: float, key: str, unit: str = "", *,
 
 
 def _check_material(nu: float, shear_modulus: float | None = None) -> None:
-    """Run the library's material check, then the command line's range of ``G``."""
-    from fastsim_ros.contact.exact import check_material
-    check_material(nu, 1.0 if shear_modulus is None else shear_modulus)
-    if shear_modulus is not None:
-        _in_range("--shear-modulus", shear_modulus, "shear_modulus", " Pa")
+    """Run the library's material checks, then the command line's range of ``G``."""
+    if shear_modulus is None:
+        check_poisson_ratio(nu)
+        return
+    check_material(nu, shear_modulus)
+    _in_range("--shear-modulus", shear_modulus, "shear_modulus", " Pa")
 
 
 def _check_exact_grid(area: areas.GridArea, *, forces: bool) -> None:
@@ -368,8 +371,7 @@ FORCE_KEYS = ("Fx", "Fy", "Mz", "N", "slip_fraction")
 def forces(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``forces``: a dict of the results (the same keys for every method, and extras)."""
     _check_material(args.nu, args.shear_modulus)
-    if not args.mu > 0.0:
-        raise InvalidInputError(f"mu must be positive, got {args.mu:g}")
+    check_friction(args.mu)
     _in_range("mu", args.mu, "mu", open_low=True)
     _in_range("xi", args.xi, "creepage", magnitude=True)
     _in_range("eta", args.eta, "creepage", magnitude=True)
