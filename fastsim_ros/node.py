@@ -17,6 +17,7 @@ every subscriber), depth ``qos_depth``; both configurable at start.
 from __future__ import annotations
 
 import sys
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -40,6 +41,7 @@ from visualization_msgs.msg import MarkerArray
 
 from fastsim_ros import params as parameters
 from fastsim_ros.contact import compiled
+from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, RAIL_TWIST_TOPIC,
                                   WHEEL_TWIST_TOPIC, WHEELSET_WRENCH_TOPIC, Outcome, Pipeline,
                                   PipelineConfig, patch_topic)
@@ -95,6 +97,9 @@ class FastsimNode(Node):
             raise StartupError(_one_line(e, spec)) from None
         config = PipelineConfig.from_values(values)
         warm = compiled.warm_up()
+        start = time.perf_counter()
+        patch_adapter.warm_up()
+        warm += time.perf_counter() - start
         self.pipeline = Pipeline(config)
         depth = int(config["qos_depth"])
         qos_in = _qos(config["patch_reliability"], depth)

@@ -665,7 +665,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     pool: cf.ProcessPoolExecutor | None = None
     try:
         from fastsim_ros.contact import compiled
+        from msg_adapters import patch as patch_adapter
         compiled.warm_up()  # load the kernels once (the forked workers inherit them)
+        patch_adapter.warm_up()
         if jobs == 1:
             results: Iterator[Result] = (replay_bag(src, name, out, values, **kwargs)
                                          for name, src in names.items())

@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from msg_adapters import patch_kernels as kernels
 from msg_adapters.cdr import Cloud
 from msg_adapters.errors import RejectedInput
 
@@ -93,7 +95,7 @@ class ContactPatch:
     ``load``: ``N = sum p dA`` (N); ``cells``: cells in contact.
     ``row_order`` and ``column_order``: +1 or -1, how rows and columns map
     to the cloud's (-1: reversed), so that results can be laid back on the
-    cloud's points (``points``, the cells' positions in the wheelset frame).
+    cloud's points.
     """
 
     stamp_ns: int
@@ -107,14 +109,30 @@ class ContactPatch:
     cells: int
     row_order: int
     column_order: int
-    points: FloatArray
 
 
-def _field_columns(cloud: Cloud) -> tuple[str, list[int], int]:
-    """Check the patch fields; return ``(numpy dtype, byte offsets, size)``."""
+@dataclass(frozen=True, slots=True)
+class _Layout:
+    """Where the patch fields lie in a point: checked once per layout and reused."""
+
+    dtype: str          # numpy dtype of every field ("" when their types differ)
+    offsets: tuple[int, ...]
+    widths: tuple[int, ...]
+    cols: NDArray[np.int64] | None  # word offsets when the buffer can be viewed as words
+
+
+_LAYOUTS: dict[tuple[Any, ...], _Layout] = {}
+
+
+def _layout(cloud: Cloud) -> _Layout:
+    """Check the patch fields; return their layout (cached: a topic keeps its layout)."""
+    key = (tuple(cloud.fields.items()), cloud.is_bigendian, cloud.point_step, cloud.row_step)
+    hit = _LAYOUTS.get(key)
+    if hit is not None:
+        return hit
     order = ">" if cloud.is_bigendian else "<"
     offsets: list[int] = []
-    sizes: set[int] = set()
+    widths: list[int] = []
     for name in PATCH_FIELDS:
         spec = cloud.fields.get(name)
         if spec is None:
@@ -127,86 +145,64 @@ def _field_columns(cloud: Cloud) -> tuple[str, list[int], int]:
             raise RejectedInput("irregular_grid", f"field {name!r} at byte {spec.offset} "
                                 f"lies outside the point_step of {cloud.point_step}")
         offsets.append(spec.offset)
-        sizes.add(size)
-    if len(sizes) > 1:
-        return "", offsets, 0
-    size = sizes.pop()
-    return order + ("f4" if size == 4 else "f8"), offsets, size
+        widths.append(size)
+    size = widths[0]
+    viewable = (all(w == size for w in widths) and not cloud.point_step % size
+                and not cloud.row_step % size and not any(o % size for o in offsets))
+    layout = _Layout(order + ("f4" if size == 4 else "f8") if viewable else "",
+                     tuple(offsets), tuple(widths),
+                     np.array([o // size for o in offsets], dtype=np.int64) if viewable
+                     else None)
+    if len(_LAYOUTS) < 256:
+        _LAYOUTS[key] = layout
+    return layout
 
 
-def _field_values(cloud: Cloud) -> FloatArray:
-    """Return the patch fields as ``(ny * nx, 7)`` float64, in PATCH_FIELDS order.
+def _words(cloud: Cloud) -> tuple[NDArray[Any], int, int, NDArray[np.int64]]:
+    """Return the cloud's points as native floats ``(words, row, step, cols)``.
 
-    Where every field has one type and all offsets and steps are multiples
-    of its size (the usual layout), the buffer is viewed as one array and
-    the seven columns are gathered in one copy; otherwise per field.
+    Point ``(j, i)`` starts at word ``j * row + i * step`` of ``words``;
+    ``cols``: word offsets of the PATCH_FIELDS.  Where every field has one
+    type and all offsets and steps are multiples of its size (the usual
+    layout) ``words`` is a view of the buffer (a copy only when its byte
+    order is not the machine's); otherwise the fields are gathered one by
+    one into a ``(ny * nx, 7)`` float64 array.
     """
     ny, nx = cloud.height, cloud.width
-    dtype, offsets, size = _field_columns(cloud)
-    if cloud.row_step < nx * cloud.point_step or len(cloud.data) < (
-            (ny - 1) * cloud.row_step + nx * cloud.point_step):
+    layout = _layout(cloud)
+    used = (ny - 1) * cloud.row_step + nx * cloud.point_step
+    if cloud.row_step < nx * cloud.point_step or len(cloud.data) < used:
         raise RejectedInput("irregular_grid", f"{len(cloud.data)} bytes of data do not hold "
                             f"{ny} rows of {nx} points (point_step {cloud.point_step}, "
                             f"row_step {cloud.row_step})")
-    if size and not (cloud.point_step % size or cloud.row_step % size
-                     or any(o % size for o in offsets)):
-        words = np.frombuffer(cloud.data, dtype=dtype,
-                              count=((ny - 1) * cloud.row_step + nx * cloud.point_step) // size)
-        grid = np.lib.stride_tricks.as_strided(
-            words, shape=(ny, nx, cloud.point_step // size),
-            strides=(cloud.row_step, cloud.point_step, size), writeable=False)
-        columns = [o // size for o in offsets]
-        if columns == list(range(columns[0], columns[0] + 7)):
-            picked = grid[:, :, columns[0]:columns[0] + 7]
-        else:
-            picked = grid[:, :, columns]
-        return picked.astype(np.float64).reshape(ny * nx, 7)
+    if layout.cols is not None:
+        size = layout.widths[0]
+        words = np.frombuffer(cloud.data, dtype=layout.dtype, count=used // size)
+        if not words.dtype.isnative:
+            words = words.astype(words.dtype.newbyteorder("="))
+        return words, cloud.row_step // size, cloud.point_step // size, layout.cols
     order = ">" if cloud.is_bigendian else "<"
-    out = np.empty((ny * nx, 7))
-    for k, (name, offset) in enumerate(zip(PATCH_FIELDS, offsets)):
-        spec = cloud.fields[name]
-        column = np.ndarray((ny, nx), dtype=order + ("f4" if spec.datatype == FLOAT32 else "f8"),
-                            buffer=cloud.data, offset=offset,
-                            strides=(cloud.row_step, cloud.point_step))
-        out[:, k] = column.reshape(-1)
-    return out
+    out = np.empty((ny, nx, 7))
+    for k, (offset, width) in enumerate(zip(layout.offsets, layout.widths)):
+        out[:, :, k] = np.ndarray((ny, nx), dtype=order + ("f4" if width == 4 else "f8"),
+                                  buffer=cloud.data, offset=offset,
+                                  strides=(cloud.row_step, cloud.point_step))
+    return out.reshape(-1), 7 * nx, 7, _PLAIN_COLUMNS
 
 
-_INDEX: dict[int, FloatArray] = {}
+_PLAIN_COLUMNS = np.arange(7, dtype=np.int64)
 
 
-def _index(n: int) -> FloatArray:
-    """Return ``arange(n)`` as float64 (cached: patches keep their size)."""
-    a = _INDEX.get(n)
-    if a is None:
-        a = np.arange(n, dtype=np.float64)
-        a.setflags(write=False)
-        _INDEX[n] = a
-    return a
+def _grid_axis(first: float, step: float, worst: float, n: int,
+               what: str) -> tuple[float, float, int]:
+    """Check one fitted grid axis; return ``(first, step, order)`` with ``step > 0``.
 
-
-def _regular_axis(coord: FloatArray, axis: int, what: str) -> tuple[float, float, int]:
-    """Return ``(first, step, order)`` of a coordinate that is linear along ``axis``.
-
-    ``coord[j, i]`` must equal ``first + step * (index along axis)`` for all
-    points within ``GRID_TOLERANCE`` of a cell (so it must not vary along
-    the other index); ``order`` is -1 where the points run towards negative
-    values (``first`` and ``step`` are then those of the reversed order).
+    ``order`` is -1 where the points run towards negative values
+    (``first`` is then that of the reversed order).  A cell centre may lie
+    ``GRID_TOLERANCE`` of a cell off its grid line.
     """
-    n = coord.shape[axis]
-    other = coord.size // n
-    if axis == 1:
-        span = float(coord[:, -1].sum() - coord[:, 0].sum())
-        index = _index(n)[None, :]
-    else:
-        span = float(coord[-1, :].sum() - coord[0, :].sum())
-        index = _index(n)[:, None]
-    step = span / (other * (n - 1))
     if not abs(step) >= MIN_CELL_SIZE:
         raise RejectedInput("degenerate", f"cells {what} are {abs(step):.3g} m apart")
-    first = float(coord.sum()) / coord.size - step * 0.5 * (n - 1)
-    off = coord - index * step
-    worst = max(float(off.max()) - first, first - float(off.min()))
     if not worst <= GRID_TOLERANCE * abs(step):
         raise RejectedInput("irregular_grid", f"a cell centre lies {worst / abs(step):.3g} "
                             f"cells off the regular grid {what}")
@@ -227,30 +223,29 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
         raise RejectedInput("too_large", f"{ny} x {nx} cells exceed max_patch_cells = "
                             f"{max_cells}")
     if ny * nx == 0:
-        _field_columns(cloud)
+        _layout(cloud)
         return None
-    values = _field_values(cloud)
-    if not np.isfinite(values).all():
+    words, row, step, cols = _words(cloud)
+    pressure = np.empty((ny, nx))
+    xyz = np.empty((ny, nx, 3))
+    status, cells, total, low, sums = kernels.scan_points(words, ny, nx, row, step, cols,
+                                                          pressure, xyz)
+    if status == kernels.NONFINITE:
         raise RejectedInput("nonfinite", "NaN or infinite values in the patch")
-    p = values[:, 6]
-    low = float(p.min())
-    if low < 0.0:
+    if status == kernels.NEGATIVE:
         raise RejectedInput("negative_pressure", f"pressure down to {low:.4g} Pa")
-    cells = int(np.count_nonzero(p))
     if cells == 0:
         return None
     if cells < MIN_CONTACT_CELLS or ny < 2 or nx < 2:
         raise RejectedInput("degenerate", f"{cells} cells in contact on a {ny} x {nx} grid "
                             f"(at least {MIN_CONTACT_CELLS} on a grid of 2 x 2 or more)")
-    total = float(p.sum())
-    # p is zero outside the contact: sums over all cells are sums over the contact
-    sums = p @ values[:, :6]
-    ox, oy, oz = (float(v) / total for v in sums[:3])
-    nx_, ny_, nz_ = (float(v) for v in sums[3:6])
-    norm = math.sqrt(nx_ * nx_ + ny_ * ny_ + nz_ * nz_)
+    # origin: the pressure-weighted centroid; e_z along sum p n
+    origin = (float(sums[0]) / total, float(sums[1]) / total, float(sums[2]) / total)
+    n0, n1, n2 = float(sums[3]), float(sums[4]), float(sums[5])
+    norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
     if not norm > 0.0:
         raise RejectedInput("degenerate", "the cells' normals cancel out")
-    ez = (nx_ / norm, ny_ / norm, nz_ / norm)
+    ez = (n0 / norm, n1 / norm, n2 / norm)
     # e_x: the wheelset's x projected on the contact plane; e_y = e_z x e_x
     exx, exy, exz = 1.0 - ez[0] * ez[0], -ez[0] * ez[1], -ez[0] * ez[2]
     ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
@@ -259,23 +254,28 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
     ex = (exx / ex_norm, exy / ex_norm, exz / ex_norm)
     ey = (ez[1] * ex[2] - ez[2] * ex[1], ez[2] * ex[0] - ez[0] * ex[2],
           ez[0] * ex[1] - ez[1] * ex[0])
-    xyz = values[:, :3]
-    local = xyz @ np.array([ex, ey]).T
-    xl = local[:, 0].reshape(ny, nx) - (ox * ex[0] + oy * ex[1] + oz * ex[2])
-    yl = local[:, 1].reshape(ny, nx) - (ox * ey[0] + oy * ey[1] + oz * ey[2])
+    fx0, fdx, worst_x, fy0, fdy, worst_y = kernels.fit_grid(xyz, origin, ex, ey)
     # each checks the whole grid: x must not vary across strips, nor y along them
-    x0, dx, column_order = _regular_axis(xl, 1, "along a strip")
-    y0, dy, row_order = _regular_axis(yl, 0, "across the strips")
+    x0, dx, column_order = _grid_axis(fx0, fdx, worst_x, nx, "along a strip")
+    y0, dy, row_order = _grid_axis(fy0, fdy, worst_y, ny, "across the strips")
     cell_area = dx * dy
     load = total * cell_area
     if not (cell_area > 0.0 and math.isfinite(load) and load > 0.0):
         raise RejectedInput("degenerate", f"cell area {cell_area:.3g} m^2, load {load:.3g} N")
-    pressure = p.reshape(ny, nx)
     if row_order < 0 or column_order < 0:
         pressure = np.ascontiguousarray(pressure[::row_order, ::column_order])
-    frame = ContactFrame((ox, oy, oz), (ex, ey, ez))
+    frame = ContactFrame(origin, (ex, ey, ez))
     return ContactPatch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, cells,
-                        row_order, column_order, xyz.reshape(ny, nx, 3))
+                        row_order, column_order)
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's disk cache) the adapter's loops for both float widths."""
+    for width in (np.float32, np.float64):
+        words = np.zeros(4 * 7, dtype=width)
+        kernels.scan_points(words, 2, 2, 14, 7, _PLAIN_COLUMNS, np.empty((2, 2)),
+                            np.empty((2, 2, 3)))
+    kernels.fit_grid(np.zeros((2, 2, 3)), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 
 
 def planar_points(origin: tuple[float, float, float], axes: ContactFrame | None, x0: float,

@@ -43,4 +43,5 @@ done
 # about 18 s; a cached load a fraction of a second), so that the first start
 # of the node reaches its first wrench quickly.  No-op when cached.
 (cd / && "$venv/bin/python" -c \
-    'from fastsim_ros.contact import compiled; compiled.warm_up()')
+    'from fastsim_ros.contact import compiled; compiled.warm_up()
+from msg_adapters import patch; patch.warm_up()')
