@@ -478,6 +478,10 @@ class Pipeline:
         """Return the contact's latest wrench in the wheelset frame ``(stamp, F, M)``."""
         return self._contacts[contact].wrench
 
+    def solve_time_percentiles(self, contact: str) -> tuple[float, float]:
+        """Return the p50 and p99 (us) of the contact's last solves (NaN before any)."""
+        return self._contacts[contact].stats.percentiles_us()
+
     def counts(self, contact: str) -> dict[str, int]:
         """Return a copy of the contact's cumulative counts by status."""
         return dict(self._contacts[contact].stats.counts)

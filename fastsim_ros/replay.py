@@ -545,9 +545,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
             bar.close()
         for c in contacts:
             result.counts[c] = pipeline.counts(c)
-            rep = dict(pipeline.report(c).values)
-            result.solve_us[c] = (float(rep["solve_time_p50_us"]),
-                                  float(rep["solve_time_p99_us"]))
+            result.solve_us[c] = pipeline.solve_time_percentiles(c)
         result.kinematics = dict(pipeline.kinematics_counts)
         if csv_file is not None:
             csv_file.close()
