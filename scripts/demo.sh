@@ -1,22 +1,24 @@
 #!/usr/bin/env bash
-# Build (scripts/setup_env.sh), then solve the bundled flange-root contact patch
-# (fastsim_ros/data/example_patch.csv, 50 kN) at one creepage with MAE + FastSim,
-# the method the node runs, and with the exact theory it is validated against,
-# through the installed console script.  Nothing needs to be sourced: the
-# script's shebang is the venv's python, and PYTHONPATH points at the install.
-# Extra arguments are passed on to both fastsim_contact runs (e.g. --json).
+# The main job on bundled data: set up (scripts/setup_env.sh: .venv, colcon
+# build, numba cache), then replay the bundled recording bags/flange_shift
+# (tread to flange-root patches from the normal solver, with a stretch of
+# two-point contact) through the node's pipeline with the installed
+# fastsim_replay, exactly as a rig engineer replays a recorded run.
+# It prints the replay summary and writes, under demo_output/:
+#   flange_shift/      a rosbag2 MCAP bag: the inputs plus wrenches, creepages,
+#                      frames, wheelset wrench, markers and diagnostics
+#                      (open it in Foxglove and plot /contact/left/wrench.wrench.force.x)
+#   flange_shift.png   forces against time and against creepage, per contact
+#   flange_shift.csv   one row per wrench
+# Extra arguments go to fastsim_replay (e.g. --jobs 2 with more bags).
 set -euo pipefail
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/setup_env.sh
 
-site_packages=(install/fastsim_ros/lib/python3.*/site-packages)
-export PYTHONPATH="$PWD/${site_packages[0]}${PYTHONPATH:+:$PYTHONPATH}"
-contact=install/fastsim_ros/lib/fastsim_ros/fastsim_contact
-patch=fastsim_ros/data/example_patch.csv
-creepage=(--xi 1e-3 --eta 0 --phi 0.5 --mu 0.3)
-
-echo "== creep forces on $patch, xi = 1e-3, phi = 0.5 1/m, mu = 0.3"
-"$contact" forces --patch "$patch" "${creepage[@]}" --method mae "$@"
-"$contact" forces --patch "$patch" "${creepage[@]}" --method fastsim_ellipse "$@"
-"$contact" forces --patch "$patch" "${creepage[@]}" --method exact "$@"
+out=demo_output
+bag=flange_shift
+rm -rf "$out/$bag" "$out/$bag.png" "$out/$bag.csv"
+.venv/bin/fastsim_replay "bags/$bag" -o "$out" --params "bags/$bag.params.yaml" \
+    --plot --csv "$@"
+echo "demo: wrote $PWD/$out/$bag/ (bag), $PWD/$out/$bag.png (plot), $PWD/$out/$bag.csv"
