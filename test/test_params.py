@@ -1,0 +1,84 @@
+"""The parameter table, the parameter files in config/ and bags/, and their checks."""
+
+import pytest
+
+from fastsim_ros import params
+from fastsim_ros.params import ParameterError, load_params_file
+from ros_harness import PACKAGE_ROOT
+
+CONFIG = PACKAGE_ROOT / "config"
+INTERFACE_DEFAULTS = {
+    "contacts": ("left", "right"), "wheelset_frame": "wheelset", "shear_modulus": 8.0e10,
+    "poisson_ratio": 0.28, "friction_coefficient": 0.3, "method": "mae",
+    "traction_bound": "given", "min_rolling_speed": 0.1, "max_kinematics_age": 0.05,
+    "publish_traction": False, "rail_twist_required": False, "friction_law": "constant",
+    "friction_limit_ratio": 1.0, "friction_decay": 0.0,
+}
+
+
+def test_defaults_are_interface_md():
+    d = params.defaults()
+    for name, value in INTERFACE_DEFAULTS.items():
+        assert d[name] == value, name
+    assert d["max_patch_cells"] >= 30 * 30
+
+
+def test_config_fastsim_yaml_lists_every_parameter_at_its_default():
+    values = load_params_file(CONFIG / "fastsim.yaml")
+    assert values == params.defaults()
+    text = (CONFIG / "fastsim.yaml").read_text()
+    for spec in params.PARAMETERS:
+        assert f"    {spec.name}:" in text, spec.name
+
+
+def test_roller_rig_yaml():
+    values = load_params_file(CONFIG / "roller_rig.yaml")
+    assert values["contacts"] == ("wheel",)
+    assert values["rail_twist_required"] is True
+
+
+@pytest.mark.parametrize("path", sorted((PACKAGE_ROOT / "bags").glob("*.params.yaml")))
+def test_bag_parameter_files_load(path):
+    load_params_file(path)
+
+
+@pytest.mark.parametrize("name, value", [
+    ("friction_coefficient", 0.0), ("friction_coefficient", float("nan")),
+    ("poisson_ratio", 0.51), ("method", "exact"), ("traction_bound", "hertz"),
+    ("contacts", []), ("contacts", ["left", "left"]), ("contacts", ["1st"]),
+    ("max_patch_cells", 2), ("max_patch_cells", 1.5), ("publish_traction", "yes"),
+    ("friction_limit_ratio", 0.0), ("friction_decay", -1.0), ("shear_modulus", "8e10"),
+])
+def test_bad_values_name_the_parameter_and_the_range(name, value):
+    spec = params.SPECS[name]
+    with pytest.raises(ParameterError, match=f"parameter '{name}'.*must be") as info:
+        spec.check(value)
+    assert spec.allowed() in str(info.value)
+
+
+def test_an_integer_is_a_double():
+    assert params.SPECS["friction_coefficient"].check(1) == 1.0
+
+
+@pytest.mark.parametrize("text, match", [
+    ("fastsim:\n  ros__parameters:\n    friction_coefficient: -1.0\n", "friction_coefficient"),
+    ("fastsim:\n  ros__parameters:\n    no_such: 1\n", "unknown parameter 'no_such'"),
+    ("other_node:\n  ros__parameters:\n    method: mae\n", "no section for node"),
+    ("fastsim: [1, 2\n", "cannot read"),
+    ("- just a list\n", "not a ROS 2 parameter file"),
+])
+def test_bad_parameter_files(tmp_path, text, match):
+    path = tmp_path / "p.yaml"
+    path.write_text(text)
+    with pytest.raises(ParameterError, match=match) as info:
+        load_params_file(path)
+    assert str(path) in str(info.value)
+
+
+def test_wildcard_section_and_node_section(tmp_path):
+    path = tmp_path / "p.yaml"
+    path.write_text("/**:\n  ros__parameters:\n    friction_coefficient: 0.2\n"
+                    "    method: fastsim_ellipse\n"
+                    "fastsim:\n  ros__parameters:\n    friction_coefficient: 0.4\n")
+    values = load_params_file(path)
+    assert values["friction_coefficient"] == 0.4 and values["method"] == "fastsim_ellipse"
