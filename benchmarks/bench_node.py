@@ -162,6 +162,44 @@ def profile(calls: int) -> None:
     rclpy.shutdown(context=ctx)
 
 
+def startup(trials: int) -> None:
+    """Time fastsim_node from process start to its first wrench (kernels cached)."""
+    ctx = Context()
+    rclpy.init(context=ctx)
+    node = Node("bench_startup", context=ctx)
+    ex = SingleThreadedExecutor(context=ctx)
+    ex.add_node(node)
+    qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
+    got: list[float] = []
+    node.create_subscription(WrenchStamped, "contact/left/wrench",
+                             lambda raw: got.append(time.perf_counter()), qos, raw=True)
+    patch_pub = node.create_publisher(PointCloud2, "contact/left/patch", qos)
+    twist_pub = node.create_publisher(TwistStamped, "wheelset/twist", qos)
+    patch, twist = patch_cdr(0), twist_cdr()
+    times = []
+    for _ in range(trials):
+        got.clear()
+        start = time.perf_counter()
+        proc = subprocess.Popen([str(NODE)], stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL)
+        stamp = 1_700_000_000 * 1_000_000_000
+        while not got and time.perf_counter() - start < 30:
+            stamp += 10_000_000
+            twist_pub.publish(set_stamp(twist, stamp - 1000))
+            patch_pub.publish(set_stamp(patch, stamp))
+            ex.spin_once(timeout_sec=0.01)
+        times.append(got[0] - start if got else float("nan"))
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(10)
+        for _ in range(20):
+            ex.spin_once(timeout_sec=0.01)
+    node.destroy_node()
+    rclpy.shutdown(context=ctx)
+    print(f"start-up to first wrench over {trials} starts (s): median "
+          f"{statistics.median(times):.2f}, max {max(times):.2f} "
+          f"({', '.join(f'{t:.2f}' for t in times)})")
+
+
 def run(contacts: int, rate: float, seconds: float, soak: float, executor: str) -> None:
     """Drive one node with ``contacts`` contacts at ``rate`` Hz each and print the figures."""
     names = [f"c{k}" for k in range(contacts)]
@@ -258,19 +296,24 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str) 
 def main() -> None:
     """Run the benchmark."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
-    parser.add_argument("--contacts", type=int, nargs="+", default=[2, 4])
+    parser.add_argument("--contacts", type=int, nargs="*", default=[2, 4],
+                        help="contact counts to drive (none: only --startup / --profile)")
     parser.add_argument("--rate", type=float, default=1000.0, help="patches per second each")
     parser.add_argument("--seconds", type=float, default=20.0)
     parser.add_argument("--soak", type=float, default=0.0, metavar="MINUTES")
     parser.add_argument("--executors", nargs="+", default=["events"],
                         choices=["events", "single_threaded"],
                         help="the node's executor parameter; several: side by side")
+    parser.add_argument("--startup", type=int, default=0, metavar="TRIALS",
+                        help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
                         help="first time the per-message path in-process")
     args = parser.parse_args()
     print(f"machine: {machine()}")
     if not NODE.exists():
         raise SystemExit(f"{NODE} is missing: run scripts/setup_env.sh")
+    if args.startup:
+        startup(args.startup)
     if args.profile:
         profile(args.profile)
     for n in args.contacts:
