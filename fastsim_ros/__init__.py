@@ -2,14 +2,15 @@
 
 Importing the package points numba's on-disk cache of the compiled kernels
 at a writable place shared by every run of the same installed files
-(``$NUMBA_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/fastsim_ros/numba``,
-``~/.cache`` by default): numba's own default, ``__pycache__`` beside the
+(``$NUMBA_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/fastsim_ros/numba/<digest
+of the kernel sources>``, ``~/.cache`` by default): numba's own default, ``__pycache__`` beside the
 source, is not writable in a read-only install tree, and a node that
 compiles its kernels at start takes about 18 s to reach its first wrench.
 numba keys each entry on the source file's path and time stamp, so the
 checkout and the install tree keep separate entries.
 """
 
+import hashlib
 import os
 import tempfile
 
@@ -27,7 +28,28 @@ def _numba_cache_dir() -> str:
     return ""
 
 
+#: the sources the compiled kernels are built from: numba checks only the time
+#: stamp of the file a kernel is defined in, not of what it compiles in from
+#: elsewhere (``rules.py`` into ``kernels.py``), so the cache directory is
+#: keyed on their contents and a changed formula can never load a stale kernel
+_KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "../msg_adapters/patch_kernels.py")
+
+
+def _sources_digest() -> str:
+    digest = hashlib.sha256()
+    here = os.path.dirname(os.path.abspath(__file__))
+    for name in _KERNEL_SOURCES:
+        try:
+            with open(os.path.join(here, name), "rb") as f:
+                digest.update(f.read())
+        except OSError:
+            digest.update(name.encode())
+    return digest.hexdigest()[:16]
+
+
 if "NUMBA_CACHE_DIR" not in os.environ:
     _cache = _numba_cache_dir()
     if _cache:
+        _cache = os.path.join(_cache, _sources_digest())
+        os.makedirs(_cache, exist_ok=True)
         os.environ["NUMBA_CACHE_DIR"] = _cache

@@ -1,4 +1,4 @@
-"""Node replay: a player publishes a bundled bag to the running node, a recorder keeps the wrenches.
+"""Node replay: a player publishes a bundled bag to the node, a recorder keeps the wrenches.
 
 They must equal the offline replay's (``fastsim_replay``) wrench for wrench:
 the node and the replay share one pipeline, and stamps come from the
