@@ -131,7 +131,8 @@ def _loop_solve(reps, p, x0, y0, dx, dy, shear_modulus, knots, polys, xi, eta, p
     for _ in range(reps):
         fx += kernels.mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0,
                                 kernels.RULE_WIDEST_STRIP, False, shear_modulus, knots, polys,
-                                none_f, none_f, none_b, False)[2]
+                                kernels.LAW_CONSTANT, np.zeros(2), 0.0, none_f, none_f, none_b,
+                                False)[2]
     return fx
 
 

@@ -13,7 +13,11 @@ a tiny patch).  Results equal the numpy reference
   compiled loop, and ``geometry`` / ``flexibility`` for inspection.
 - :class:`EquivalentEllipseSolver` ``(nu, shear_modulus)``: the same calls.
 
-Units: SI throughout (m, Pa, N, N m; ``phi`` in 1/m).  Bad input raises the
+Friction: ``mu`` (Coulomb, as always), or ``friction=`` a law of
+:mod:`~fastsim_ros.contact.friction` with ``speed=`` the rolling speed
+``|V|`` (m/s) that a slip-dependent law needs.
+
+Units: SI throughout (m, Pa, N, N m; ``phi`` in 1/m; ``speed`` in m/s).  Bad input raises the
 errors of :mod:`fastsim_ros.contact.errors` (validation runs in the kernels:
 it costs one pass over the cells, not a dozen numpy calls).
 """
@@ -35,6 +39,7 @@ from fastsim_ros.contact.checks import (Bound, SplitRule, check_bound, check_she
 from fastsim_ros.contact.equivalent import EquivalentEllipse
 from fastsim_ros.contact.errors import (ContactError, EmptyContactError, InvalidInputError,
                                         OutOfTableError)
+from fastsim_ros.contact.friction import ExponentialFriction, FrictionLaw, check_speed, resolve
 from fastsim_ros.contact.mae import MaeGeometry, Zone, ZoneFlexibility
 from fastsim_ros.contact.rules import ellipse_grid
 from fastsim_ros.contact.tables import coefficient_table
@@ -49,6 +54,8 @@ _RULES = {"auto": k.RULE_AUTO, "widest_strip": k.RULE_WIDEST_STRIP,
 # argument type for both cases, so one compiled specialisation
 _NO_FLOAT = np.empty((0, 0))
 _NO_BOOL = np.empty((0, 0), dtype=np.bool_)
+# the parameters of a law that has none (constant friction)
+_NO_PARAMS = np.zeros(2)
 
 
 @dataclass(frozen=True, eq=False, slots=True)
@@ -138,9 +145,40 @@ def _per_item(value: ArrayLike, size: int, name: str) -> FloatArray:
     return np.ascontiguousarray(a)
 
 
+def _law(mu: float | None, friction: FrictionLaw | None,
+         speed: float | None) -> tuple[int, FloatArray, float, float]:
+    """Return the kernels' ``(law code, params, mu_s, speed)`` of a solve."""
+    law = resolve(mu, friction)
+    if law.slip_dependent:
+        return law.code, law.params, law.mu_s, check_speed(speed)
+    return law.code, _NO_PARAMS, law.mu_s, 0.0
+
+
+def _batch_law(mu: ArrayLike | None, friction: FrictionLaw | None, speed: ArrayLike | None,
+               size: int) -> tuple[int, FloatArray, FloatArray, FloatArray]:
+    """Return the kernels' ``(law code, params, mu per item, speed per item)`` of a batch."""
+    if friction is None:
+        if mu is None:
+            raise InvalidInputError("give mu or a friction law")
+        return k.LAW_CONSTANT, _NO_PARAMS, _per_item(mu, size, "mu"), np.zeros(size)
+    law = resolve(None, friction)
+    mus = np.full(size, law.mu_s)
+    if mu is not None and not np.array_equal(_per_item(mu, size, "mu"), mus):
+        raise InvalidInputError(f"mu differs from the friction law's mu_s = {law.mu_s}")
+    if not law.slip_dependent:
+        return k.LAW_CONSTANT, _NO_PARAMS, mus, np.zeros(size)
+    if speed is None:
+        check_speed(None)
+    speeds = _per_item(speed, size, "speed")  # type: ignore[arg-type]
+    bad = ~(np.isfinite(speeds) & (speeds >= 0.0))
+    if bad.any():
+        check_speed(float(speeds[np.argmax(bad)]))
+    return law.code, law.params, mus, speeds
+
+
 def _batch_inputs(pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
-                  dy: ArrayLike, creepages: ArrayLike,
-                  mu: ArrayLike) -> tuple[FloatArray, list[FloatArray], FloatArray, FloatArray]:
+                  dy: ArrayLike,
+                  creepages: ArrayLike) -> tuple[FloatArray, list[FloatArray], FloatArray]:
     ps = np.asarray(pressures, dtype=np.float64)
     if ps.ndim == 2:
         ps = ps[None]
@@ -155,7 +193,7 @@ def _batch_inputs(pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayL
                                 "patch or one per creepage")
     named = ((x0, "x0"), (y0, "y0"), (dx, "dx"), (dy, "dy"))
     grid = [_per_item(v, size, name) for v, name in named]
-    return ps, grid, cr, _per_item(mu, size, "mu")
+    return ps, grid, cr
 
 
 class _Solver:
@@ -178,33 +216,39 @@ class _Solver:
             return _NO_FLOAT, _NO_FLOAT, _NO_BOOL
         return np.empty(shape), np.empty(shape), np.empty(shape, dtype=np.bool_)
 
-    def solve(self, area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
-              reference: tuple[float, float] = (0.0, 0.0), bound: Bound = "given",
-              tractions: bool = False) -> ContactForces:
+    def solve(self, area: GridArea, xi: float, eta: float, phi: float, *,
+              mu: float | None = None, reference: tuple[float, float] = (0.0, 0.0),
+              bound: Bound = "given", tractions: bool = False,
+              friction: FrictionLaw | None = None, speed: float | None = None) -> ContactForces:
         """Solve at creepages ``xi``, ``eta`` (1) and spin ``phi`` (1/m) about ``reference`` (m).
 
         ``mu``: friction coefficient; ``bound``: ``"given"`` (``g = mu p``)
         or ``"parabolic"`` (``mu N p^2 / sum(p^2 dA)``: Kalker's on a Hertzian patch);
-        ``tractions``: also return the traction field.
+        ``tractions``: also return the traction field.  ``friction``: a law
+        (:mod:`~fastsim_ros.contact.friction`; default ``ConstantFriction(mu)``;
+        ``mu``, if given too, must be its ``mu_s``; the bound is then that of
+        ``mu_s`` times ``mu(v)/mu_s``); ``speed``: the rolling speed ``|V|``
+        (m/s), required by a slip-dependent law.
         """
         return self._solve(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,
-                           mu, reference, bound, tractions)
+                           _law(mu, friction, speed), reference, bound, tractions)
 
     def solve_arrays(self, pressure: ArrayLike, x0: float, y0: float, dx: float, dy: float,
-                     xi: float, eta: float, phi: float, mu: float, *,
+                     xi: float, eta: float, phi: float, mu: float | None = None, *,
                      reference: tuple[float, float] = (0.0, 0.0), bound: Bound = "given",
-                     tractions: bool = False) -> ContactForces:
+                     tractions: bool = False, friction: FrictionLaw | None = None,
+                     speed: float | None = None) -> ContactForces:
         """Solve on the pressure ``p[j, i]`` (Pa) of the grid ``x0, y0, dx, dy`` (m).
 
         The grid as in :class:`~fastsim_ros.contact.area.GridArea` (``(x0,
         y0)`` the centre of cell ``[0, 0]``); the rest as :meth:`solve`.
         """
-        return self._solve(_pressure(pressure, 2), x0, y0, dx, dy, xi, eta, phi, mu,
-                           reference, bound, tractions)
+        return self._solve(_pressure(pressure, 2), x0, y0, dx, dy, xi, eta, phi,
+                           _law(mu, friction, speed), reference, bound, tractions)
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
-               eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
-               tractions: bool) -> ContactForces:
+               eta: float, phi: float, law: tuple[int, FloatArray, float, float],
+               reference: tuple[float, float], bound: str, tractions: bool) -> ContactForces:
         raise NotImplementedError
 
     def _forces(self, result: tuple[Any, ...], grid: tuple[float, float, float, float],
@@ -233,34 +277,39 @@ class MaeSolver(_Solver):
         self._rule = _RULES[rule]
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
-               eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
-               tractions: bool) -> ContactForces:
+               eta: float, phi: float, law: tuple[int, FloatArray, float, float],
+               reference: tuple[float, float], bound: str, tractions: bool) -> ContactForces:
         tractions = bool(tractions)
+        code, prm, mu, speed = law
         out = self._outputs(p.shape, tractions)  # type: ignore[arg-type]
         grid = (float(x0), float(y0), float(dx), float(dy))
         result = k.mae_solve(p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta),
                              float(phi), float(mu), float(reference[0]), float(reference[1]),
                              self._rule, _bound(bound), self.shear_modulus, self._knots,
-                             self._polys, out[0], out[1], out[2], tractions)
+                             self._polys, code, prm, speed, out[0], out[1], out[2], tractions)
         return self._forces(result, grid, out, tractions)
 
     def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
-                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike,
+                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
                     reference: tuple[float, float] = (0.0, 0.0),
-                    bound: Bound = "given") -> FloatArray:
+                    bound: Bound = "given", friction: FrictionLaw | None = None,
+                    speed: ArrayLike | None = None) -> FloatArray:
         """Solve a batch in one compiled loop; return ``(B, 3)``: ``Fx, Fy`` (N), ``Mz`` (N m).
 
         ``pressures``: ``(B, ny, nx)`` (Pa), or one ``(ny, nx)`` patch for
         every creepage; ``x0 .. dy`` (m) and ``mu``: scalars or ``(B,)``;
         ``creepages``: ``(B, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about
-        ``reference`` (m).  Item ``b`` equals ``solve_arrays`` on it.
+        ``reference`` (m).  ``friction``: one law for the batch (``mu``, if
+        given too, must be its ``mu_s``); ``speed``: ``|V|`` (m/s), a scalar
+        or ``(B,)``.  Item ``b`` equals ``solve_arrays`` on it.
         """
-        ps, grid, cr, mus = _batch_inputs(pressures, x0, y0, dx, dy, creepages, mu)
+        ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
+        code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
         out = np.empty((cr.shape[0], 3))
         status, index, info = k.mae_batch(ps, grid[0], grid[1], grid[2], grid[3], cr, mus,
                                           float(reference[0]), float(reference[1]),
                                           self._rule, _bound(bound), self.shear_modulus,
-                                          self._knots, self._polys, out)
+                                          self._knots, self._polys, code, prm, speeds, out)
         if status:
             _raise(status, info, self._knots, f"batch item {index}: ")
         return out
@@ -312,17 +361,18 @@ class EquivalentEllipseSolver(_Solver):
         self.cells = None if cells is None else int(cells)
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
-               eta: float, phi: float, mu: float, reference: tuple[float, float], bound: str,
-               tractions: bool) -> ContactForces:
+               eta: float, phi: float, law: tuple[int, FloatArray, float, float],
+               reference: tuple[float, float], bound: str, tractions: bool) -> ContactForces:
         tractions = bool(tractions)
+        code, prm, mu, speed = law
         # the kernel sizes the ellipse's grid itself (n = 0) unless tractions need arrays
         n = self.cells or (k.ellipse_cells(int(np.count_nonzero(p > 0.0))) if tractions else 0)
         out = self._outputs((n, n), tractions)
         result = k.equivalent_solve(p, float(x0), float(y0), float(dx), float(dy), float(xi),
                                     float(eta), float(phi), float(mu), float(reference[0]),
                                     float(reference[1]), _bound(bound), n,
-                                    self.shear_modulus, self._knots, self._polys, out[0],
-                                    out[1], out[2], tractions)
+                                    self.shear_modulus, self._knots, self._polys, code, prm,
+                                    speed, out[0], out[1], out[2], tractions)
         grid = (math.nan,) * 4
         if tractions and result[0] == k.OK:
             e = self._ellipse(p, x0, y0, dx, dy)
@@ -330,16 +380,18 @@ class EquivalentEllipseSolver(_Solver):
         return self._forces(result, grid, out, tractions)  # type: ignore[arg-type]
 
     def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
-                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike,
+                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
                     reference: tuple[float, float] = (0.0, 0.0),
-                    bound: Bound = "given") -> FloatArray:
+                    bound: Bound = "given", friction: FrictionLaw | None = None,
+                    speed: ArrayLike | None = None) -> FloatArray:
         """Solve a batch in one compiled loop: as :meth:`MaeSolver.solve_batch`."""
-        ps, grid, cr, mus = _batch_inputs(pressures, x0, y0, dx, dy, creepages, mu)
+        ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
+        code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
         out = np.empty((cr.shape[0], 3))
         status, index, info = k.equivalent_batch(
             ps, grid[0], grid[1], grid[2], grid[3], cr, mus, float(reference[0]),
             float(reference[1]), _bound(bound), self.cells or 0, self.shear_modulus,
-            self._knots, self._polys, out)
+            self._knots, self._polys, code, prm, speeds, out)
         if status:
             _raise(status, info, self._knots, f"batch item {index}: ")
         return out
@@ -369,10 +421,12 @@ def warm_up() -> float:
         [[0.0, 1.0, 2.0, 1.0, 0.0], [1.0, 2.0, 3.0, 2.0, 1.0], [1.0, 3.0, 4.0, 3.0, 1.0],
          [1.0, 2.0, 3.0, 2.0, 1.0], [0.0, 1.0, 2.0, 1.0, 0.0]]))
     creep = np.array([[1e-3, 0.0, 0.1], [0.0, -1e-3, 0.0]])
+    falling = ExponentialFriction(0.3, 0.5, 0.5)
     for solver in (MaeSolver(0.28, 8e10), EquivalentEllipseSolver(0.28, 8e10)):
         solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3)
         solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3, tractions=True)
         solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, creep, mu=0.3)
+        solver.solve(area, 1e-3, 0.0, 0.0, friction=falling, speed=10.0)
         if isinstance(solver, MaeSolver):
             solver.geometry(area)
         else:

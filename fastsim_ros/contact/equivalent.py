@@ -22,6 +22,7 @@ from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
                                          traction_bound)
+from fastsim_ros.contact.friction import FrictionLaw, resolve
 from fastsim_ros.contact.rules import ellipse_cells
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
@@ -64,25 +65,29 @@ class EquivalentResult:
     traction: Tractions
 
 
-def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
-                       table: CoefficientTable, shear_modulus: float,
+def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
+                       mu: float | None = None, table: CoefficientTable, shear_modulus: float,
                        reference: tuple[float, float] = (0.0, 0.0), bound: str = "given",
-                       cells: int | None = None) -> EquivalentResult:
+                       cells: int | None = None, friction: FrictionLaw | None = None,
+                       speed: float | None = None) -> EquivalentResult:
     """Plain FastSim on the area's equivalent ellipse, load ``N`` of the area.
 
     The ellipse is discretised on ``cells`` x ``cells`` cells over its bounding
     box (default: as many cells in contact as the area has, :func:`ellipse_cells`).
+    ``friction``: the law (default ``ConstantFriction(mu)``; ``mu``, if also
+    given, must be its ``mu_s``); ``speed``: ``|V|`` (m/s) for a slip-dependent law.
     """
+    law = resolve(mu, friction)
     e = equivalent_ellipse(area)
     n = cells or ellipse_cells(int(np.count_nonzero(area.mask)))
     grid = ellipse(e.a, e.b, nx=n, ny=n, load=area.load).shifted(e.x_c, e.y_c)
-    g = traction_bound(grid, mu, bound=bound)
+    g = traction_bound(grid, law.mu_s, bound=bound)
     c11, c22, c23 = table.kalker(e.a / e.b)
     l1, l2, l3 = kalker_flexibility(e.a, e.b, c11, c22, c23, shear_modulus)
     ones = np.ones(grid.ny)
     flex = StripFlexibility(l1 * ones, l2 * ones, l3 * ones, l3 * ones)
     res = fastsim(grid, xi, eta, phi, bound=g, flexibility=flex, sweep_point=(e.x_c, e.y_c),
-                  reference=reference)
+                  reference=reference, friction=law, speed=speed)
     return EquivalentResult(res.fx, res.fy, res.mz, e, grid, res)
 
 

@@ -21,6 +21,10 @@ pressure is positive; each segment of a strip starts from zero traction at the
 front face of its first cell; tractions live at cell centres, so the first
 step is ``dx/2`` and every later one ``dx``; ``phi x`` is taken at the middle
 of each step.
+
+Slip-dependent friction (:mod:`~fastsim_ros.contact.friction`, bound
+``g(v) = g_s ratio(v)``, ``g_s = mu_s p`` the static bound): see
+:func:`slipping_bound` for the scalar equation each slipping cell solves.
 """
 
 from __future__ import annotations
@@ -31,8 +35,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from fastsim_ros.contact import rules
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import check_bound, check_creepages, check_friction
+from fastsim_ros.contact.friction import FrictionLaw, check_speed
 from fastsim_ros.contact.traction import Tractions, resultants
 
 FloatArray = NDArray[np.float64]
@@ -80,17 +86,81 @@ def traction_bound(area: GridArea, mu: float, *, bound: str = "given") -> FloatA
     return mu * area.load * p2 / (float(p2.sum()) * area.cell_area)
 
 
+#: Newton's stopping rule in :func:`slipping_bound` (shared with the kernels): a step
+#: below ``NEWTON_TOL * g_s``, at most ``NEWTON_MAX`` steps
+NEWTON_TOL, NEWTON_MAX = rules.NEWTON_TOL, rules.NEWTON_MAX
+
+
+def slipping_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
+                   law: FrictionLaw) -> FloatArray:
+    """Return the traction magnitude ``r`` (Pa) of slipping cells under a slip-dependent law.
+
+    The FastSim step of a cell: the trial (adhesion) traction ``t* = tau_prev
+    - (w / L) h`` (``h`` the step, m; ``w`` the rigid slip per unit rolling
+    distance) exceeds the static bound, ``m = |t*| > g_s``.  The cell slips:
+    ``tau = r t*/m`` (radial return, as with constant friction), and its
+    local slip per unit rolling distance follows from the traction increment,
+    ``s = w + L (tau - tau_prev)/h = L (tau - t*)/h`` (componentwise, ``L =
+    (L1, L2)``; zero in adhesion), so ``|s| = (m - r) |L t*| / (m h)`` and the
+    slip velocity is ``v = |V| |s| = q (m - r)`` with ``q = |V| |L t*|/(m h)``
+    (m/(s Pa)).  The bound and the slip must agree:
+
+        F(r) = r - g_s ratio(q (m - r)) = 0,    0 <= r <= m.
+
+    ``F(0) = -g_s ratio(q m) < 0`` and ``F(m) = m - g_s > 0``, so a root lies
+    in ``(0, m)``.  It is unique when ``ratio`` is convex in ``v`` (constant
+    and exponential laws): then ``F`` is concave in ``r``, and a concave
+    function that is negative at 0 and positive at ``m`` crosses zero once
+    (on ``(r1, m]`` it lies above the chord from ``(r1, 0)`` to ``(m,
+    F(m))``).  For a non-increasing law, ``F`` is also negative at ``r0 =
+    g_s ratio(q m)``; Newton from there climbs monotonically to the root
+    (``F`` concave: each tangent lies above ``F``, and ``F' > 0`` left of the
+    root), kept inside the bracket ``[r0, m]`` (a bisection step where a
+    Newton step would leave it).  It stops after a step below
+    :data:`NEWTON_TOL` ``* g_s`` (at most :data:`NEWTON_MAX` steps; 2-4 are
+    usual).  ``m``, ``gs`` (Pa), ``q`` (m/(s Pa)): arrays of the slipping
+    cells.
+    """
+    lo = gs * law.ratio(q * m)
+    hi = m.copy()
+    r = lo.copy()
+    active = np.ones(m.shape, dtype=bool)
+    for _ in range(NEWTON_MAX):
+        if not active.any():
+            break
+        v = q * (m - r)
+        f = r - gs * law.ratio(v)
+        df = 1.0 + gs * q * law.ratio_slope(v)
+        lo = np.where(active & (f <= 0.0), r, lo)
+        hi = np.where(active & (f >= 0.0), r, hi)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cand = np.where(df > 0.0, r - f / df, np.inf)
+        outside = ~((cand > lo) & (cand < hi))
+        cand = np.where(outside, 0.5 * (lo + hi), cand)
+        cand = np.where(f == 0.0, r, cand)
+        done = np.abs(cand - r) <= NEWTON_TOL * gs
+        r = np.where(active, cand, r)
+        active &= ~done
+    return r
+
+
 def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
           eta: FloatArray | float, phi: float, flex: StripFlexibility, y_rel: FloatArray,
-          x_c: float) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+          x_c: float, *, friction: FrictionLaw | None = None,
+          speed: float | None = None) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
     """March every strip from its leading edge; the readable reference of the kernel.
 
-    ``bound``: ``g`` (Pa), ``(ny, nx)``, zero outside the contact; ``x``:
-    cell-centre ``x`` (m); ``xi``, ``eta``: creepages at the sweep's
-    reference point (scalars or one per strip); ``y_rel``: ``y_j - y_s`` (m).
-    Returns ``tau_x``, ``tau_y`` (Pa) and the slip flags.  Vectorised over
-    the strips, marched over the columns.
+    ``bound``: ``g`` (Pa), ``(ny, nx)``, zero outside the contact (with a
+    slip-dependent ``friction`` law: the static bound ``g_s``, at ``v =
+    0``); ``x``: cell-centre ``x`` (m); ``xi``, ``eta``: creepages at the
+    sweep's reference point (scalars or one per strip); ``y_rel``: ``y_j -
+    y_s`` (m); ``speed``: the rolling speed ``|V|`` (m/s), needed by a
+    slip-dependent law (each slipping cell then solves
+    :func:`slipping_bound`).  Returns ``tau_x``, ``tau_y`` (Pa) and the slip
+    flags.  Vectorised over the strips, marched over the columns.
     """
+    law = friction if friction is not None and friction.slip_dependent else None
+    v_roll = check_speed(speed) if law is not None else 0.0
     ny, nx = bound.shape
     tx = np.zeros(ny)
     ty = np.zeros(ny)
@@ -112,6 +182,13 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
         ty = np.where(inside, ty - (rate_y0 + rate_yx * x_mid) * step, 0.0)
         mag = np.hypot(tx, ty)
         over = mag > g
+        if law is not None and over.any():
+            m = mag[over]
+            # |L t*| / m: the slip per unit of the traction cut back (componentwise L1, L2)
+            lt = np.hypot(flex.l1[over] * tx[over], flex.l2[over] * ty[over])
+            q = v_roll * lt / (m * step[over])
+            g = g.copy()
+            g[over] = slipping_bound(m, g[over], q, law)
         scale = np.where(over, g / np.where(over, mag, 1.0), 1.0)
         tx = tx * scale
         ty = ty * scale
@@ -124,12 +201,15 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
 
 def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
             flexibility: StripFlexibility, sweep_point: tuple[float, float] = (0.0, 0.0),
-            reference: tuple[float, float] = (0.0, 0.0)) -> Tractions:
+            reference: tuple[float, float] = (0.0, 0.0), friction: FrictionLaw | None = None,
+            speed: float | None = None) -> Tractions:
     """Solve FastSim on ``area``, creepages ``xi``, ``eta``, ``phi`` (1/m) about ``reference``.
 
     ``sweep_point`` ``(x_c, y_s)`` is the point the strips' rates refer to
     (the reference point itself in plain FastSim, MAE's ``S``); creepages are
     moved to it by the rigid-slip identity.  ``Mz`` is about ``reference``.
+    ``bound`` is the static bound ``g_s`` (Pa) of a slip-dependent
+    ``friction`` law (whose ``mu_s`` made it); ``speed``: ``|V|`` (m/s).
     """
     check_creepages(xi, eta, phi)
     xc, ys = sweep_point
@@ -137,5 +217,5 @@ def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatAr
     xi_s = xi + phi * (yp - ys)
     eta_s = eta - phi * (xp - xc)
     tx, ty, slip = sweep(bound, area.x, area.dx, xi_s, eta_s, phi, flexibility,
-                         area.y - ys, xc)
+                         area.y - ys, xc, friction=friction, speed=speed)
     return Tractions(tx, ty, slip, *resultants(area, tx, ty, reference))

@@ -266,12 +266,75 @@ def kalker_flexibility(a, b, c11, c22, c23, shear_modulus):
             math.pi * a * math.sqrt(a / b) / (4.0 * shear_modulus * c23))
 
 
+# ---------------------------------------------------------------- friction laws
+
+#: law codes (:mod:`fastsim_ros.contact.friction`) and Newton's stopping rule
+LAW_CONSTANT = rules.LAW_CONSTANT
+LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
+NEWTON_TOL = rules.NEWTON_TOL
+NEWTON_MAX = rules.NEWTON_MAX
+
+
+@njit(cache=True, error_model="numpy")
+def law_ratio(law, prm, v):
+    """``mu(v)/mu_s`` of law ``law`` with parameters ``prm`` at slip velocity ``v`` (m/s).
+
+    The one place the kernels know the laws' formulas (a new law: a branch
+    here and in :func:`law_slope`, and its class in
+    :mod:`~fastsim_ros.contact.friction`).  Exponential: ``prm = (A, B)``,
+    ``(1 - A) exp(-B v) + A``.
+    """
+    if law == LAW_EXPONENTIAL:
+        a = prm[0]
+        return (1.0 - a) * math.exp(-prm[1] * v) + a
+    return 1.0
+
+
+@njit(cache=True, error_model="numpy")
+def law_slope(law, prm, v):
+    """``d ratio/dv`` (s/m) of :func:`law_ratio`."""
+    if law == LAW_EXPONENTIAL:
+        return -(1.0 - prm[0]) * prm[1] * math.exp(-prm[1] * v)
+    return 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def slipping_bound(m, gs, q, law, prm):
+    """Traction magnitude (Pa) of a slipping cell: the root of ``r - g_s ratio(q (m - r))``.
+
+    :func:`fastsim_ros.contact.fastsim.slipping_bound` for one cell, step for
+    step: ``m = |t*|`` and ``gs`` the static bound (Pa), ``q`` (m/(s Pa)) the
+    slip velocity per pascal of traction cut back.
+    """
+    lo = gs * law_ratio(law, prm, q * m)
+    hi = m
+    r = lo
+    for _ in range(NEWTON_MAX):
+        v = q * (m - r)
+        f = r - gs * law_ratio(law, prm, v)
+        df = 1.0 + gs * q * law_slope(law, prm, v)
+        if f <= 0.0:
+            lo = r
+        if f >= 0.0:
+            hi = r
+        cand = r - f / df if df > 0.0 else math.inf
+        if not (cand > lo and cand < hi):
+            cand = 0.5 * (lo + hi)
+        if f == 0.0:
+            cand = r
+        done = abs(cand - r) <= NEWTON_TOL * gs
+        r = cand
+        if done:
+            break
+    return r
+
+
 # ---------------------------------------------------------------- the sweep
 
 
 @njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
-          out_x, out_y, slip, store):
+          law, prm, speed, out_x, out_y, slip, store):
     """March every strip from its leading edge; return ``(Fx, Fy, Mz, slipping, in contact)``.
 
     The kernel of :func:`fastsim_ros.contact.fastsim.sweep` and the
@@ -286,7 +349,11 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     (N), ``Mz`` (N m) about ``(xp, yp)`` (m), cells on the bound, cells in
     contact.  With ``store`` the tractions (Pa) and slip flags are written
     to ``out_x``, ``out_y``, ``slip`` (shape of ``shape``); without it
-    those are not touched (pass empty arrays).
+    those are not touched (pass empty arrays).  ``law``, ``prm``: the
+    friction law (:func:`law_ratio`); the bound above is then the static one
+    and each slipping cell solves :func:`slipping_bound` at rolling speed
+    ``speed`` (m/s); :data:`LAW_CONSTANT` is the constant-friction path as
+    it always was.
 
     Like the reference, the march goes column by column with the strips side
     by side: the strips are independent, so the CPU overlaps their chains of
@@ -347,6 +414,10 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                 if abs(mag - g) <= _ON_BOUND * g:
                     mag = math.hypot(t_x, t_y)
                 if mag > g:
+                    if law != LAW_CONSTANT:
+                        # slip velocity per pascal cut back: |V| |L t*| / (|t*| step)
+                        lt = math.hypot(flex[0, j] * t_x, flex[1, j] * t_y)
+                        g = slipping_bound(mag, g, speed * lt / (mag * s), law, prm)
                     scale = g / mag
                     t_x = t_x * scale
                     t_y = t_y * scale
@@ -728,8 +799,8 @@ def equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell):
 
 
 @njit(cache=True, error_model="numpy")
-def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, out_x, out_y, slip,
-                     store):
+def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, law, prm, speed,
+                     out_x, out_y, slip, store):
     """Plain FastSim on the equivalent ellipse's ``n`` x ``n`` grid, bound ``mu shape scale``.
 
     The grid of ``ellipse(a, b, nx=n, ny=n).shifted(x_c, y_c)``; Kalker's
@@ -751,7 +822,7 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, out_x, ou
     xi_s = xi + phi * (yp - y_c)
     eta_s = eta - phi * (xp - x_c)
     return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi,
-                 flex, x_c, y_c, xp, yp, out_x, out_y, slip, store)
+                 flex, x_c, y_c, xp, yp, law, prm, speed, out_x, out_y, slip, store)
 
 
 # ---------------------------------------------------------------- whole solves
@@ -759,7 +830,7 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, out_x, ou
 
 @njit(cache=True, error_model="numpy")
 def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, phi, xp, yp,
-              out_x, out_y, slip, store):
+              law, prm, speed, out_x, out_y, slip, store):
     """MAE step 7: FastSim with each zone's ``L``'s, creepages moved to ``S = (x_c, y_s)``.
 
     The bound is ``mu p``, or with ``parabolic`` the finished ``bound`` (Pa).
@@ -770,14 +841,14 @@ def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, 
     eta_s = eta - phi * (xp - x_c)
     if parabolic:
         return sweep(bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s,
-                     xp, yp, out_x, out_y, slip, store)
+                     xp, yp, law, prm, speed, out_x, out_y, slip, store)
     return sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-                 out_x, out_y, slip, store)
+                 law, prm, speed, out_x, out_y, slip, store)
 
 
 @njit(cache=True, error_model="numpy")
 def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
-              shear_modulus, knots, polys, out_x, out_y, slip, store):
+              shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store):
     """Solve MAE + FastSim on one patch (:func:`fastsim_ros.contact.mae.mae_fastsim`).
 
     ``p`` (Pa) on the grid ``x0, y0, dx, dy`` (m); creepages ``xi``, ``eta``
@@ -802,7 +873,8 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     flex = np.empty((4, ny))
     mae_strip_flexibility(geo, flex)
     fx, fy, mz, nslip, _ = mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex,
-                                     xi, eta, phi, xp, yp, out_x, out_y, slip, store)
+                                     xi, eta, phi, xp, yp, law, prm, speed, out_x, out_y,
+                                     slip, store)
     return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT])
 
 
@@ -814,7 +886,7 @@ ellipse_grid = njit(cache=True, error_model="numpy")(rules.ellipse_grid)
 
 @njit(cache=True, error_model="numpy")
 def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
-                     shear_modulus, knots, polys, out_x, out_y, slip, store):
+                     shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store):
     """Solve plain FastSim on the patch's equivalent ellipse (:func:`equivalent_fastsim`).
 
     ``n``: cells across the ellipse's box along each axis (``n >= 2``);
@@ -841,7 +913,8 @@ def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
     total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
     scale = ell[ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
     fx, fy, mz, nslip, ncontact = equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi,
-                                                   xp, yp, out_x, out_y, slip, store)
+                                                   xp, yp, law, prm, speed, out_x, out_y,
+                                                   slip, store)
     return OK, 0.0, fx, fy, mz, ell[ELL_LOAD], nslip, ncontact
 
 
@@ -857,12 +930,13 @@ def _same_patch(b, pb, prev_pb, x0, y0, dx, dy):
 
 @njit(cache=True, error_model="numpy")
 def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modulus,
-              knots, polys, out):
+              knots, polys, law, prm, speed, out):
     """MAE + FastSim on a batch; write ``Fx, Fy, Mz`` (N, N, N m) of item ``b`` to ``out[b]``.
 
     ``ps`` ``(P, ny, nx)`` (Pa) with ``P`` = batch size, or ``P = 1`` for one
     patch under every creepage; ``x0 .. dy`` (m), ``mu``: ``(B,)``; ``creep``
-    ``(B, 3)``: ``xi, eta, phi`` (1, 1, 1/m) about ``(xp, yp)`` (m).  The
+    ``(B, 3)``: ``xi, eta, phi`` (1, 1, 1/m) about ``(xp, yp)`` (m); ``law``,
+    ``prm``: one friction law, ``speed`` ``(B,)``: ``|V|`` (m/s).  The
     geometry, look-ups and bound are redone only when the patch (or, for the
     parabolic bound, ``mu``) changes from one item to the next.  Return
     ``(status, index of the failing item, info)``; stops at the first error.
@@ -894,8 +968,8 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
             parabolic_bound(p, dx[b], dy[b], mu[b], geo[G_LOAD], bound)
         prev_pb = pb
         fx, fy, mz, _, _ = mae_sweep(p, mu[b], parabolic, bound, env, x0[b], y0[b], dx[b],
-                                     dy[b], geo, flex, xi, eta, phi, xp, yp, empty_f, empty_f,
-                                     empty_b, False)
+                                     dy[b], geo, flex, xi, eta, phi, xp, yp, law, prm,
+                                     speed[b], empty_f, empty_f, empty_b, False)
         out[b, 0] = fx
         out[b, 1] = fy
         out[b, 2] = mz
@@ -904,7 +978,7 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
 
 @njit(cache=True, error_model="numpy")
 def equivalent_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, parabolic, n, shear_modulus,
-                     knots, polys, out):
+                     knots, polys, law, prm, speed, out):
     """Equivalent-ellipse FastSim on a batch; the layout and return of :func:`mae_batch`.
 
     ``n``: cells across each ellipse's box (``<= 0``: :func:`ellipse_cells` of
@@ -944,7 +1018,8 @@ def equivalent_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, parabolic, n, shear_
             scale = ell[ELL_LOAD] / (total * ((2 * a / nb_cells) * (2 * bb / nb_cells)))
         prev_pb = pb
         fx, fy, mz, _, _ = equivalent_sweep(ell, shape, scale, mu[b], env, xi, eta, phi, xp,
-                                            yp, empty_f, empty_f, empty_b, False)
+                                            yp, law, prm, speed[b], empty_f, empty_f, empty_b,
+                                            False)
         out[b, 0] = fx
         out[b, 1] = fy
         out[b, 2] = mz

@@ -28,6 +28,7 @@ from fastsim_ros.contact.checks import SplitRule, check_split_rule
 from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
+from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.rules import MIN_ZONE_SHARE
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
@@ -280,18 +281,22 @@ class MaeResult:
 def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
                 table: CoefficientTable, shear_modulus: float,
                 reference: tuple[float, float] = (0.0, 0.0),
-                rule: SplitRule = DEFAULT_SPLIT) -> MaeResult:
+                rule: SplitRule = DEFAULT_SPLIT, friction: FrictionLaw | None = None,
+                speed: float | None = None) -> MaeResult:
     """MAE step 7: FastSim zone by zone, creepages about ``reference`` (``phi`` in 1/m).
 
     ``bound``: traction bound ``g`` (Pa) on the area's cells
-    (:func:`fastsim_ros.contact.fastsim.traction_bound`); ``shear_modulus``:
+    (:func:`fastsim_ros.contact.fastsim.traction_bound`; with a
+    slip-dependent ``friction`` law the static one, of its ``mu_s``);
+    ``speed``: rolling speed ``|V|`` (m/s) for such a law; ``shear_modulus``:
     combined ``G`` (Pa); ``table``: coefficients at the material's ``nu``.
     """
     geometry = mae_geometry(area, rule)
     zones = zone_flexibilities(geometry, table, shear_modulus)
     res = fastsim(area, xi, eta, phi, bound=bound,
                   flexibility=strip_flexibility(area, geometry, zones),
-                  sweep_point=(geometry.x_c, geometry.y_s), reference=reference)
+                  sweep_point=(geometry.x_c, geometry.y_s), reference=reference,
+                  friction=friction, speed=speed)
     return MaeResult(res.fx, res.fy, res.mz, res, geometry, zones)
 
 

@@ -1,0 +1,236 @@
+"""Slip-dependent friction (issue 13): the laws, FastSim (reference and compiled), MAE, the ellipse.
+
+Physics asserted: A = 1 or B = 0 is constant friction bit for bit; in every
+slipping cell the traction equals mu(v) p with v the slip velocity that the
+traction increment implies; at full slip |F| = mu(V s) N; the creep curve
+has a peak below mu_s N that moves to smaller creepage as B grows; the
+compiled path equals the numpy reference.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import samples
+from fastsim_ros.contact.area import ellipse
+from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.contact.equivalent import equivalent_fastsim
+from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
+                                         traction_bound)
+from fastsim_ros.contact.friction import (LAW_CONSTANT, ConstantFriction, ExponentialFriction,
+                                          friction_law)
+from fastsim_ros.contact.mae import mae_fastsim
+from fastsim_ros.contact.tables import coefficient_table
+
+NU, G = 0.28, 8.0e10
+MU = 0.4
+V = 20.0  # rolling speed, m/s
+A_AX, B_AX, LOAD = 6e-3, 4e-3, 1e5
+FALLING = ExponentialFriction(MU, 0.4, 0.6)
+CREEP = [(2e-3, 0.0, 0.0), (1e-3, -1e-3, 0.5), (4e-3, 2e-3, -1.0), (0.05, 0.0, 0.0)]
+
+
+@pytest.fixture(scope="module")
+def table():
+    return coefficient_table(NU)
+
+
+@pytest.fixture(scope="module")
+def hertz():
+    return ellipse(A_AX, B_AX, nx=30, ny=30, load=LOAD)
+
+
+@pytest.fixture(scope="module")
+def flange():
+    return samples.flange_root_patch(cells=30)
+
+
+def kalker_fastsim(area, table, xi, eta, phi, law, speed, bound="parabolic"):
+    c11, c22, c23 = table.kalker(A_AX / B_AX)
+    l1, l2, l3 = kalker_flexibility(A_AX, B_AX, c11, c22, c23, G)
+    ones = np.ones(area.ny)
+    flex = StripFlexibility(l1 * ones, l2 * ones, l3 * ones, l3 * ones)
+    g = traction_bound(area, law.mu_s, bound=bound)
+    return fastsim(area, xi, eta, phi, bound=g, flexibility=flex, friction=law,
+                   speed=speed), flex, g
+
+
+# ---------------------------------------------------------------- the laws
+
+
+def test_exponential_law_values():
+    law = ExponentialFriction(0.5, 0.3, 2.0)
+    v = np.array([0.0, 0.5, 1e6])
+    assert law.mu(v) == pytest.approx([0.5, 0.5 * (0.7 * math.exp(-1.0) + 0.3), 0.15])
+    # slope against a central difference
+    h = 1e-6
+    assert law.ratio_slope(0.5) == pytest.approx(
+        (law.ratio(0.5 + h) - law.ratio(0.5 - h)) / (2 * h), rel=1e-7)
+    assert law.slip_dependent and not ConstantFriction(0.3).slip_dependent
+    assert ExponentialFriction(0.3, 1.0, 5.0).code == LAW_CONSTANT
+    assert ExponentialFriction(0.3, 0.2, 0.0).code == LAW_CONSTANT
+
+
+@pytest.mark.parametrize("args, text", [
+    ((0.0, 0.5, 1.0), "mu must be positive"),
+    ((math.nan, 0.5, 1.0), "mu must be positive"),
+    ((0.3, 0.0, 1.0), "limit ratio A"),
+    ((0.3, 1.5, 1.0), "limit ratio A"),
+    ((0.3, 0.5, -1.0), "decay B"),
+    ((0.3, 0.5, math.inf), "decay B"),
+])
+def test_exponential_law_refuses(args, text):
+    with pytest.raises(InvalidInputError, match=text):
+        ExponentialFriction(*args)
+
+
+def test_law_by_name():
+    assert friction_law("constant", 0.3) == ConstantFriction(0.3)
+    assert friction_law("exponential", 0.3, limit_ratio=0.5, decay=1.0) == \
+        ExponentialFriction(0.3, 0.5, 1.0)
+    with pytest.raises(InvalidInputError, match="unknown friction law"):
+        friction_law("polach", 0.3)
+
+
+# ---------------------------------------------------------------- reduction to constant
+
+
+@pytest.mark.parametrize("law", [ExponentialFriction(MU, 1.0, 0.8),
+                                 ExponentialFriction(MU, 0.3, 0.0), ConstantFriction(MU)])
+@pytest.mark.parametrize("creep", CREEP)
+def test_constant_limits_give_todays_numbers(law, creep, table, hertz, flange):
+    g = traction_bound(flange, MU)
+    old = mae_fastsim(flange, *creep, bound=g, table=table, shear_modulus=G)
+    new = mae_fastsim(flange, *creep, bound=g, table=table, shear_modulus=G, friction=law,
+                      speed=V)
+    assert (new.fx, new.fy, new.mz) == (old.fx, old.fy, old.mz)
+    old_e = equivalent_fastsim(flange, *creep, mu=MU, table=table, shear_modulus=G)
+    new_e = equivalent_fastsim(flange, *creep, table=table, shear_modulus=G, friction=law,
+                               speed=V)
+    assert (new_e.fx, new_e.fy, new_e.mz) == (old_e.fx, old_e.fy, old_e.mz)
+    for solver in (MaeSolver(NU, G), EquivalentEllipseSolver(NU, G)):
+        for area in (hertz, flange):
+            for bound in ("given", "parabolic"):
+                a = solver.solve(area, *creep, mu=MU, bound=bound)
+                b = solver.solve(area, *creep, friction=law, speed=V, bound=bound)
+                assert (a.fx, a.fy, a.mz, a.slip_fraction) == (b.fx, b.fy, b.mz,
+                                                                b.slip_fraction)
+        batch = np.array([creep, creep])
+        a = solver.solve_batch(flange.pressure, flange.x0, flange.y0, flange.dx, flange.dy,
+                               batch, mu=MU)
+        b = solver.solve_batch(flange.pressure, flange.x0, flange.y0, flange.dx, flange.dy,
+                               batch, friction=law, speed=V)
+        assert np.array_equal(a, b)
+
+
+# ---------------------------------------------------------------- consistency per cell
+
+
+@pytest.mark.parametrize("creep", [(2e-3, 0.0, 0.0), (1e-3, 1.5e-3, 0.0), (0.02, -0.01, 0.0)])
+def test_slipping_cells_satisfy_the_law(creep, table, hertz):
+    """|tau| = mu(v) p in each slipping cell, v = V |s|, s = w + L (tau - tau_prev)/h."""
+    res, flex, g = kalker_fastsim(hertz, table, *creep, FALLING, V)
+    xi, eta, _ = creep
+    checked = 0
+    for j in range(hertz.ny):
+        prev = np.zeros(2)
+        first = True
+        for i in range(hertz.nx - 1, -1, -1):
+            if not g[j, i] > 0.0:
+                prev, first = np.zeros(2), True
+                continue
+            h = 0.5 * hertz.dx if first else hertz.dx
+            tau = np.array([res.tau_x[j, i], res.tau_y[j, i]])
+            s = np.array([xi, eta]) + np.array([flex.l1[j], flex.l2[j]]) * (tau - prev) / h
+            if res.slip[j, i]:
+                mu_v = FALLING.mu(V * np.hypot(*s))
+                assert np.hypot(*tau) == pytest.approx(mu_v / MU * g[j, i], rel=1e-11)
+                # the slip opposes the traction
+                assert float(s @ tau) < 0.0
+                checked += 1
+            else:
+                assert np.hypot(*s) <= 1e-9 * np.hypot(xi, eta)
+            prev, first = tau, False
+    assert checked > 10
+
+
+# ---------------------------------------------------------------- compiled = reference
+
+
+@pytest.mark.parametrize("creep", CREEP)
+@pytest.mark.parametrize("bound", ["given", "parabolic"])
+def test_compiled_equals_reference(creep, bound, table, flange):
+    g = traction_bound(flange, MU, bound=bound)
+    ref = mae_fastsim(flange, *creep, bound=g, table=table, shear_modulus=G, friction=FALLING,
+                      speed=V)
+    got = MaeSolver(NU, G).solve(flange, *creep, friction=FALLING, speed=V, bound=bound,
+                                 tractions=True)
+    n = flange.load
+    assert abs(got.fx - ref.fx) <= 1e-12 * MU * n and abs(got.fy - ref.fy) <= 1e-12 * MU * n
+    assert np.abs(got.tau_x - ref.traction.tau_x).max() <= 1e-12 * g.max()
+    assert np.array_equal(got.slip, ref.traction.slip)
+    ref_e = equivalent_fastsim(flange, *creep, table=table, shear_modulus=G, friction=FALLING,
+                               speed=V, bound=bound)
+    got_e = EquivalentEllipseSolver(NU, G).solve(flange, *creep, friction=FALLING, speed=V,
+                                                 bound=bound)
+    assert abs(got_e.fx - ref_e.fx) <= 1e-12 * MU * n
+    assert abs(got_e.fy - ref_e.fy) <= 1e-12 * MU * n
+    # a batch item equals the single solve, with per-item speeds
+    out = MaeSolver(NU, G).solve_batch(flange.pressure, flange.x0, flange.y0, flange.dx,
+                                       flange.dy, np.array([creep, creep]), friction=FALLING,
+                                       speed=np.array([V, 2 * V]), bound=bound)
+    assert out[0, 0] == got.fx
+    twice = MaeSolver(NU, G).solve(flange, *creep, friction=FALLING, speed=2 * V, bound=bound)
+    assert out[1, 0] == twice.fx
+
+
+# ---------------------------------------------------------------- full slip and the peak
+
+
+def test_full_slip_force_is_mu_of_the_slip_velocity(table, hertz, flange):
+    xi = 0.5  # rigid slip 0.5: v = V * 0.5 = 10 m/s
+    mu_full = float(FALLING.mu(V * xi))
+    res, _, _ = kalker_fastsim(hertz, table, xi, 0.0, 0.0, FALLING, V)
+    assert -res.fx == pytest.approx(mu_full * LOAD, rel=2e-3)
+    for solver in (MaeSolver(NU, G), EquivalentEllipseSolver(NU, G)):
+        for area in (hertz, flange):
+            f = solver.solve(area, xi, 0.0, 0.0, friction=FALLING, speed=V)
+            assert -f.fx == pytest.approx(mu_full * area.load, rel=2e-3)
+            assert f.slip_fraction == 1.0
+    # lateral, too
+    f = MaeSolver(NU, G).solve(flange, 0.0, -xi, 0.0, friction=FALLING, speed=V)
+    assert f.fy == pytest.approx(mu_full * flange.load, rel=2e-3)
+
+
+def test_peak_below_mu_s_moves_to_smaller_creepage(table, hertz):
+    xis = np.geomspace(2e-4, 0.1, 60)
+    peaks = []
+    for decay in (0.2, 0.6, 2.0):
+        law = ExponentialFriction(MU, 0.4, decay)
+        f = np.array([-kalker_fastsim(hertz, table, xi, 0.0, 0.0, law, V)[0].fx for xi in xis])
+        k = int(np.argmax(f))
+        assert 0 < k < xis.size - 1, "an interior maximum"
+        assert f[k] < MU * LOAD
+        assert f[-1] < 0.9 * f[k], "the curve falls after its peak"
+        peaks.append((xis[k], f[k]))
+    assert peaks[0][0] > peaks[1][0] > peaks[2][0]
+    assert peaks[0][1] > peaks[1][1] > peaks[2][1]
+
+
+def test_solvers_refuse_bad_friction_arguments(flange):
+    solver = MaeSolver(NU, G)
+    with pytest.raises(InvalidInputError, match="rolling speed"):
+        solver.solve(flange, 1e-3, 0.0, 0.0, friction=FALLING)
+    with pytest.raises(InvalidInputError, match="rolling speed"):
+        solver.solve(flange, 1e-3, 0.0, 0.0, friction=FALLING, speed=-1.0)
+    with pytest.raises(InvalidInputError, match="differs"):
+        solver.solve(flange, 1e-3, 0.0, 0.0, mu=0.3, friction=FALLING, speed=V)
+    with pytest.raises(InvalidInputError, match="give mu"):
+        solver.solve(flange, 1e-3, 0.0, 0.0)
+    with pytest.raises(InvalidInputError, match="rolling speed"):
+        solver.solve_batch(flange.pressure, flange.x0, flange.y0, flange.dx, flange.dy,
+                           np.zeros((2, 3)), friction=FALLING, speed=[1.0, math.nan])
+    # constant friction needs no speed (today's calls)
+    solver.solve(flange, 1e-3, 0.0, 0.0, mu=MU)
