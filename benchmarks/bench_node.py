@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import signal
 import statistics
 import struct
@@ -48,25 +47,12 @@ from geometry_msgs.msg import TwistStamped, WrenchStamped  # noqa: E402
 from sensor_msgs.msg import PointCloud2, PointField  # noqa: E402
 
 from fastsim_ros.contact import samples  # noqa: E402
+from bench_fastsim import machine  # noqa: E402  (one machine line for every benchmark)
 from msg_adapters import patch as pa  # noqa: E402
 
 NODE = ROOT / "install" / "fastsim_ros" / "lib" / "fastsim_ros" / "fastsim_node"
 RADIUS = 0.46
 _STAMP = struct.Struct("<iI")
-
-
-def machine() -> str:
-    """Return a one-line description of this machine."""
-    cpu = "unknown cpu"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return (f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-            f"numpy {np.__version__}")
 
 
 def patch_cdr(k: int) -> bytearray:

@@ -32,8 +32,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
-import os
-import platform
 import sys
 import tempfile
 import time
@@ -45,6 +43,7 @@ from rosbags.rosbag2 import Reader
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from bench_fastsim import machine  # noqa: E402  (one machine line for every benchmark)
 from fastsim_ros import replay  # noqa: E402
 from fastsim_ros.contact import compiled  # noqa: E402
 from fastsim_ros.contact.compiled import MaeSolver  # noqa: E402
@@ -55,21 +54,6 @@ NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_
 #: bags whose params use the default contacts (left, right): one --params for all
 SAME_CONTACTS = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
 PHASES = ("read", "copy", "pipeline", "emit", "write")
-
-
-def machine() -> str:
-    """Return the machine line: CPU model, cores, Python, numpy, load average."""
-    model = platform.processor() or "unknown cpu"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    load = ", ".join(f"{v:.2f}" for v in os.getloadavg())
-    return (f"machine: {model}, {os.cpu_count()} cores, Python {platform.python_version()}, "
-            f"numpy {np.__version__}; load average {load}")
 
 
 def _us(values_ns) -> tuple[float, float]:
@@ -168,7 +152,7 @@ def main(argv: list[str] | None = None) -> int:
                     help="copies of each default-contact bag in the many-bags run")
     ap.add_argument("--bags", nargs="+", default=list(NAMES), choices=NAMES)
     args = ap.parse_args(argv)
-    print(machine())
+    print(f"machine: {machine()}")
     warm = compiled.warm_up()
     print(f"kernels ready in {warm:.2f} s (cached)\n")
 
@@ -230,7 +214,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  --jobs {jobs}: {3 * args.copies} bags, {patches} patches in {wall:.2f} s: "
                   f"{patches / wall:.0f} patches/s, {log_s / wall:.1f}x real time")
         print(f"  speed-up --jobs 2 / --jobs 1: {walls[1] / walls[2]:.2f}x")
-    print("\n" + machine())
+    print(f"\nmachine: {machine()}")
     return 0
 
 
