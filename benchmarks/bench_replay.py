@@ -154,7 +154,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     print(f"machine: {machine()}")
     warm = compiled.warm_up()
-    print(f"kernels ready in {warm:.2f} s ({'from the disk cache' if warm < 5 else 'compiled: the cache was cold'})\n")
+    source = "from the disk cache" if warm < 5.0 else "compiled: the cache was cold"
+    print(f"kernels ready in {warm:.2f} s ({source})\n")
 
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
