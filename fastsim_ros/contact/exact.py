@@ -21,7 +21,10 @@ fine meshes in seconds.  A dense direct solve is kept as the reference.
 Coulomb friction (``|tau| <= mu p``; ``s = 0`` where ``|tau| < mu p``; ``s``
 opposite to ``tau`` where ``|tau| = mu p``) is solved by block Gauss-Seidel
 over the lateral strips, each strip's own nonlinear problem solved exactly by
-semismooth Newton.
+semismooth Newton.  With a slip-dependent law
+(:mod:`~fastsim_ros.contact.friction`) the bound is ``mu(v) p`` with ``v =
+|V| |s|`` the cell's own slip velocity: the projection's radius depends on
+the unknowns, and the strip's Newton carries that dependence in its Jacobian.
 """
 
 from __future__ import annotations
@@ -43,6 +46,7 @@ from fastsim_ros.contact.checks import (check_creepages, check_friction, check_m
 from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
 from fastsim_ros.contact.errors import ConvergenceError, InvalidInputError
+from fastsim_ros.contact.friction import FrictionLaw, check_speed, resolve
 from fastsim_ros.contact.influence import influence_kernel
 from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
 
@@ -307,8 +311,9 @@ def _project(z: FloatArray, bound: FloatArray) -> tuple[FloatArray, NDArray[np.b
 
 
 def _strip_coulomb(q: FloatArray, bp: FloatArray, bound: FloatArray, c: float,
-                   tau0: FloatArray, tol: float,
-                   max_newton: int = 50) -> tuple[FloatArray, NDArray[np.bool_]]:
+                   tau0: FloatArray, tol: float, max_newton: int = 50,
+                   law: FrictionLaw | None = None,
+                   speed: float = 0.0) -> tuple[FloatArray, NDArray[np.bool_]]:
     """Coulomb friction on one strip, the other strips' tractions frozen.
 
     Slip ``s = q + Bp tau`` (``q``, ``tau`` of shape (m, 2); ``Bp`` the strip's
@@ -318,15 +323,25 @@ def _strip_coulomb(q: FloatArray, bp: FloatArray, bound: FloatArray, c: float,
     on its rim that ``s`` is opposite to ``tau``.  Solved by semismooth Newton,
     ``J = I - Pi (I - c Bp)`` with ``Pi`` the projection's derivative, and a
     backtracking line search on ``|F|``.
+
+    A slip-dependent ``law``: ``bound`` is the static one (``mu_s p``) and the
+    disc's radius is ``bound ratio(speed |s|)`` (``speed`` = ``|V|``, m/s), a
+    function of the unknowns; on a clipped cell ``P = g z/|z|`` then also
+    moves with ``g``: ``J`` gains ``- (z/|z|) g_s ratio'(v) V (s/|s|)^T Bp``.
     """
     m = q.shape[0]
     eye = np.eye(2 * m)
     az = eye - c * bp
     tau = tau0.copy()
+    radius = bound
 
     def residual(t: FloatArray) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+        nonlocal radius
         z = (az @ t.ravel()).reshape(m, 2) - c * q
-        pz, out = _project(z, bound)
+        if law is not None:
+            slip = q + (bp @ t.ravel()).reshape(m, 2)
+            radius = bound * law.ratio(speed * np.hypot(slip[:, 0], slip[:, 1]))
+        pz, out = _project(z, radius)
         return t - pz, z, out
 
     f, z, out = residual(tau)
@@ -340,12 +355,27 @@ def _strip_coulomb(q: FloatArray, bp: FloatArray, bound: FloatArray, c: float,
         zo = z[out]
         nz = np.hypot(zo[:, 0], zo[:, 1])
         zh = zo / nz[:, None]
-        pi[out] = (bound[out] / nz)[:, None, None] * (np.eye(2) - zh[:, :, None] * zh[:, None, :])
+        pi[out] = (radius[out] / nz)[:, None, None] * (np.eye(2) - zh[:, :, None] * zh[:, None, :])
         big_pi = np.zeros((2 * m, 2 * m))
         for a in range(2):
             for b in range(2):
                 big_pi[a::2, b::2] = np.diag(pi[:, a, b])
         jac = eye - big_pi @ az
+        if law is not None and out.any():
+            # d radius_i / d s_i = g_s ratio'(V |s_i|) V s_i/|s_i|; ds = Bp dtau
+            slip = q + (bp @ tau.ravel()).reshape(m, 2)
+            ns = np.hypot(slip[:, 0], slip[:, 1])
+            safe = np.where(ns > 0.0, ns, 1.0)
+            dg = np.where(ns > 0.0, bound * law.ratio_slope(speed * ns) * speed / safe, 0.0)
+            dir_z = np.zeros((m, 2))
+            dir_z[out] = zh
+            # rows of cell i: dir_z_i (dg_i s_i^T) Bp[2i:2i+2, :]
+            row = (slip * dg[:, None])
+            ds_row = row[:, 0:1] * bp[0::2] + row[:, 1:2] * bp[1::2]  # (m, 2m)
+            big = np.zeros((2 * m, 2 * m))
+            big[0::2] = dir_z[:, 0:1] * ds_row
+            big[1::2] = dir_z[:, 1:2] * ds_row
+            jac = jac - big
         step = np.linalg.solve(jac, -f.ravel()).reshape(m, 2)
         alpha = 1.0
         while True:
@@ -357,14 +387,20 @@ def _strip_coulomb(q: FloatArray, bp: FloatArray, bound: FloatArray, c: float,
             alpha *= 0.5
         tau, f, z, out, fnorm = trial, f_t, z_t, out_t, fn_t
     # a clipped z is slip; the projection of the converged fixed point is the traction
-    return _project(z, bound)[0] if fnorm <= tol else tau, out
+    return _project(z, radius)[0] if fnorm <= tol else tau, out
 
 
-def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu: float,
-            shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
+def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | None = None,
+            nu: float, shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
             tol: float = 1e-9, max_sweeps: int = 500,
-            operator: SteadyRollingOperator | None = None) -> TractionSolution:
+            operator: SteadyRollingOperator | None = None, friction: FrictionLaw | None = None,
+            speed: float | None = None) -> TractionSolution:
     """Tractions with Coulomb friction ``|tau| <= mu p``, ``p`` the area's pressure (Pa).
+
+    ``friction``: a law (default ``ConstantFriction(mu)``; ``mu``, if given
+    too, must be its ``mu_s``): the bound is ``mu(v) p`` with ``v = |V| |s|``
+    the local slip velocity (m/s), ``speed`` = ``|V|`` (m/s, required by a
+    slip-dependent law), ``s`` the slip per unit rolling distance.
 
     Creepages about ``reference`` (``phi`` in 1/m); ``shear_modulus`` the
     combined ``G`` (Pa).  Block Gauss-Seidel over the lateral strips, each
@@ -374,7 +410,10 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
     terms of the difference kernel amplify).  Stops when the largest traction
     change of a sweep is below ``tol * mu * max(p)``.
     """
-    check_friction(mu)
+    law = resolve(mu, friction)
+    mu = check_friction(law.mu_s)
+    slip_law = law if law.slip_dependent else None
+    v_roll = check_speed(speed) if slip_law is not None else 0.0
     check_creepages(xi, eta, phi)
     op = _operator(operator, area, nu, shear_modulus)
     mask = area.mask
@@ -407,7 +446,8 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu:
             old = tau[idx]
             s_strip = np.stack([s[idx], s[n + idx]], axis=1)
             q = s_strip - (bp @ old.ravel()).reshape(-1, 2)
-            new, slip[idx] = _strip_coulomb(q, bp, bound[idx], c, old, 1e-3 * tol * scale)
+            new, slip[idx] = _strip_coulomb(q, bp, bound[idx], c, old, 1e-3 * tol * scale,
+                                            law=slip_law, speed=v_roll)
             delta = new - old
             change = max(change, float(np.abs(delta).max()))
             s -= delta[:, 0] @ bt[idx] + delta[:, 1] @ bt[n + idx]
