@@ -36,6 +36,7 @@ from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
                                         check_poisson_ratio)
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
+from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, FrictionLaw
 
 #: cells across the bounding box of a shape, per method: exact coefficients are
 #: extrapolated from grids up to this; FastSim's discretisation error at 60
@@ -140,7 +141,17 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--xi", type=_finite, required=True, help="longitudinal creepage")
     fo.add_argument("--eta", type=_finite, required=True, help="lateral creepage")
     fo.add_argument("--phi", type=_finite, required=True, help="spin creepage (1/m)")
-    fo.add_argument("--mu", type=_finite, required=True, help="friction coefficient")
+    fo.add_argument("--mu", type=_finite, required=True,
+                    help="friction coefficient (the static mu_s of a slip-dependent law)")
+    fo.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
+                    help="constant (Coulomb) or exponential: mu(v) = mu_s ((1 - A) exp(-B v) "
+                    "+ A), v the local slip velocity (m/s)")
+    fo.add_argument("--friction-limit-ratio", type=_finite, metavar="A",
+                    help="A in (0, 1] of the exponential law")
+    fo.add_argument("--friction-decay", type=_finite, metavar="B",
+                    help="B >= 0 (s/m) of the exponential law")
+    fo.add_argument("--speed", type=_finite, metavar="V",
+                    help="rolling speed V (m/s; its magnitude is used)")
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
     fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
@@ -380,20 +391,26 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         raise InvalidInputError(f"--load must be positive, got {args.load:g}")
     if args.method == "exact" and args.bound == "parabolic":
         raise UsageError("--method exact takes the pressure as given (--bound given)")
+    law = _friction(args)
     patch = _force_area(args)
-    result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound}
+    result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound,
+                              "friction_law": law.name}
+    if isinstance(law, ExponentialFriction):
+        result.update(friction_limit_ratio=law.limit_ratio, friction_decay=law.decay,
+                      speed=args.speed)
     creepages = (args.xi, args.eta, args.phi)
+    speed = None if args.speed is None else abs(args.speed)
     if args.method == "exact":
         from fastsim_ros.contact import exact
         _check_exact_grid(patch, forces=True)
-        sol = exact.coulomb(patch, *creepages, mu=args.mu, nu=args.nu,
-                            shear_modulus=args.shear_modulus)
+        sol = exact.coulomb(patch, *creepages, nu=args.nu, shear_modulus=args.shear_modulus,
+                            friction=law, speed=speed)
         result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
             np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
     elif args.method == "mae":
         from fastsim_ros.contact.compiled import MaeSolver
         mae = MaeSolver(args.nu, args.shear_modulus)
-        res = mae.solve(patch, *creepages, mu=args.mu, bound=args.bound)
+        res = mae.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
         g = mae.geometry(patch)
         result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
                       split_y=g.y_s,
@@ -403,13 +420,42 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     else:
         from fastsim_ros.contact.compiled import EquivalentEllipseSolver
         eq = EquivalentEllipseSolver(args.nu, args.shear_modulus)
-        res = eq.solve(patch, *creepages, mu=args.mu, bound=args.bound)
+        res = eq.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
         e = eq.ellipse(patch)
         result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
                       ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
     _finite_result(result, FORCE_KEYS)
     result["cells"] = [patch.nx, patch.ny]
     return result
+
+
+def _friction(args: argparse.Namespace) -> FrictionLaw:
+    """Return the friction law of ``forces``, its flags checked (each named when refused)."""
+    given = {"--friction-limit-ratio": args.friction_limit_ratio,
+             "--friction-decay": args.friction_decay, "--speed": args.speed}
+    if args.friction_law == "constant":
+        extra = [flag for flag in ("--friction-limit-ratio", "--friction-decay")
+                 if given[flag] is not None]
+        if extra:
+            raise UsageError(f"{' and '.join(extra)} only apply to --friction-law exponential")
+        if args.speed is not None:
+            _speed(args.speed)
+        return ConstantFriction(args.mu)
+    missing = [flag for flag, v in given.items() if v is None]
+    if missing:
+        raise UsageError(f"--friction-law exponential requires {', '.join(missing)}")
+    a, b = args.friction_limit_ratio, args.friction_decay
+    if not 0.0 < a <= 1.0:
+        raise InvalidInputError(f"--friction-limit-ratio must lie in (0, 1], got {a:g}")
+    if not 0.0 <= b <= 1e4:
+        raise InvalidInputError(f"--friction-decay must lie in [0, 1e4] s/m, got {b:g}")
+    _speed(args.speed)
+    return ExponentialFriction(args.mu, a, b)
+
+
+def _speed(v: float) -> None:
+    if not abs(v) <= 1e4:
+        raise InvalidInputError(f"--speed must be at most 1e4 m/s in magnitude, got {v:g}")
 
 
 def _force_area(args: argparse.Namespace) -> areas.GridArea:
@@ -466,7 +512,8 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
             if all(v is not None for _, v in values):
                 print("  " + "  ".join(f"{k} = {v:9.4f}" for k, v in values))
     else:
-        print(f"method {result['method']}, N = {result['N']:.6g} N")
+        print(f"method {result['method']}, N = {result['N']:.6g} N, friction "
+              f"{result['friction_law']}")
         print(f"  Fx = {result['Fx']:.6g} N\n  Fy = {result['Fy']:.6g} N\n"
               f"  Mz = {result['Mz']:.6g} N m\n"
               f"  slip fraction = {result['slip_fraction']:.4g}")

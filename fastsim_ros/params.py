@@ -19,8 +19,9 @@ import yaml
 
 #: the methods of the library the node offers (INTERFACE.md: ``method``)
 METHODS = ("mae", "fastsim_ellipse")
-#: friction laws available today (slip-dependent friction is issue 13)
-FRICTION_LAWS = ("constant",)
+#: friction laws (:mod:`fastsim_ros.contact.friction`): Coulomb, and the falling
+#: mu(v) = mu_s ((1 - A) exp(-B v) + A) of the local slip velocity v
+FRICTION_LAWS = ("constant", "exponential")
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
@@ -127,7 +128,9 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "a patch needs a fresh rail/twist (roller rigs); else a rail at rest",
                   dynamic=True),
     ParameterSpec("friction_law", "string", "constant",
-                  "friction law: constant (Coulomb with friction_coefficient)",
+                  "friction law: constant (Coulomb with friction_coefficient) or exponential "
+                  "(mu(v) = mu_s ((1 - A) exp(-B v) + A), v the local slip velocity in m/s, "
+                  "mu_s = friction_coefficient, A = friction_limit_ratio, B = friction_decay)",
                   choices=FRICTION_LAWS, dynamic=True),
     ParameterSpec("friction_limit_ratio", "double", 1.0,
                   "A of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",

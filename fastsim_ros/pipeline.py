@@ -30,6 +30,7 @@ import numpy as np
 from fastsim_ros import params as parameters
 from fastsim_ros.contact.compiled import ContactForces, EquivalentEllipseSolver, MaeSolver
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
+from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from msg_adapters import outputs as out
 from msg_adapters.cdr import Cloud, StampedTwist, read_cloud, read_twist
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
@@ -224,6 +225,11 @@ class Pipeline:
         self.config = config
         self._solver = self._solvers[config["method"]]
         self._mu = float(config["friction_coefficient"])
+        # None: constant friction, the call of old (speed unused); else the law, run at |V|
+        law = friction_law(str(config["friction_law"]), self._mu,
+                           limit_ratio=float(config["friction_limit_ratio"]),
+                           decay=float(config["friction_decay"]))
+        self._law: FrictionLaw | None = law if law.slip_dependent else None
         self._bound = config["traction_bound"]
         self._frame_id = config["wheelset_frame"]
         self._max_cells = int(config["max_patch_cells"])
@@ -367,7 +373,8 @@ class Pipeline:
         start = time.perf_counter()
         try:
             f = self._solver.solve_arrays(p, x0, y0, dx, dy, xi, eta, phi, self._mu,
-                                          bound=self._bound, tractions=self._tractions)
+                                          bound=self._bound, tractions=self._tractions,
+                                          friction=self._law, speed=abs(creep.speed))
         except OutOfTableError as e:
             raise RejectedInput("out_of_table", str(e)) from None
         except ContactError as e:  # inputs the adapters passed but the solver refuses
@@ -499,6 +506,8 @@ class Pipeline:
             ("method", self.config["method"]),
             ("friction_law", self.config["friction_law"]),
             ("friction_coefficient", f"{self._mu:g}"),
+            ("friction_limit_ratio", f"{self.config['friction_limit_ratio']:g}"),
+            ("friction_decay", f"{self.config['friction_decay']:g}"),
             ("traction_bound", self._bound),
             ("solve_time_p50_us", f"{p50:.1f}"),
             ("solve_time_p99_us", f"{p99:.1f}"),

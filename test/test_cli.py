@@ -180,3 +180,50 @@ def test_forces_methods_agree_on_the_example_patch(capsys):
     # MAE is the closer one on this asymmetric patch
     assert (abs(forces["mae"]["Fx"] - forces["exact"]["Fx"])
             < abs(forces["fastsim_ellipse"]["Fx"] - forces["exact"]["Fx"]))
+
+
+FORCES = ["forces", "--shape", "ellipse", "--a", "6e-3", "--b", "4e-3", "--load", "1e5",
+          "--eta", "0", "--phi", "0", "--mu", "0.4", "--json"]
+FALLING = ["--friction-law", "exponential", "--friction-limit-ratio", "0.4",
+           "--friction-decay", "0.6", "--speed", "-20"]
+
+
+@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse", "exact"])
+def test_forces_with_falling_friction(capsys, method):
+    """Full slip: |Fx| = mu(|V| xi) N; A = 1 gives the constant-friction numbers."""
+    cells = ["--cells", "16"] if method == "exact" else []
+    rc, out, _ = run(capsys, *FORCES, "--xi", "0.5", "--method", method, *cells, *FALLING)
+    assert rc == 0
+    res = json.loads(out)
+    assert res["friction_law"] == "exponential" and res["friction_decay"] == 0.6
+    mu = 0.4 * (0.6 * math.exp(-0.6 * 20 * 0.5) + 0.4)
+    assert -res["Fx"] == pytest.approx(mu * 1e5, rel=3e-3)
+    rc, out, _ = run(capsys, *FORCES, "--xi", "3e-3", "--method", method, *cells)
+    const = json.loads(out)
+    rc, out, _ = run(capsys, *FORCES, "--xi", "3e-3", "--method", method, *cells,
+                     "--friction-law", "exponential", "--friction-limit-ratio", "1",
+                     "--friction-decay", "0.6", "--speed", "20")
+    assert json.loads(out)["Fx"] == const["Fx"] and const["friction_law"] == "constant"
+
+
+@pytest.mark.parametrize("extra, match", [
+    (["--friction-law", "exponential", "--friction-limit-ratio", "0.4"],
+     "--friction-law exponential requires --friction-decay, --speed"),
+    (["--friction-law", "exponential", "--friction-limit-ratio", "0", "--friction-decay", "1",
+      "--speed", "20"], "--friction-limit-ratio must lie in (0, 1]"),
+    (["--friction-law", "exponential", "--friction-limit-ratio", "1.5", "--friction-decay",
+      "1", "--speed", "20"], "--friction-limit-ratio must lie in (0, 1]"),
+    (["--friction-law", "exponential", "--friction-limit-ratio", "0.5", "--friction-decay",
+      "-1", "--speed", "20"], "--friction-decay must lie in [0, 1e4]"),
+    (["--friction-law", "exponential", "--friction-limit-ratio", "0.5", "--friction-decay",
+      "1", "--speed", "nan"], "--speed"),
+    (["--friction-law", "exponential", "--friction-limit-ratio", "0.5", "--friction-decay",
+      "1", "--speed", "1e9"], "--speed must be at most"),
+    (["--friction-decay", "1"], "only apply to --friction-law exponential"),
+    (["--friction-law", "polach"], "--friction-law"),
+])
+def test_bad_friction_flags_one_line_exit_2(capsys, extra, match):
+    rc, out, err = run(capsys, *FORCES, "--xi", "1e-3", *extra)
+    assert rc == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1
+    assert match in err

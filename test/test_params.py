@@ -48,6 +48,8 @@ def test_bag_parameter_files_load(path):
     ("contacts", []), ("contacts", ["left", "left"]), ("contacts", ["1st"]),
     ("max_patch_cells", 2), ("max_patch_cells", 1.5), ("publish_traction", "yes"),
     ("friction_limit_ratio", 0.0), ("friction_decay", -1.0), ("shear_modulus", "8e10"),
+    ("friction_limit_ratio", 1.01), ("friction_limit_ratio", float("nan")),
+    ("friction_decay", float("inf")), ("friction_law", "polach"), ("friction_law", ""),
 ])
 def test_bad_values_name_the_parameter_and_the_range(name, value):
     spec = params.SPECS[name]
@@ -82,3 +84,10 @@ def test_wildcard_section_and_node_section(tmp_path):
                     "fastsim:\n  ros__parameters:\n    friction_coefficient: 0.4\n")
     values = load_params_file(path)
     assert values["friction_coefficient"] == 0.4 and values["method"] == "fastsim_ellipse"
+
+
+def test_friction_laws_and_their_parameters_are_dynamic():
+    assert params.FRICTION_LAWS == ("constant", "exponential")
+    for name in ("friction_law", "friction_limit_ratio", "friction_decay"):
+        assert params.SPECS[name].dynamic
+    assert params.SPECS["friction_law"].check("exponential") == "exponential"

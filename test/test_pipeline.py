@@ -312,3 +312,45 @@ def test_diagnostics_name_every_reason():
         assert key in values
     assert diag.status[0].level == b"\x01"
     assert values["twists/wheel"] == "0"
+
+
+@pytest.mark.parametrize("speed", [20.0, -20.0])
+def test_falling_friction_reaches_the_solver_at_the_rolling_speed(speed):
+    """The pipeline runs the law at |V| from the kinematics; reverse running too."""
+    from fastsim_ros.contact.friction import ExponentialFriction
+    law = {"friction_law": "exponential", "friction_limit_ratio": 0.4, "friction_decay": 0.6}
+    pipe = make(**law)
+    xi = 2e-2
+    assert pipe.on_wheel_twist(cdr(rolling_twist(xi, speed=speed, stamp_ns=T0))) == "ok"
+    out = solve(pipe, egg())
+    assert out.status == "solved" and out.creepage.speed * speed > 0.0
+    a = in_plane_area(egg())
+    solver = MaeSolver(0.28, 8e10)
+    if speed > 0:
+        ref = solver.solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy, out.creepage.xi,
+                                  out.creepage.eta, out.creepage.phi,
+                                  friction=ExponentialFriction(0.3, 0.4, 0.6),
+                                  speed=out.creepage.speed)
+        assert out.forces.fx == pytest.approx(ref.fx, rel=1e-9)
+    # the falling law gives less than constant friction at this creepage, same sign
+    const = make()
+    const.on_wheel_twist(cdr(rolling_twist(xi, speed=speed, stamp_ns=T0)))
+    c = solve(const, egg()).forces
+    assert 0.0 < out.forces.fx / c.fx < 0.97
+    values = dict(out_values(pipe))
+    assert values["friction_law"] == "exponential" and values["friction_decay"] == "0.6"
+    # the law may change while running, and constant friction is today's again
+    pipe.update({"friction_law": "constant"})
+    again = solve(pipe, egg(), stamp=T0 + 20 * MS).forces
+    assert again.fx == c.fx
+    with pytest.raises(ParameterError, match="friction_limit_ratio"):
+        pipe.update({"friction_limit_ratio": 1.5})
+    with pytest.raises(ParameterError, match="friction_decay"):
+        pipe.update({"friction_decay": -0.1})
+    with pytest.raises(ParameterError, match="friction_law"):
+        pipe.update({"friction_law": "polach"})
+
+
+def out_values(pipe):
+    status = pipe.diagnostics(T0 + 30 * MS)
+    return [(kv.key, kv.value) for kv in status.status[0].values]

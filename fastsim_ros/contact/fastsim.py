@@ -120,6 +120,13 @@ def slipping_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
     :data:`NEWTON_TOL` ``* g_s`` (at most :data:`NEWTON_MAX` steps; 2-4 are
     usual).  ``m``, ``gs`` (Pa), ``q`` (m/(s Pa)): arrays of the slipping
     cells.
+
+    Where several solutions exist the cell takes adhesion: a cell whose trial
+    traction is within the static bound (``m <= g_s``) adheres (``v = 0``,
+    ``mu = mu_s``, consistent) even where, with a falling law, a slipping
+    solution ``r < m`` might exist too (behind a slipping cell); a cell above
+    the static bound has the one root above.  So static friction holds a cell
+    whenever it can, and a slip zone may alternate with adhering cells.
     """
     lo = gs * law.ratio(q * m)
     hi = m.copy()
