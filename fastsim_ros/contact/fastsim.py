@@ -121,12 +121,9 @@ def slipping_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
     usual).  ``m``, ``gs`` (Pa), ``q`` (m/(s Pa)): arrays of the slipping
     cells.
 
-    Where several solutions exist the cell takes adhesion: a cell whose trial
-    traction is within the static bound (``m <= g_s``) adheres (``v = 0``,
-    ``mu = mu_s``, consistent) even where, with a falling law, a slipping
-    solution ``r < m`` might exist too (behind a slipping cell); a cell above
-    the static bound has the one root above.  So static friction holds a cell
-    whenever it can, and a slip zone may alternate with adhering cells.
+    A cell within the static bound (``m <= g_s``) may, with a falling law,
+    have two slipping roots besides adhesion (``F`` concave, ``F(m) <= 0``):
+    see :func:`kinetic_bound` for which one is taken and when.
     """
     lo = gs * law.ratio(q * m)
     hi = m.copy()
@@ -149,6 +146,46 @@ def slipping_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
         r = np.where(active, cand, r)
         active &= ~done
     return r
+
+
+def kinetic_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
+                  law: FrictionLaw) -> FloatArray:
+    """Return ``r`` (Pa) of cells within the static bound that keep slipping; ``nan``: adhesion.
+
+    Applied to a cell (``m = |t*| <= g_s``) whose predecessor in its strip
+    slipped: kinetic friction keeps it slipping if ``F(r) = r - g_s ratio(q
+    (m - r))`` (:func:`slipping_bound`) has a root in ``(0, m)``.  ``F`` is
+    concave with ``F(m) <= 0``, so it has none or two; the one taken is the
+    smaller, ``r1``, where ``F`` rises through zero (``F' > 0``: the same
+    branch as the unique root above the static bound, the root continuous in
+    ``m`` across ``g_s``; on a smooth slip zone it gives ``|s|`` near the
+    rigid slip, as the continuous theory).  Newton from ``r0 = g_s ratio(q
+    m)`` (``F(r0) <= 0``) climbs to ``r1``; it has none if a step reaches
+    ``m`` or ``F' <= 0`` first (``F`` stays negative: the cell adheres).
+    Without this hysteresis a slip zone would alternate cell by cell between
+    adhesion and slip, each new slip a jump from ``mu_s`` to kinetic friction
+    over one cell, whose slip velocity grows as the cell shrinks.
+    """
+    r = gs * law.ratio(q * m)
+    out = np.full(m.shape, np.nan)
+    active = np.ones(m.shape, dtype=bool)
+    for _ in range(NEWTON_MAX):
+        if not active.any():
+            break
+        v = q * (m - r)
+        f = r - gs * law.ratio(v)
+        df = 1.0 + gs * q * law.ratio_slope(v)
+        found = active & (f >= 0.0)
+        out = np.where(found, r, out)
+        active &= ~found
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cand = np.where(df > 0.0, r - f / df, np.inf)
+        active &= cand < m
+        done = active & (np.abs(cand - r) <= NEWTON_TOL * gs)
+        out = np.where(done, cand, out)
+        active &= ~done
+        r = np.where(active, cand, r)
+    return out
 
 
 def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
@@ -179,6 +216,7 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     rate_y0 = np.asarray(eta) / flex.l2
     rate_yx = phi / flex.l3
     prev_in = np.zeros(ny, dtype=bool)
+    prev_slip = np.zeros(ny, dtype=bool)
     for i in range(nx - 1, -1, -1):
         g = bound[:, i]
         inside = g > 0.0
@@ -196,6 +234,18 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
             q = v_roll * lt / (m * step[over])
             g = g.copy()
             g[over] = slipping_bound(m, g[over], q, law)
+        if law is not None:
+            keep = inside & ~over & prev_slip & prev_in & (mag > 0.0)
+            if keep.any():
+                m = mag[keep]
+                lt = np.hypot(flex.l1[keep] * tx[keep], flex.l2[keep] * ty[keep])
+                r = kinetic_bound(m, g[keep], v_roll * lt / (m * step[keep]), law)
+                sliding = np.zeros(ny, dtype=bool)
+                sliding[keep] = ~np.isnan(r)
+                if sliding.any():
+                    g = g.copy()
+                    g[sliding] = r[~np.isnan(r)]
+                    over = over | sliding
         scale = np.where(over, g / np.where(over, mag, 1.0), 1.0)
         tx = tx * scale
         ty = ty * scale
@@ -203,6 +253,7 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
         out_y[:, i] = ty
         slip[:, i] = over & inside
         prev_in = inside
+        prev_slip = over & inside
     return out_x, out_y, slip
 
 

@@ -329,6 +329,29 @@ def slipping_bound(m, gs, q, law, prm):
     return r
 
 
+@njit(cache=True, error_model="numpy")
+def kinetic_bound(m, gs, q, law, prm):
+    """Slipping root ``r1`` (Pa) of a cell within the static bound behind a slipping cell.
+
+    :func:`fastsim_ros.contact.fastsim.kinetic_bound` for one cell, step for
+    step; ``-1.0``: no root, the cell adheres.
+    """
+    r = gs * law_ratio(law, prm, q * m)
+    for _ in range(NEWTON_MAX):
+        v = q * (m - r)
+        f = r - gs * law_ratio(law, prm, v)
+        df = 1.0 + gs * q * law_slope(law, prm, v)
+        if f >= 0.0:
+            return r
+        cand = r - f / df if df > 0.0 else math.inf
+        if not cand < m:
+            return -1.0
+        if abs(cand - r) <= NEWTON_TOL * gs:
+            return cand
+        r = cand
+    return -1.0
+
+
 # ---------------------------------------------------------------- the sweep
 
 
@@ -369,6 +392,8 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     rate_x, rate_y0, rate_yx, yr = w[5], w[6], w[7], w[8]
     # the column a strip's current segment continues into (else: a new segment)
     cont = np.empty(ny, dtype=np.int64)
+    # whether strip j's previous cell slipped (slip-dependent laws: kinetic friction holds)
+    sliding = np.zeros(ny, dtype=np.bool_)
     for j in range(ny):
         y = y0 + dy * j
         # constant part of the strip's rates (Pa/m), grouped as the reference does
@@ -403,6 +428,7 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                 s = half
                 t_x = 0.0
                 t_y = 0.0
+                sliding[j] = False
             cont[j] = i - 1
             x_mid = x_rel + 0.5 * s
             t_x = t_x - rate_x[j] * s
@@ -423,6 +449,18 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                     t_y = t_y * scale
                     over = True
                     nslip += 1
+            if law != LAW_CONSTANT:
+                if not over and sliding[j] and m2 > 0.0:
+                    mag = math.hypot(t_x, t_y)
+                    lt = math.hypot(flex[0, j] * t_x, flex[1, j] * t_y)
+                    r = kinetic_bound(mag, g, speed * lt / (mag * s), law, prm)
+                    if r >= 0.0:
+                        scale = r / mag
+                        t_x = t_x * scale
+                        t_y = t_y * scale
+                        over = True
+                        nslip += 1
+                sliding[j] = over
             tx[j] = t_x
             ty[j] = t_y
             sx[j] += t_x
