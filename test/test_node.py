@@ -186,6 +186,10 @@ def bad_inputs():
         p[5, 5:8] = 1e9
         return cloud_msg(area, stamp_ns=stamp, pressure=p)
 
+    def out_of_table(stamp):  # 2 x 101 cells: MAE zones of a/b about 50, beyond the tables
+        strip = areas.GridArea(-50e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 101)) * 1e9)
+        return cloud_msg(strip, stamp_ns=stamp)
+
     def tiny(stamp):
         return cloud_msg(area.scaled(1e-200), origin=(0.0, 0.0, 0.0), stamp_ns=stamp,
                          dtype="<f8")
@@ -194,14 +198,17 @@ def bad_inputs():
             ("irregular_grid", irregular), ("irregular_grid", stray),
             ("missing_field", missing),
             ("wrong_frame", lambda s: cloud_msg(area, stamp_ns=s, frame_id="base_link")),
-            ("too_large", huge), ("degenerate", degenerate), ("degenerate", tiny)]
+            ("too_large", huge), ("degenerate", degenerate), ("degenerate", tiny),
+            ("out_of_table", out_of_table)]
 
 
 def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
     _, client = run_node("-p", "max_patch_cells:=10000", contacts=("left",))
+    # before any twist: no kinematics
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 - MS), timeout=0.5) == []
     send_twist(client, rolling_twist(1e-3, stamp_ns=T0))
     stamp = T0 + MS
-    expected = {}
+    expected = {"no_kinematics": 1}
     for reason, build in bad_inputs():
         stamp += MS
         assert exchange(client, "left", build(stamp), timeout=0.5) == [], reason
