@@ -130,30 +130,92 @@ def test_constant_limits_give_todays_numbers(law, creep, table, hertz, flange):
 
 @pytest.mark.parametrize("creep", [(2e-3, 0.0, 0.0), (1e-3, 1.5e-3, 0.0), (0.02, -0.01, 0.0)])
 def test_slipping_cells_satisfy_the_law(creep, table, hertz):
-    """|tau| = mu(v) p in each slipping cell, v = V |s|, s = w + L (tau - tau_prev)/h."""
+    """|tau| = mu(v) p in each slipping cell, v = V |s_k| the slip at the upstream cell's ratio.
+
+    Trial t* = tau_prev - (w/L) h; kinetic level k g_s (k: the upstream
+    cell's |tau|/g_s if it slipped, else 1); s_k = w + L (k g_s t*/|t*| -
+    tau_prev)/h (fastsim.slip_ratio).  A slipping cell lies on mu(V |s_k|)
+    p along t*; an adhering one is the trial itself (s = 0), within its
+    level or with friction at its level's slip above the trial.
+    """
     res, flex, g = kalker_fastsim(hertz, table, *creep, FALLING, V)
     xi, eta, _ = creep
+    w = np.array([xi, eta])
     checked = 0
     for j in range(hertz.ny):
+        lj = np.array([flex.l1[j], flex.l2[j]])
         prev = np.zeros(2)
         first = True
+        k = 1.0
         for i in range(hertz.nx - 1, -1, -1):
             if not g[j, i] > 0.0:
-                prev, first = np.zeros(2), True
+                prev, first, k = np.zeros(2), True, 1.0
                 continue
             h = 0.5 * hertz.dx if first else hertz.dx
             tau = np.array([res.tau_x[j, i], res.tau_y[j, i]])
-            s = np.array([xi, eta]) + np.array([flex.l1[j], flex.l2[j]]) * (tau - prev) / h
+            trial = prev - w / lj * h
+            m = np.hypot(*trial)
+            s_k = w + lj * (k * g[j, i] * trial / m - prev) / h
+            mu_k = FALLING.mu(V * np.hypot(*s_k))
             if res.slip[j, i]:
-                mu_v = FALLING.mu(V * np.hypot(*s))
-                assert np.hypot(*tau) == pytest.approx(mu_v / MU * g[j, i], rel=1e-11)
+                assert m > k * g[j, i]
+                assert np.hypot(*tau) == pytest.approx(mu_k / MU * g[j, i], rel=1e-12)
+                assert np.abs(tau / np.hypot(*tau) - trial / m).max() <= 1e-12
                 # the slip opposes the traction
-                assert float(s @ tau) < 0.0
+                assert float(s_k @ tau) < 0.0
+                k = np.hypot(*tau) / g[j, i]
                 checked += 1
             else:
-                assert np.hypot(*s) <= 1e-9 * np.hypot(xi, eta)
+                assert np.abs(tau - trial).max() <= 1e-9 * g[j, i]
+                assert m <= k * g[j, i] or mu_k / MU * g[j, i] >= m
+                k = 1.0
             prev, first = tau, False
     assert checked > 10
+
+
+def slip_runs(flags):
+    """Count the separate runs of slipping cells in a strip's flags."""
+    f = np.concatenate([[False], flags])
+    return int(np.count_nonzero(f[1:] & ~f[:-1]))
+
+
+@pytest.mark.parametrize("decay", [0.3, 1.0, 3.0, 10.0])
+@pytest.mark.parametrize("xi", [2e-3, 5e-3, 9.3e-3, 2e-2])
+def test_slip_zones_stay_whole_and_slip_velocities_bounded(decay, xi, table, hertz):
+    """Pure xi on an ellipse: the strips stick and slip as with constant friction, in one piece.
+
+    The rule's reason (fastsim.slip_ratio): with the cell's own traction
+    change in its slip, the first slipping cell dropped to near A g_s with a
+    slip ten times the rigid one and the strip alternated stick and slip.
+    Here no strip has more separate slip zones than with constant friction
+    (a strip's first cell may slip on the staircase edge), and the slip at
+    the frozen ratio stays below the constant-friction FastSim's largest
+    slip, xi + 2 L1 g_0/a on the ellipse.
+    """
+    law = ExponentialFriction(MU, 0.4, decay)
+    res, flex, g = kalker_fastsim(hertz, table, xi, 0.0, 0.0, law, V)
+    const, _, _ = kalker_fastsim(hertz, table, xi, 0.0, 0.0, ConstantFriction(MU), V)
+    g0 = float(g.max())
+    s_max = xi + 2.0 * flex.l1[0] * g0 / A_AX
+    checked = 0
+    for j in range(hertz.ny):
+        cells = np.flatnonzero(g[j] > 0.0)[::-1]  # leading edge first
+        flags = res.slip[j, cells]
+        assert slip_runs(flags) <= max(1, slip_runs(const.slip[j, cells])), f"strip {j}"
+        tau = -res.tau_x[j, cells]
+        # the slip at the upstream cell's level, per cell: L (m - k g_s)/h
+        prev, k = 0.0, 1.0
+        for n, i in enumerate(cells):
+            h = 0.5 * hertz.dx if n == 0 else hertz.dx
+            m = prev + xi / flex.l1[j] * h
+            if flags[n]:
+                assert flex.l1[j] * (m - k * g[j, i]) / h <= s_max
+                k = tau[n] / g[j, i]
+                checked += 1
+            else:
+                k = 1.0
+            prev = tau[n]
+    assert checked > 0
 
 
 # ---------------------------------------------------------------- compiled = reference

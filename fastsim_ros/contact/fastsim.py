@@ -24,7 +24,8 @@ of each step.
 
 Slip-dependent friction (:mod:`~fastsim_ros.contact.friction`, bound
 ``g(v) = g_s ratio(v)``, ``g_s = mu_s p`` the static bound): see
-:func:`slipping_bound` for the scalar equation each slipping cell solves.
+:func:`slip_ratio` for the rule each slipping cell follows (its slip taken at
+the friction ratio of its upstream neighbour).
 """
 
 from __future__ import annotations
@@ -35,7 +36,6 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from fastsim_ros.contact import rules
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import check_bound, check_creepages, check_friction
 from fastsim_ros.contact.friction import FrictionLaw, check_speed
@@ -86,106 +86,59 @@ def traction_bound(area: GridArea, mu: float, *, bound: str = "given") -> FloatA
     return mu * area.load * p2 / (float(p2.sum()) * area.cell_area)
 
 
-#: Newton's stopping rule in :func:`slipping_bound` (shared with the kernels): a step
-#: below ``NEWTON_TOL * g_s``, at most ``NEWTON_MAX`` steps
-NEWTON_TOL, NEWTON_MAX = rules.NEWTON_TOL, rules.NEWTON_MAX
+def slip_ratio(m: FloatArray, level: FloatArray, q: FloatArray,
+               law: FrictionLaw) -> FloatArray:
+    """Return the friction ratio of cells whose trial traction exceeds their kinetic level.
 
+    The FastSim step of a cell under a slip-dependent law (bound ``g(v) =
+    g_s ratio(v)``, ``g_s`` the static bound): the trial (adhesion) traction
+    ``t* = tau_prev - (w / L) h`` (``h`` the step, m; ``w`` the rigid slip per
+    unit rolling distance), ``m = |t*|``.  The cell's *kinetic level* is
+    ``k g_s``, ``k`` the friction ratio of its upstream neighbour if that one
+    slipped, else 1 (static friction; also at a segment's first cell).  With
+    ``m > k g_s`` the cell slips at the friction ratio frozen over the step:
+    radial return onto ``k g_s``, whose slip per unit rolling distance
+    follows from the traction increment, ``s = w + L (tau_k - tau_prev)/h =
+    L (tau_k - t*)/h`` (componentwise ``L = (L1, L2)``), ``|s| = (m - k g_s)
+    |L t*| / (m h)``, so the slip velocity is
 
-def slipping_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
-                   law: FrictionLaw) -> FloatArray:
-    """Return the traction magnitude ``r`` (Pa) of slipping cells under a slip-dependent law.
+        v = |V| |s| = q (m - k g_s),    q = |V| |L t*| / (m h)  (m/(s Pa)),
 
-    The FastSim step of a cell: the trial (adhesion) traction ``t* = tau_prev
-    - (w / L) h`` (``h`` the step, m; ``w`` the rigid slip per unit rolling
-    distance) exceeds the static bound, ``m = |t*| > g_s``.  The cell slips:
-    ``tau = r t*/m`` (radial return, as with constant friction), and its
-    local slip per unit rolling distance follows from the traction increment,
-    ``s = w + L (tau - tau_prev)/h = L (tau - t*)/h`` (componentwise, ``L =
-    (L1, L2)``; zero in adhesion), so ``|s| = (m - r) |L t*| / (m h)`` and the
-    slip velocity is ``v = |V| |s| = q (m - r)`` with ``q = |V| |L t*|/(m h)``
-    (m/(s Pa)).  The bound and the slip must agree:
+    and the cell's ratio is ``ratio(v)``, its traction ``r t*/m`` with ``r =
+    g_s ratio(v)`` where ``r < m``; where ``r >= m`` (possible only within
+    the static bound, ``m <= g_s``: the slip at the frozen ratio is so small
+    that friction recovers beyond the trial) the cell adheres.  ``m``,
+    ``level`` (``k g_s``, Pa), ``q``: arrays of the cells with ``m > level``.
 
-        F(r) = r - g_s ratio(q (m - r)) = 0,    0 <= r <= m.
-
-    ``F(0) = -g_s ratio(q m) < 0`` and ``F(m) = m - g_s > 0``, so a root lies
-    in ``(0, m)``.  It is unique when ``ratio`` is convex in ``v`` (constant
-    and exponential laws): then ``F`` is concave in ``r``, and a concave
-    function that is negative at 0 and positive at ``m`` crosses zero once
-    (on ``(r1, m]`` it lies above the chord from ``(r1, 0)`` to ``(m,
-    F(m))``).  For a non-increasing law, ``F`` is also negative at ``r0 =
-    g_s ratio(q m)``; Newton from there climbs monotonically to the root
-    (``F`` concave: each tangent lies above ``F``, and ``F' > 0`` left of the
-    root), kept inside the bracket ``[r0, m]`` (a bisection step where a
-    Newton step would leave it).  It stops after a step below
-    :data:`NEWTON_TOL` ``* g_s`` (at most :data:`NEWTON_MAX` steps; 2-4 are
-    usual).  ``m``, ``gs`` (Pa), ``q`` (m/(s Pa)): arrays of the slipping
-    cells.
-
-    A cell within the static bound (``m <= g_s``) may, with a falling law,
-    have two slipping roots besides adhesion (``F`` concave, ``F(m) <= 0``):
-    see :func:`kinetic_bound` for which one is taken and when.
+    Why the ratio is frozen over the step, and not solved for with the
+    cell's own slip (``r = g_s ratio(q (m - r))``, the implicit step):
+    FastSim's ``u = L tau`` is a contact-scale flexibility (calibrated on
+    the full-adhesion creep forces), and through ``s = L (tau - t*)/h`` it
+    gives a cell's slip a compliance ``L/h`` towards the cell's own traction
+    change.  With a falling law the implicit step's gain ``q g_s |ratio'|
+    ~ |V| g_s L B (1 - A) / h`` then exceeds 1 (2.7 at the centre of a
+    Hertzian ellipse of 60 cells at ``mu_s = 0.4``, ``A = 0.4``, ``B = 1``
+    s/m, ``V = 20`` m/s, and it grows as the grid is refined): the only root
+    is a drop of the traction towards ``A g_s`` with a slip ten times the
+    rigid slip in the first slipping cell, after which the strip re-adheres
+    and slips again, cell by cell; in the continuous simplified theory, too,
+    ``tau = g_s ratio(|V| s)`` with ``s = w - L dtau/dt`` makes the slip run
+    away from its quasi-static value along the strip.  The half-space the
+    exact theory solves has a local compliance instead: the slip of a cell
+    changes by ``D_x`` per pascal of its own traction (the steady-rolling
+    operator's self-coefficient, ``0.57/G``, independent of the cell size),
+    15 to 30 times less than ``L/h`` on these grids, and the same gain is
+    0.07 (``B = 1``): there the slip grows continuously from zero at the
+    stick-slip boundary.  So the cell-scale traction change that the
+    ratio's own change between neighbouring cells causes is left out of the
+    slip (the half-space would answer it with ``D_x``, not ``L/h``): what
+    remains is FastSim's slip with the friction level of the upstream cell,
+    which tends to the quasi-static slip ``s = w - L (g_s ratio)'`` with
+    ``ratio`` held locally constant as the cells shrink.  One evaluation of
+    the law per slipping cell, no root to choose; ``A = 1`` or ``B = 0``
+    never comes here (constant friction runs its own path).
     """
-    lo = gs * law.ratio(q * m)
-    hi = m.copy()
-    r = lo.copy()
-    active = np.ones(m.shape, dtype=bool)
-    for _ in range(NEWTON_MAX):
-        if not active.any():
-            break
-        v = q * (m - r)
-        f = r - gs * law.ratio(v)
-        df = 1.0 + gs * q * law.ratio_slope(v)
-        lo = np.where(active & (f <= 0.0), r, lo)
-        hi = np.where(active & (f >= 0.0), r, hi)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            cand = np.where(df > 0.0, r - f / df, np.inf)
-        outside = ~((cand > lo) & (cand < hi))
-        cand = np.where(outside, 0.5 * (lo + hi), cand)
-        cand = np.where(f == 0.0, r, cand)
-        done = np.abs(cand - r) <= NEWTON_TOL * gs
-        r = np.where(active, cand, r)
-        active &= ~done
-    return r
-
-
-def kinetic_bound(m: FloatArray, gs: FloatArray, q: FloatArray,
-                  law: FrictionLaw) -> FloatArray:
-    """Return ``r`` (Pa) of cells within the static bound that keep slipping; ``nan``: adhesion.
-
-    Applied to a cell (``m = |t*| <= g_s``) whose predecessor in its strip
-    slipped: kinetic friction keeps it slipping if ``F(r) = r - g_s ratio(q
-    (m - r))`` (:func:`slipping_bound`) has a root in ``(0, m)``.  ``F`` is
-    concave with ``F(m) <= 0``, so it has none or two; the one taken is the
-    smaller, ``r1``, where ``F`` rises through zero (``F' > 0``: the same
-    branch as the unique root above the static bound, the root continuous in
-    ``m`` across ``g_s``; on a smooth slip zone it gives ``|s|`` near the
-    rigid slip, as the continuous theory).  Newton from ``r0 = g_s ratio(q
-    m)`` (``F(r0) <= 0``) climbs to ``r1``; it has none if a step reaches
-    ``m`` or ``F' <= 0`` first (``F`` stays negative: the cell adheres).
-    Without this hysteresis a slip zone would alternate cell by cell between
-    adhesion and slip, each new slip a jump from ``mu_s`` to kinetic friction
-    over one cell, whose slip velocity grows as the cell shrinks.
-    """
-    r = gs * law.ratio(q * m)
-    out = np.full(m.shape, np.nan)
-    active = np.ones(m.shape, dtype=bool)
-    for _ in range(NEWTON_MAX):
-        if not active.any():
-            break
-        v = q * (m - r)
-        f = r - gs * law.ratio(v)
-        df = 1.0 + gs * q * law.ratio_slope(v)
-        found = active & (f >= 0.0)
-        out = np.where(found, r, out)
-        active &= ~found
-        with np.errstate(divide="ignore", invalid="ignore"):
-            cand = np.where(df > 0.0, r - f / df, np.inf)
-        active &= cand < m
-        done = active & (np.abs(cand - r) <= NEWTON_TOL * gs)
-        out = np.where(done, cand, out)
-        active &= ~done
-        r = np.where(active, cand, r)
-    return out
+    return law.ratio(q * (m - level))
 
 
 def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
@@ -199,8 +152,8 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     0``); ``x``: cell-centre ``x`` (m); ``xi``, ``eta``: creepages at the
     sweep's reference point (scalars or one per strip); ``y_rel``: ``y_j -
     y_s`` (m); ``speed``: the rolling speed ``|V|`` (m/s), needed by a
-    slip-dependent law (each slipping cell then solves
-    :func:`slipping_bound`).  Returns ``tau_x``, ``tau_y`` (Pa) and the slip
+    slip-dependent law (each slipping cell then follows
+    :func:`slip_ratio`).  Returns ``tau_x``, ``tau_y`` (Pa) and the slip
     flags.  Vectorised over the strips, marched over the columns.
     """
     law = friction if friction is not None and friction.slip_dependent else None
@@ -217,6 +170,8 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     rate_yx = phi / flex.l3
     prev_in = np.zeros(ny, dtype=bool)
     prev_slip = np.zeros(ny, dtype=bool)
+    # each strip's friction ratio in its last cell (read only where that cell slipped)
+    ratio = np.ones(ny)
     for i in range(nx - 1, -1, -1):
         g = bound[:, i]
         inside = g > 0.0
@@ -226,26 +181,25 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
         tx = np.where(inside, tx - rate_x * step, 0.0)
         ty = np.where(inside, ty - (rate_y0 + rate_yx * x_mid) * step, 0.0)
         mag = np.hypot(tx, ty)
-        over = mag > g
-        if law is not None and over.any():
-            m = mag[over]
-            # |L t*| / m: the slip per unit of the traction cut back (componentwise L1, L2)
-            lt = np.hypot(flex.l1[over] * tx[over], flex.l2[over] * ty[over])
-            q = v_roll * lt / (m * step[over])
-            g = g.copy()
-            g[over] = slipping_bound(m, g[over], q, law)
-        if law is not None:
-            keep = inside & ~over & prev_slip & prev_in & (mag > 0.0)
-            if keep.any():
-                m = mag[keep]
-                lt = np.hypot(flex.l1[keep] * tx[keep], flex.l2[keep] * ty[keep])
-                r = kinetic_bound(m, g[keep], v_roll * lt / (m * step[keep]), law)
-                sliding = np.zeros(ny, dtype=bool)
-                sliding[keep] = ~np.isnan(r)
-                if sliding.any():
-                    g = g.copy()
-                    g[sliding] = r[~np.isnan(r)]
-                    over = over | sliding
+        if law is None:
+            over = mag > g
+        else:
+            # kinetic level: the upstream cell's friction ratio if it slipped, else static
+            level = g * np.where(prev_slip, ratio, 1.0)
+            over = mag > level
+            if over.any():
+                idx = np.flatnonzero(over)
+                m = mag[idx]
+                # |L t*| / m: the slip per unit of the traction cut back (componentwise L1, L2)
+                lt = np.hypot(flex.l1[idx] * tx[idx], flex.l2[idx] * ty[idx])
+                q = v_roll * lt / (m * step[idx])
+                k = slip_ratio(m, level[idx], q, law)
+                r = g[idx] * k
+                slides = r < m
+                g = g.copy()
+                g[idx] = r
+                ratio[idx] = k
+                over[idx[~slides]] = False
         scale = np.where(over, g / np.where(over, mag, 1.0), 1.0)
         tx = tx * scale
         ty = ty * scale

@@ -20,10 +20,9 @@ The solvers see a law only through:
   the readable reference and the exact solver take.
 
 Adding a law is a class here and one branch in ``kernels.law_ratio``; the
-solvers do not change.  For the FastSim step and the exact solver's
-projection to have one consistent traction per slipping cell, a law's
-``ratio`` must be convex in ``v`` (constant and exponential are): see
-:func:`fastsim_ros.contact.fastsim.sweep`.
+solvers do not change.  FastSim evaluates ``ratio`` once per slipping cell
+(:func:`fastsim_ros.contact.fastsim.slip_ratio`: no equation to solve, any
+law will do); the exact solver's Newton also takes ``ratio_slope``.
 
 With ``A = 1`` or ``B = 0`` the exponential law *is* the constant one:
 :class:`ExponentialFriction` then reports :data:`LAW_CONSTANT`, so every
@@ -125,8 +124,7 @@ class ExponentialFriction(FrictionLaw):
     ``mu_s > 0`` the static coefficient (``v = 0``), ``limit_ratio`` ``A`` in
     ``(0, 1]`` the ratio ``mu(inf)/mu_s``, ``decay`` ``B >= 0`` in s/m (the
     law's rate of decay with the slip velocity ``v`` in m/s).  ``A = 1`` or
-    ``B = 0`` is constant friction ``mu_s`` (and runs as such).  Convex in
-    ``v``, so every slipping cell has one consistent traction.
+    ``B = 0`` is constant friction ``mu_s`` (and runs as such).
     """
 
     limit_ratio: float = 1.0

@@ -268,11 +268,9 @@ def kalker_flexibility(a, b, c11, c22, c23, shear_modulus):
 
 # ---------------------------------------------------------------- friction laws
 
-#: law codes (:mod:`fastsim_ros.contact.friction`) and Newton's stopping rule
+#: law codes (:mod:`fastsim_ros.contact.friction`)
 LAW_CONSTANT = rules.LAW_CONSTANT
 LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
-NEWTON_TOL = rules.NEWTON_TOL
-NEWTON_MAX = rules.NEWTON_MAX
 
 
 @njit(cache=True, error_model="numpy")
@@ -280,76 +278,13 @@ def law_ratio(law, prm, v):
     """``mu(v)/mu_s`` of law ``law`` with parameters ``prm`` at slip velocity ``v`` (m/s).
 
     The one place the kernels know the laws' formulas (a new law: a branch
-    here and in :func:`law_slope`, and its class in
-    :mod:`~fastsim_ros.contact.friction`).  Exponential: ``prm = (A, B)``,
+    here and its class in :mod:`~fastsim_ros.contact.friction`).  Exponential: ``prm = (A, B)``,
     ``(1 - A) exp(-B v) + A``.
     """
     if law == LAW_EXPONENTIAL:
         a = prm[0]
         return (1.0 - a) * math.exp(-prm[1] * v) + a
     return 1.0
-
-
-@njit(cache=True, error_model="numpy")
-def law_slope(law, prm, v):
-    """``d ratio/dv`` (s/m) of :func:`law_ratio`."""
-    if law == LAW_EXPONENTIAL:
-        return -(1.0 - prm[0]) * prm[1] * math.exp(-prm[1] * v)
-    return 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def slipping_bound(m, gs, q, law, prm):
-    """Traction magnitude (Pa) of a slipping cell: the root of ``r - g_s ratio(q (m - r))``.
-
-    :func:`fastsim_ros.contact.fastsim.slipping_bound` for one cell, step for
-    step: ``m = |t*|`` and ``gs`` the static bound (Pa), ``q`` (m/(s Pa)) the
-    slip velocity per pascal of traction cut back.
-    """
-    lo = gs * law_ratio(law, prm, q * m)
-    hi = m
-    r = lo
-    for _ in range(NEWTON_MAX):
-        v = q * (m - r)
-        f = r - gs * law_ratio(law, prm, v)
-        df = 1.0 + gs * q * law_slope(law, prm, v)
-        if f <= 0.0:
-            lo = r
-        if f >= 0.0:
-            hi = r
-        cand = r - f / df if df > 0.0 else math.inf
-        if not (cand > lo and cand < hi):
-            cand = 0.5 * (lo + hi)
-        if f == 0.0:
-            cand = r
-        done = abs(cand - r) <= NEWTON_TOL * gs
-        r = cand
-        if done:
-            break
-    return r
-
-
-@njit(cache=True, error_model="numpy")
-def kinetic_bound(m, gs, q, law, prm):
-    """Slipping root ``r1`` (Pa) of a cell within the static bound behind a slipping cell.
-
-    :func:`fastsim_ros.contact.fastsim.kinetic_bound` for one cell, step for
-    step; ``-1.0``: no root, the cell adheres.
-    """
-    r = gs * law_ratio(law, prm, q * m)
-    for _ in range(NEWTON_MAX):
-        v = q * (m - r)
-        f = r - gs * law_ratio(law, prm, v)
-        df = 1.0 + gs * q * law_slope(law, prm, v)
-        if f >= 0.0:
-            return r
-        cand = r - f / df if df > 0.0 else math.inf
-        if not cand < m:
-            return -1.0
-        if abs(cand - r) <= NEWTON_TOL * gs:
-            return cand
-        r = cand
-    return -1.0
 
 
 # ---------------------------------------------------------------- the sweep
@@ -374,9 +309,12 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     to ``out_x``, ``out_y``, ``slip`` (shape of ``shape``); without it
     those are not touched (pass empty arrays).  ``law``, ``prm``: the
     friction law (:func:`law_ratio`); the bound above is then the static one
-    and each slipping cell solves :func:`slipping_bound` at rolling speed
-    ``speed`` (m/s); :data:`LAW_CONSTANT` is the constant-friction path as
-    it always was.
+    and each cell follows :func:`fastsim_ros.contact.fastsim.slip_ratio` at
+    rolling speed ``speed`` (m/s), step for step: it slips where its trial
+    exceeds its kinetic level (the upstream cell's friction ratio, if that
+    one slipped, times the static bound), with the ratio of the slip it has
+    at that level; :data:`LAW_CONSTANT` is the constant-friction path as it
+    always was.
 
     Like the reference, the march goes column by column with the strips side
     by side: the strips are independent, so the CPU overlaps their chains of
@@ -392,8 +330,8 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     rate_x, rate_y0, rate_yx, yr = w[5], w[6], w[7], w[8]
     # the column a strip's current segment continues into (else: a new segment)
     cont = np.empty(ny, dtype=np.int64)
-    # whether strip j's previous cell slipped (slip-dependent laws: kinetic friction holds)
-    sliding = np.zeros(ny, dtype=np.bool_)
+    # slip-dependent laws: strip j's friction ratio in its last cell if that one slipped, else 1
+    level = np.ones(ny)
     for j in range(ny):
         y = y0 + dy * j
         # constant part of the strip's rates (Pa/m), grouped as the reference does
@@ -428,39 +366,45 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                 s = half
                 t_x = 0.0
                 t_y = 0.0
-                sliding[j] = False
+                level[j] = 1.0
             cont[j] = i - 1
             x_mid = x_rel + 0.5 * s
             t_x = t_x - rate_x[j] * s
             t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s
             over = False
             m2 = t_x * t_x + t_y * t_y
-            if not m2 <= _NO_SLIP * g * g:
-                mag = math.sqrt(m2)
-                if abs(mag - g) <= _ON_BOUND * g:
-                    mag = math.hypot(t_x, t_y)
-                if mag > g:
-                    if law != LAW_CONSTANT:
-                        # slip velocity per pascal cut back: |V| |L t*| / (|t*| step)
-                        lt = math.hypot(flex[0, j] * t_x, flex[1, j] * t_y)
-                        g = slipping_bound(mag, g, speed * lt / (mag * s), law, prm)
-                    scale = g / mag
-                    t_x = t_x * scale
-                    t_y = t_y * scale
-                    over = True
-                    nslip += 1
-            if law != LAW_CONSTANT:
-                if not over and sliding[j] and m2 > 0.0:
-                    mag = math.hypot(t_x, t_y)
-                    lt = math.hypot(flex[0, j] * t_x, flex[1, j] * t_y)
-                    r = kinetic_bound(mag, g, speed * lt / (mag * s), law, prm)
-                    if r >= 0.0:
-                        scale = r / mag
+            if law == LAW_CONSTANT:
+                if not m2 <= _NO_SLIP * g * g:
+                    mag = math.sqrt(m2)
+                    if abs(mag - g) <= _ON_BOUND * g:
+                        mag = math.hypot(t_x, t_y)
+                    if mag > g:
+                        scale = g / mag
                         t_x = t_x * scale
                         t_y = t_y * scale
                         over = True
                         nslip += 1
-                sliding[j] = over
+            else:
+                # the kinetic level: static bound times the upstream cell's friction ratio
+                gk = g * level[j]
+                if not m2 <= _NO_SLIP * gk * gk:
+                    mag = math.sqrt(m2)
+                    if abs(mag - gk) <= _ON_BOUND * gk:
+                        mag = math.hypot(t_x, t_y)
+                    if mag > gk:
+                        # slip velocity at that level: |V| |L t*| (|t*| - gk) / (|t*| step)
+                        lt = math.hypot(flex[0, j] * t_x, flex[1, j] * t_y)
+                        k = law_ratio(law, prm, speed * lt / (mag * s) * (mag - gk))
+                        r = g * k
+                        if r < mag:
+                            scale = r / mag
+                            t_x = t_x * scale
+                            t_y = t_y * scale
+                            over = True
+                            nslip += 1
+                            level[j] = k
+                if not over:
+                    level[j] = 1.0
             tx[j] = t_x
             ty[j] = t_y
             sx[j] += t_x

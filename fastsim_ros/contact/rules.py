@@ -17,10 +17,6 @@ import math
 #: friction-law codes of the kernels (:mod:`fastsim_ros.contact.friction`)
 LAW_CONSTANT = 0
 LAW_EXPONENTIAL = 1
-#: Newton on a slipping cell's bound (:func:`fastsim_ros.contact.fastsim.slipping_bound`):
-#: stop after a step below ``NEWTON_TOL * g_s``, at most ``NEWTON_MAX`` steps
-NEWTON_TOL = 1e-13
-NEWTON_MAX = 60
 
 #: the smallest share of the area a ``widest_strip`` zone may have under the
 #: ``auto`` split rule (:func:`fastsim_ros.contact.mae.split_face`)
