@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shlex
 import signal
 import statistics
 import struct
@@ -187,11 +188,13 @@ def startup(trials: int) -> None:
           f"({', '.join(f'{t:.2f}' for t in times)})")
 
 
-def run(contacts: int, rate: float, seconds: float, soak: float, executor: str) -> None:
+def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
+        node_args: list[str]) -> None:
     """Drive one node with ``contacts`` contacts at ``rate`` Hz each and print the figures."""
     names = [f"c{k}" for k in range(contacts)]
     proc = subprocess.Popen([str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",
-                             "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]"],
+                             "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]",
+                             *node_args],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     ctx = Context()
     rclpy.init(context=ctx)
@@ -270,7 +273,8 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str) 
     rclpy.shutdown(context=ctx)
     got = sum(received)
     lat = np.array(latency) * 1e3 if latency else np.array([np.nan])
-    print(f"{executor:15s} {contacts} contacts x {rate:g} Hz for {wall:.1f} s: sent {inputs}, "
+    extra = " ".join([executor, *node_args])
+    print(f"{extra}: {contacts} contacts x {rate:g} Hz for {wall:.1f} s: sent {inputs}, "
           f"wrenches {got}, dropped {inputs - got} ({100.0 * (inputs - got) / inputs:.2f}%), "
           f"latency p50 {np.median(lat):.3f} ms, p99 {np.percentile(lat, 99):.3f} ms, "
           f"max {lat.max():.3f} ms; node CPU {100.0 * cpu / wall:.0f}% of one core; "
@@ -293,6 +297,8 @@ def main() -> None:
     parser.add_argument("--executors", nargs="+", default=["events"],
                         choices=["events", "single_threaded"],
                         help="the node's executor parameter; several: side by side")
+    parser.add_argument("--node-args", default="", metavar="ARGS",
+                        help="more --ros-args for the node, e.g. --node-args='-p qos_depth:=50'")
     parser.add_argument("--startup", type=int, default=0, metavar="TRIALS",
                         help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
@@ -307,7 +313,7 @@ def main() -> None:
         profile(args.profile)
     for n in args.contacts:
         for executor in args.executors:
-            run(n, args.rate, args.seconds, args.soak, executor)
+            run(n, args.rate, args.seconds, args.soak, executor, shlex.split(args.node_args))
 
 
 if __name__ == "__main__":
