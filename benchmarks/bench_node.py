@@ -28,6 +28,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +39,6 @@ os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
 
 import rclpy  # noqa: E402
 from rclpy.context import Context  # noqa: E402
-from rclpy.executors import SingleThreadedExecutor  # noqa: E402
 from rclpy.experimental import EventsExecutor  # noqa: E402
 from rclpy.node import Node  # noqa: E402
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
@@ -150,13 +150,23 @@ def profile(calls: int) -> None:
     rclpy.shutdown(context=ctx)
 
 
-def startup(trials: int) -> None:
-    """Time fastsim_node from process start to its first wrench (kernels cached)."""
+def driver(name: str) -> tuple[Context, Node, Any]:
+    """Return a context, a node and an events executor spinning it, for the driver side.
+
+    The driver runs the events executor too: a Python executor here would add
+    its own ~50 us per wrench callback to the latencies measured.
+    """
     ctx = Context()
     rclpy.init(context=ctx)
-    node = Node("bench_startup", context=ctx)
-    ex = SingleThreadedExecutor(context=ctx)
+    node = Node(name, context=ctx)
+    ex = EventsExecutor(context=ctx)
     ex.add_node(node)
+    return ctx, node, ex
+
+
+def startup(trials: int) -> None:
+    """Time fastsim_node from process start to its first wrench (kernels cached)."""
+    ctx, node, ex = driver("bench_startup")
     qos = QoSProfile(depth=10, reliability=ReliabilityPolicy.RELIABLE)
     got: list[float] = []
     node.create_subscription(WrenchStamped, "contact/left/wrench",
@@ -196,13 +206,7 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
                              "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]",
                              *node_args],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    ctx = Context()
-    rclpy.init(context=ctx)
-    node = Node("bench_driver", context=ctx)
-    # the driver runs the events executor too: a Python executor here would
-    # add its own ~50 us per wrench callback to the latencies measured
-    ex = EventsExecutor(context=ctx)
-    ex.add_node(node)
+    ctx, node, ex = driver("bench_driver")
     qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
     sent: dict[tuple[int, int], float] = {}
     latency: list[float] = []
