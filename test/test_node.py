@@ -70,7 +70,7 @@ def exchange(client, contact, msg, *, count=1, timeout=5.0):
 
 def send_twist(client, msg, rail=False):
     (client.rail if rail else client.twist).publish(msg)
-    client.spin(0.15)  # twists and patches travel on different topics: let it land first
+    client.spin(0.3)  # twists and patches travel on different topics: let it land first
 
 
 def force(w):

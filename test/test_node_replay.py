@@ -3,10 +3,10 @@
 They must equal the offline replay's (``fastsim_replay``) wrench for wrench:
 the node and the replay share one pipeline, and stamps come from the
 messages, so the same inputs in the same order give the same numbers.  The
-player publishes in the bag's log-time order at twice real time, which
-keeps each twist ahead of the patches stamped after it (different topics
-carry no order between them over DDS, so an unpaced player could reorder
-them).
+player publishes in the bag's log-time order at real time, which keeps each
+twist (2.5 ms ahead in the bundled bags) ahead of the patches stamped after
+it: different topics carry no order between them over DDS, so an unpaced
+player could reorder them.
 """
 
 import time
@@ -23,7 +23,7 @@ from fastsim_ros.params import load_params_file
 from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
 
 BAGS = PACKAGE_ROOT / "bags"
-SPEED = 2.0
+SPEED = 1.0
 
 pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
                                 reason="fastsim_node is not installed (run colcon build)")
