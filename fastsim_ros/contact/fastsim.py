@@ -191,8 +191,9 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
                 idx = np.flatnonzero(over)
                 m = mag[idx]
                 # |L t*| / m: the slip per unit of the traction cut back (componentwise L1, L2)
-                lt = np.hypot(flex.l1[idx] * tx[idx], flex.l2[idx] * ty[idx])
-                q = v_roll * lt / (m * step[idx])
+                lx = flex.l1[idx] * tx[idx]
+                ly = flex.l2[idx] * ty[idx]
+                q = v_roll / step[idx] * np.sqrt(lx * lx + ly * ly) / m
                 k = slip_ratio(m, level[idx], q, law)
                 r = g[idx] * k
                 slides = r < m

@@ -349,6 +349,9 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
         slip[:, :] = False
     nslip = 0
     ncontact = 0
+    # slip-dependent laws: |V| per metre of a full step and of a segment's first half step
+    v_full = speed / dx
+    v_half = speed / half
     for i in range(nx - 1, -1, -1):
         x = x0 + dx * i
         x_rel = x - x_c
@@ -393,11 +396,15 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                         mag = math.hypot(t_x, t_y)
                     if mag > gk:
                         # slip velocity at that level: |V| |L t*| (|t*| - gk) / (|t*| step)
-                        lt = math.hypot(flex[0, j] * t_x, flex[1, j] * t_y)
-                        k = law_ratio(law, prm, speed * lt / (mag * s) * (mag - gk))
+                        inv = 1.0 / mag
+                        lx = flex[0, j] * t_x
+                        ly = flex[1, j] * t_y
+                        vs = v_full if s == dx else v_half
+                        k = law_ratio(law, prm, vs * math.sqrt(lx * lx + ly * ly)
+                                      * ((mag - gk) * inv))
                         r = g * k
                         if r < mag:
-                            scale = r / mag
+                            scale = r * inv
                             t_x = t_x * scale
                             t_y = t_y * scale
                             over = True
