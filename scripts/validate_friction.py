@@ -5,10 +5,14 @@ FastSim on a Hertzian ellipse (Kalker's FastSim with the parabolic bound,
 as ``fastsim_ellipse`` runs it on an ellipse), and against MAE + FastSim and
 the equivalent ellipse on the flange-root patch
 (:func:`fastsim_ros.contact.samples.flange_root_patch`), for the law
-``mu(v) = mu_s ((1 - A) exp(-B v) + A)`` at rolling speed ``V``.  Writes
-``docs/figures/friction_creep_curves.png`` and
-``docs/data/friction_curves.csv`` and prints the table of
-docs/validation.md ("Slip-dependent friction").  About a minute here.
+``mu(v) = mu_s ((1 - A) exp(-B v) + A)`` at rolling speed ``V``.  Also the
+exact solver's grid check at one creepage near the peak (20, 30, 40 cells
+across) and, at that creepage, the central strip of the ellipse: traction
+over its static bound and slip velocity along ``x``, exact against FastSim
+(the third panel of the figure; ``docs/data/friction_strip.csv``).  Writes
+``docs/figures/friction_creep_curves.png``, ``docs/data/friction_curves.csv``
+and ``docs/data/friction_strip.csv`` and prints the tables of
+docs/validation.md ("Slip-dependent friction").  About two minutes here.
 """
 
 from __future__ import annotations
@@ -27,7 +31,11 @@ from fastsim_ros.contact import samples  # noqa: E402
 from fastsim_ros.contact.area import ellipse  # noqa: E402
 from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from fastsim_ros.contact.exact import SteadyRollingOperator, coulomb  # noqa: E402
+from fastsim_ros.contact.equivalent import equivalent_fastsim  # noqa: E402
+from fastsim_ros.contact.fastsim import traction_bound  # noqa: E402
 from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction  # noqa: E402
+from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
+from fastsim_ros.contact.traction import rigid_slip  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 NU, G = 0.28, 8.0e10
@@ -35,6 +43,10 @@ MU_S, A_LIMIT, SPEED = 0.4, 0.4, 20.0  # mu_s, A, |V| (m/s)
 DECAYS = (0.0, 0.3, 1.0, 3.0)          # B (s/m); 0 = constant friction
 XI = np.geomspace(5e-4, 0.1, 16)
 EXACT_CELLS = 30
+SEMI_AXES = (6e-3, 4e-3)  # the Hertzian ellipse (m), load 1e5 N
+#: the grid check and the strip: B (s/m) and xi near the exact curve's peak
+CHECK_DECAY, CHECK_XI = 1.0, 0.0093
+CHECK_CELLS = (20, 30, 40)
 
 
 def law(decay: float):
@@ -62,8 +74,56 @@ def peak(f):
     return float(np.polyval(c, tm)), float(np.exp(tm))
 
 
+def exact_strip(area, op, decay, xi):
+    """Central strip of the exact solution: x/a, |tau|/(mu_s p), slip velocity (m/s)."""
+    sol = coulomb(area, xi, 0.0, 0.0, nu=NU, shear_modulus=G, operator=op,
+                  friction=law(decay), speed=SPEED)
+    mask = area.mask
+    wx, wy = rigid_slip(area, xi, 0.0, 0.0, (0.0, 0.0))
+    tau = np.concatenate([sol.tau_x[mask], sol.tau_y[mask]])
+    s = np.concatenate([wx[mask], wy[mask]]) - op.dense() @ tau
+    n = int(mask.sum())
+    sx, sy = np.zeros(mask.shape), np.zeros(mask.shape)
+    sx[mask], sy[mask] = s[:n], s[n:]
+    j = area.ny // 2
+    cells = np.flatnonzero(mask[j])
+    g = MU_S * area.pressure[j, cells]
+    return (area.x[cells] / SEMI_AXES[0], np.hypot(sol.tau_x[j, cells], sol.tau_y[j, cells]) / g,
+            SPEED * np.hypot(sx[j, cells], sy[j, cells]))
+
+
+def fastsim_strip(area, decay, xi):
+    """Central strip of Kalker's FastSim (60 cells, parabolic bound): as :func:`exact_strip`.
+
+    The slip velocity is the one the law sees (fastsim.slip_ratio): the slip
+    at the upstream cell's friction ratio, ``L1 (m - k g_s)/h``; zero in
+    adhesion.
+    """
+    res = equivalent_fastsim(area, xi, 0.0, 0.0, table=coefficient_table(NU), shear_modulus=G,
+                             friction=law(decay), speed=SPEED, bound="parabolic", cells=60)
+    grid, e = res.grid, res.ellipse
+    gs = traction_bound(grid, MU_S, bound="parabolic")
+    c11 = coefficient_table(NU).kalker(e.a / e.b)[0]
+    l1 = 8.0 * e.a / (3.0 * G * c11)
+    j = grid.ny // 2
+    cells = np.flatnonzero(gs[j] > 0.0)[::-1]
+    tau = -res.traction.tau_x[j, cells]
+    slip = res.traction.slip[j, cells]
+    v = np.zeros(cells.size)
+    prev, k = 0.0, 1.0
+    for n, i in enumerate(cells):
+        h = (0.5 if n == 0 else 1.0) * grid.dx
+        if slip[n]:
+            v[n] = SPEED * l1 * (prev + xi / l1 * h - k * gs[j, i]) / h
+            k = tau[n] / gs[j, i]
+        else:
+            k = 1.0
+        prev = tau[n]
+    return grid.x[cells] / e.a, tau / gs[j, cells], v
+
+
 def main() -> int:
-    hertz = ellipse(6e-3, 4e-3, nx=EXACT_CELLS, ny=EXACT_CELLS, load=1e5)
+    hertz = ellipse(*SEMI_AXES, nx=EXACT_CELLS, ny=EXACT_CELLS, load=1e5)
     flange = samples.flange_root_patch(cells=EXACT_CELLS)
     curves = {}
     for name, area in (("hertz", hertz), ("flange_root", flange)):
@@ -95,8 +155,33 @@ def main() -> int:
         err = "" if method == "exact" else \
             f"{100 * np.abs(fx - curves[(name, 'exact', b)]).max():.1f}"
         print(f"| {name} | {method} | {b:g} | {h:.3f} | {x:.3g} | {err} |")
+    # the exact solver's grid check near the peak
+    print(f"\nexact solver, B = {CHECK_DECAY:g} s/m, xi = {CHECK_XI:g}: grid check\n")
+    print("| cells across | Fx/(mu_s N) | constant friction |")
+    print("| --- | --- | --- |")
+    for n in CHECK_CELLS:
+        ar = ellipse(*SEMI_AXES, nx=n, ny=n, load=1e5)
+        op = SteadyRollingOperator.of(ar, nu=NU, shear_modulus=G)
+        f = [-coulomb(ar, CHECK_XI, 0.0, 0.0, nu=NU, shear_modulus=G, operator=op,
+                      friction=law(b), speed=SPEED).fx / (MU_S * ar.load)
+             for b in (CHECK_DECAY, 0.0)]
+        print(f"| {n} | {f[0]:.4f} | {f[1]:.4f} |")
+    # the central strip near the peak
+    op = SteadyRollingOperator.of(hertz, nu=NU, shear_modulus=G)
+    strips = {"exact": exact_strip(hertz, op, CHECK_DECAY, CHECK_XI),
+              "fastsim": fastsim_strip(hertz, CHECK_DECAY, CHECK_XI)}
+    with open(ROOT / "docs" / "data" / "friction_strip.csv", "w", newline="") as f:
+        w = csv.writer(f, lineterminator="\n")
+        w.writerow(["method", "x_over_a", "tau_over_mu_s_p", "slip_velocity_m_per_s"])
+        for method, (xa, tg, v) in strips.items():
+            for row in zip(xa, tg, v):
+                w.writerow([method] + [f"{c:.6g}" for c in row])
+    for method, (xa, tg, v) in strips.items():
+        print(f"{method} strip: largest slip velocity {v.max():.3f} m/s, "
+              f"|tau|/(mu_s p) from {tg.min():.3f} to {tg.max():.3f}")
     # the figure
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8), sharey=True)
+    fig, axes = plt.subplots(1, 3, figsize=(17, 4.8),
+                             gridspec_kw={"width_ratios": (1, 1, 0.8)})
     colours = dict(zip(DECAYS, ("k", "tab:blue", "tab:orange", "tab:red")))
     styles = {"exact": "-", "fastsim": "--", "mae": "--", "equivalent": ":"}
     marks = {"exact": "o", "fastsim": "", "mae": "", "equivalent": ""}
@@ -115,6 +200,24 @@ def main() -> int:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7, ncol=2, loc="lower right")
     axes[0].set_ylabel("-Fx / (mu_s N)")
+    axes[1].sharey(axes[0])
+    ax = axes[2]
+    twin = ax.twinx()
+    for method, (xa, tg, v) in strips.items():
+        style = "-o" if method == "exact" else "--"
+        ax.plot(xa, tg, style, color="tab:orange", ms=3, label=f"{method}: |tau|/(mu_s p)")
+        twin.plot(xa, v, style, color="tab:purple", ms=3, label=f"{method}: slip velocity")
+    ax.set_xlabel("x / a (leading edge on the left)")
+    ax.set_ylabel("|tau| / (mu_s p)", color="tab:orange")
+    twin.set_ylabel("slip velocity V |s| (m/s)", color="tab:purple")
+    ax.set_ylim(0.0, 1.05)
+    ax.invert_xaxis()
+    ax.set_title(f"central strip, B = {CHECK_DECAY:g} s/m, xi = {CHECK_XI:g} (near the peak)",
+                 fontsize=10)
+    ax.grid(True, alpha=0.3)
+    lines = ax.get_legend_handles_labels()
+    more = twin.get_legend_handles_labels()
+    ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=7, loc="center left")
     fig.suptitle(f"Falling friction mu(v) = mu_s ((1 - A) exp(-B v) + A), mu_s = {MU_S}, "
                  f"A = {A_LIMIT}, rolling speed |V| = {SPEED} m/s", fontsize=11)
     fig.tight_layout()
