@@ -7,9 +7,10 @@ the equivalent ellipse on the flange-root patch
 (:func:`fastsim_ros.contact.samples.flange_root_patch`), for the law
 ``mu(v) = mu_s ((1 - A) exp(-B v) + A)`` at rolling speed ``V``.  Also the
 exact solver's grid check at one creepage near the peak (20, 30, 40 cells
-across) and, at that creepage, the central strip of the ellipse: traction
-over its static bound and slip velocity along ``x``, exact against FastSim
-(the third panel of the figure; ``docs/data/friction_strip.csv``).  Writes
+across), FastSim's peak on 30 to 240 cells and, at that creepage, the
+central strip of the ellipse: traction over its static bound and slip
+velocity along ``x``, exact against FastSim (the third panel of the figure;
+``docs/data/friction_strip.csv``).  Writes
 ``docs/figures/friction_creep_curves.png``, ``docs/data/friction_curves.csv``
 and ``docs/data/friction_strip.csv`` and prints the tables of
 docs/validation.md ("Slip-dependent friction").  About two minutes here.
@@ -166,6 +167,21 @@ def main() -> int:
                       friction=law(b), speed=SPEED).fx / (MU_S * ar.load)
              for b in (CHECK_DECAY, 0.0)]
         print(f"| {n} | {f[0]:.4f} | {f[1]:.4f} |")
+    # FastSim's own grid convergence with the falling law (the peak on a finer xi grid)
+    fine = np.geomspace(XI[0], XI[-1], 61)
+    print("\nFastSim (Kalker's, parabolic bound) on n x n cells: peak Fx/(mu_s N) and its xi "
+          "(61 creepages)\n")
+    print("| cells across | " + " | ".join(f"B = {b:g} s/m" for b in DECAYS[1:]) + " |")
+    print("| --- |" + " --- |" * (len(DECAYS) - 1))
+    for n in (30, 60, 120, 240):
+        solver = EquivalentEllipseSolver(NU, G, cells=n)
+        cols = []
+        for b in DECAYS[1:]:
+            f = np.array([-solver.solve(hertz, xi, 0.0, 0.0, friction=law(b), speed=SPEED,
+                                        bound="parabolic").fx for xi in fine])
+            k = int(np.argmax(f))
+            cols.append(f"{f[k] / (MU_S * hertz.load):.4f} at {fine[k]:.3g}")
+        print(f"| {n} | " + " | ".join(cols) + " |")
     # the central strip near the peak
     op = SteadyRollingOperator.of(hertz, nu=NU, shear_modulus=G)
     strips = {"exact": exact_strip(hertz, op, CHECK_DECAY, CHECK_XI),
