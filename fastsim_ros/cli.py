@@ -8,7 +8,8 @@ non-finite number is ever printed as a result.
 
 ``forces --method mae`` and ``fastsim_ellipse`` run the compiled solvers of
 :mod:`fastsim_ros.contact.compiled`, the code the node runs; ``exact`` runs
-the exact theory (:mod:`fastsim_ros.contact.exact`).
+the exact theory (:mod:`fastsim_ros.contact.exact`); ``fastrip`` the numpy
+FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path).
 
 What the command line accepts is bounded (:data:`LIMITS`, :data:`MAX_PATCH_CELLS`,
 :data:`MAX_STRIP_CELLS`, :data:`MAX_EXACT_FORCE_CELLS`): every real contact lies
@@ -42,7 +43,7 @@ from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, 
 #: extrapolated from grids up to this; FastSim's discretisation error at 60
 #: cells is 0.1% on ellipses (docs/validation.md).
 DEFAULT_CELLS = {"exact": 100, "mae": 100, "fastsim": 60, "exact_forces": 60,
-                 "mae_forces": 60, "fastsim_ellipse_forces": 60}
+                 "mae_forces": 60, "fastsim_ellipse_forces": 60, "fastrip_forces": 60}
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -155,7 +156,8 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
     fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
-    fo.add_argument("--method", choices=("mae", "fastsim_ellipse", "exact"), default="mae")
+    fo.add_argument("--method", choices=("mae", "fastsim_ellipse", "exact", "fastrip"),
+                    default="mae")
     fo.add_argument("--bound", choices=BOUNDS, default="given",
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch)")
@@ -391,7 +393,12 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         raise InvalidInputError(f"--load must be positive, got {args.load:g}")
     if args.method == "exact" and args.bound == "parabolic":
         raise UsageError("--method exact takes the pressure as given (--bound given)")
+    if args.method == "fastrip" and args.bound == "parabolic":
+        raise UsageError("--method fastrip takes the strips' Hertzian pressure of the given "
+                         "load (--bound given)")
     law = _friction(args)
+    if args.method == "fastrip" and not isinstance(law, ConstantFriction):
+        raise UsageError("--method fastrip takes constant friction (--friction-law constant)")
     patch = _force_area(args)
     result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound,
                               "friction_law": law.name}
@@ -417,6 +424,15 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
                       # an empty zone (a one-sided split) has no semi-ellipse: null axes
                       zones=[{"area": z.area, "a": _or_none(z.a_eq), "b": _or_none(z.b_eq)}
                              for z in (g.zone1, g.zone2)])
+    elif args.method == "fastrip":
+        from fastsim_ros.contact.fastrip import fastrip
+        from fastsim_ros.contact.tables import coefficient_table
+        fr = fastrip(patch, *creepages, mu=args.mu, table=coefficient_table(args.nu),
+                     shear_modulus=args.shear_modulus)
+        e = fr.ellipse
+        result.update(Fx=fr.fx, Fy=fr.fy, Mz=fr.mz, slip_fraction=float(
+            np.count_nonzero(fr.traction.slip)) / np.count_nonzero(patch.mask),
+            ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
     else:
         from fastsim_ros.contact.compiled import EquivalentEllipseSolver
         eq = EquivalentEllipseSolver(args.nu, args.shear_modulus)

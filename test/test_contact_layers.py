@@ -30,6 +30,8 @@ ALLOWED = {
             "tables", "traction"},
     "equivalent": {"numpy", "area", "checks", "coefficients", "fastsim", "friction", "rules",
                    "tables", "traction"},
+    "fastrip": {"numpy", "area", "checks", "coefficients", "equivalent", "errors", "fastsim",
+                "tables", "traction"},
     "kernels": {"numpy", "numba", "rules"},
     "compiled": {"numpy", "kernels", "area", "checks", "errors", "friction", "rules", "tables",
                  "mae", "equivalent"},

@@ -33,6 +33,8 @@ _HOME = {
     "mae_geometry": "mae", "mae_coefficients": "mae", "mae_fastsim": "mae",
     "mae_fastsim_coefficients": "mae",
     "equivalent_fastsim": "equivalent", "equivalent_coefficients": "equivalent",
+    # FaStrip (fastrip() itself: the submodule takes the name)
+    "fastrip_coefficients": "fastrip",
     # the exact theory and the normal problem (SciPy)
     "SteadyRollingOperator": "exact", "full_adhesion": "exact", "coulomb": "exact",
     "creep_coefficients": "exact", "unit_solutions": "exact",

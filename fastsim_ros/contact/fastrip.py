@@ -1,0 +1,313 @@
+"""FaStrip on a grid area: strip theory made three-dimensional by Kalker's linear theory.
+
+FaStrip (Sichani, Enblom and Berg, "An alternative to FASTSIM for tangential
+solution of the wheel-rail contact", Vehicle System Dynamics 54(6), 2016) is
+the baseline a user would pick instead of FastSim: each lateral strip of the
+patch is solved in closed form as a two-dimensional rolling contact (Carter's
+solution, as in Kalker's 1967 strip theory), and the strips' elastic constant
+is taken from Kalker's linear theory so that the three-dimensional creep
+coefficients come out right.  On a non-elliptical patch every strip segment
+is treated with its own local half-length (the non-elliptical FaStrip of
+Sichani et al. that ANALYN feeds).
+
+Provenance.  The paper's text could not be retrieved here (the search tool
+holds no copy of it, nor of the ANALYN-FaStrip papers), so the equation
+numbers of the paper are not quoted: each equation below is stated with its
+derivation, and every one of them is pinned by an exactness test
+(``test/test_contact_fastrip.py``).  Where this reading had to choose, the
+choice and its reason are given.
+
+Per strip segment ``j`` (cells of one row in contact without a gap):
+
+(F1) local geometry: half-length ``a_j`` and centre ``x_j`` from the
+     segment's cell faces, strip load per unit width ``P_j = sum p dx``
+     (N/m), and the semi-elliptic strip pressure of that load,
+     ``p_j(s) = p0_j sqrt(1 - s^2)``, ``p0_j = 2 P_j/(pi a_j)``, ``s = (x -
+     x_j)/a_j``.  On a Hertzian patch this is the given pressure exactly
+     (``1 - x^2/a^2 - y^2/b^2 = (1 - y^2/b^2)(1 - x^2/a_y^2)``).  Assumption of
+     strip theory: the strip is a plane-strain rolling contact with a
+     Hertzian pressure along it; FaStrip's traction bound is therefore
+     ``mu p_j``, not the given pressure cell by cell (``bound="given"`` is
+     the only bound it takes).
+(F2) Carter's partial-slip solution in the strip, stick zone at the leading
+     edge ``2 nu_j - 1 <= s <= 1`` (half-length ``k = 1 - nu_j``, centre
+     ``nu_j``): ``|tau| = mu p0_j (sqrt(1 - s^2) - sqrt(k^2 - (s - nu_j)^2))``
+     there and ``|tau| = mu p0_j sqrt(1 - s^2)`` in the slip zone behind it;
+     the strip's force is ``mu P_j (1 - k^2)`` up to ``nu_j = 1``, ``mu P_j``
+     beyond.  In the stick zone the difference is evaluated as
+     ``2 nu sqrt(1 - s) / (sqrt(1 + s) + sqrt(1 + s - 2 nu))`` in effect
+     (below ``nu = 1e-8`` by its first-order term ``nu sqrt((1-s)/(1+s))``,
+     whose cell integrals are closed-form), so that vanishing creepage and
+     ``mu -> infinity`` lose no digits.
+(F3) the three-dimensional elastic constant: the strip's normalised creepage
+     vector is ``nu_j = q_j / mu`` with
+     ``q_x = a_j^2 (xi_c/L1 - phi (y_j - y_c)/L3) / P_j``,
+     ``q_y = a_j^2 (eta_c/L2 + phi (x_j - x_c)/L3 + phi a_j/(3 L3)) / P_j``,
+     ``L1..L3`` Kalker's flexibilities (METHOD.md 2) of the patch's
+     equivalent ellipse (:func:`~fastsim_ros.contact.equivalent.equivalent_ellipse`:
+     area, centroid ``(x_c, y_c)``, second-moment ratio; Kalker's C from the
+     package's tables), creepages moved to the centroid by the rigid-slip
+     identity.  Why: at vanishing creepage (F2) gives the strip force ``2 mu
+     P_j nu_j = 2 a_j^2 xi/L1``, which is FastSim's strip force in full
+     adhesion; on an ellipse, summed over strips, that is Kalker's ``G a b
+     C11 xi`` (and C22).  The lateral spin term varies along the strip; it
+     enters as the constant lateral creepage with the same full-adhesion
+     strip force as FastSim's ``phi x/L3`` (``2 a_j^3/(3 L3)`` about the
+     strip centre), which gives Kalker's C23.  Choice: Kalker's 1967 strip
+     theory takes the strip's constant from plane strain (its known 25%
+     error on round patches); FaStrip's point is to take it from the linear
+     theory, and FastSim's L's are the one set of constants that do so
+     strip by strip.
+(F4) directions: the stick zone's traction opposes ``q_j`` (the vector form of
+     Carter's solution, one direction per strip); in the slip zone the
+     traction opposes the local rigid slip ``w = (xi - phi (y - y_P), eta +
+     phi (x - x_P))`` at the cell centre (Coulomb's law with the elastic
+     part of the slip neglected there, which is what makes pure spin at
+     large creepage tend to ``-mu p w/|w|`` and a pure creepage to ``mu N``).
+     Choice: the strip solution itself has no direction field; the rigid
+     slip is the one the exact theory approaches as the slip zone grows.
+
+Discretisation: each cell's traction is the mean of (F2) over the cell (the
+stick/slip boundary may cut a cell), so a strip's force is the closed form
+whatever the cell size; a cell is reported as slipping when its centre lies
+in the slip zone.  Strips of several segments (a notch): each segment is a
+strip of its own, restarting at its own leading edge.  Units: SI (m, Pa, N,
+N m; ``phi`` in 1/m).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.checks import (check_bound, check_creepages, check_friction,
+                                        check_shear_modulus)
+from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
+                                              coefficients_from_unit_solutions)
+from fastsim_ros.contact.equivalent import EquivalentEllipse, equivalent_ellipse
+from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.contact.fastsim import kalker_flexibility
+from fastsim_ros.contact.tables import CoefficientTable
+from fastsim_ros.contact.traction import Tractions, resultants
+
+FloatArray = NDArray[np.float64]
+
+#: below this normalised creepage (F2) is evaluated by its first-order term
+SMALL_NU = 1e-8
+
+
+@dataclass(frozen=True, eq=False)
+class StripSegments:
+    """The strip segments of an area: row ``j``, first and one-past-last column, per segment."""
+
+    row: NDArray[np.int_]
+    start: NDArray[np.int_]
+    stop: NDArray[np.int_]
+
+
+def strip_segments(area: GridArea) -> StripSegments:
+    """Return every run of cells in contact along each row (the strips FaStrip solves)."""
+    m = area.mask
+    pad = np.zeros((m.shape[0], 1), dtype=bool)
+    edges = np.diff(np.hstack([pad, m, pad]).astype(np.int8), axis=1)
+    rs, starts = np.nonzero(edges == 1)
+    re, stops = np.nonzero(edges == -1)
+    # np.nonzero walks row-major: runs come in the same order in both
+    if not np.array_equal(rs, re):
+        raise InvalidInputError("inconsistent strip segments")  # cannot happen
+    return StripSegments(rs, starts, stops)
+
+
+@dataclass(frozen=True)
+class FastripFlexibility:
+    """Kalker's ``L1, L2, L3`` (m/Pa) of the patch's equivalent ellipse."""
+
+    l1: float
+    l2: float
+    l3: float
+
+
+@dataclass(frozen=True, eq=False)
+class FastripResult:
+    """Forces (N), ``Mz`` (N m) about the reference point, the ellipse, its L's and the field."""
+
+    fx: float
+    fy: float
+    mz: float
+    ellipse: EquivalentEllipse
+    flexibility: FastripFlexibility
+    traction: Tractions
+
+
+def _half_disc(s: FloatArray) -> FloatArray:
+    """Return ``A1(s) = int sqrt(1 - s^2) ds`` (from 0), ``s`` clipped to [-1, 1]."""
+    s = np.clip(s, -1.0, 1.0)
+    return 0.5 * (s * np.sqrt(1.0 - s * s) + np.arcsin(s))
+
+
+def _disc(s: FloatArray, centre: FloatArray, radius: FloatArray) -> FloatArray:
+    """Return ``int sqrt(r^2 - (s - c)^2) ds`` (from ``c``), clipped to the disc."""
+    r = np.maximum(radius, 1e-300)
+    u = np.clip((s - centre) / r, -1.0, 1.0)
+    return 0.5 * r * r * (u * np.sqrt(1.0 - u * u) + np.arcsin(u))
+
+
+def _adhesion_shape(s: FloatArray) -> FloatArray:
+    """Return ``H(s) = sqrt(1 - s^2) + asin(s)``, the integral of ``sqrt((1-s)/(1+s))``."""
+    s = np.clip(s, -1.0, 1.0)
+    return np.sqrt(1.0 - s * s) + np.arcsin(s)
+
+
+def _slip_directions(area: GridArea, stick: FloatArray, slip: FloatArray, ux: FloatArray,
+                     uy: FloatArray, xi_c: float, eta_c: float, phi: float,
+                     centroid: tuple[float, float],
+                     flex: FastripFlexibility) -> tuple[FloatArray, FloatArray]:
+    """Return ``tau_x``, ``tau_y`` (Pa): the cells' stick and slip magnitudes with directions.
+
+    ``stick``, ``slip``: each cell's mean traction magnitude (Pa) from its
+    stick and its slip part (F2); ``ux``, ``uy``: the unit vector of its
+    strip's ``q`` (the stick part opposes it).  The slip part's direction is
+    the simplified theory's (F4): march each strip from its leading edge,
+    the trial traction ``tau_prev - (xi_c/L1 - phi (y - y_c)/L3, eta_c/L2 +
+    phi (x - x_c)/L3) h`` (first step ``h = dx/2``, then ``dx``; ``phi x`` at
+    the middle of the step, METHOD.md 2), and take its direction.
+    """
+    x_c, y_c = centroid
+    ny, nx = stick.shape
+    dx = area.dx
+    inside_all = area.mask
+    rate_x = xi_c / flex.l1 - phi * (area.y - y_c) / flex.l3
+    tx = np.zeros(ny)
+    ty = np.zeros(ny)
+    out_x = np.zeros((ny, nx))
+    out_y = np.zeros((ny, nx))
+    prev_in = np.zeros(ny, dtype=bool)
+    for i in range(nx - 1, -1, -1):
+        inside = inside_all[:, i]
+        step = np.where(prev_in, dx, 0.5 * dx)
+        x_mid = area.x[i] - x_c + 0.5 * step
+        trial_x = tx - rate_x * step
+        trial_y = ty - (eta_c / flex.l2 + phi * x_mid / flex.l3) * step
+        norm = np.hypot(trial_x, trial_y)
+        ok = norm > 0.0
+        safe = np.where(ok, norm, 1.0)
+        dir_x = np.where(ok, trial_x / safe, -ux[:, i])
+        dir_y = np.where(ok, trial_y / safe, -uy[:, i])
+        tx = np.where(inside, -stick[:, i] * ux[:, i] + slip[:, i] * dir_x, 0.0)
+        ty = np.where(inside, -stick[:, i] * uy[:, i] + slip[:, i] * dir_y, 0.0)
+        out_x[:, i] = tx
+        out_y[:, i] = ty
+        prev_in = inside
+    return out_x, out_y
+
+
+def fastrip_flexibility(area: GridArea, table: CoefficientTable,
+                        shear_modulus: float) -> tuple[EquivalentEllipse, FastripFlexibility]:
+    """Return the equivalent ellipse of the area and its Kalker flexibilities (F3)."""
+    check_shear_modulus(shear_modulus)
+    e = equivalent_ellipse(area)
+    c11, c22, c23 = table.kalker(e.a / e.b)
+    l1, l2, l3 = kalker_flexibility(e.a, e.b, c11, c22, c23, shear_modulus)
+    return e, FastripFlexibility(l1, l2, l3)
+
+
+def fastrip(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
+            table: CoefficientTable, shear_modulus: float,
+            reference: tuple[float, float] = (0.0, 0.0), bound: str = "given") -> FastripResult:
+    """Solve FaStrip on ``area`` at ``xi``, ``eta`` (1) and ``phi`` (1/m) about ``reference`` (m).
+
+    ``mu``: Coulomb's friction coefficient; ``table``: the coefficient tables
+    at the material's Poisson ratio; ``shear_modulus``: combined ``G`` (Pa).
+    ``bound`` must be ``"given"`` (F1: the strip's own Hertzian pressure of
+    the given load); ``"parabolic"`` is refused.  ``Mz`` is about ``reference``.
+    """
+    check_creepages(xi, eta, phi)
+    mu = check_friction(mu)
+    if check_bound(bound):
+        raise InvalidInputError("FaStrip takes the strips' Hertzian pressure of the given load "
+                                "(bound 'given'), not the parabolic bound")
+    ell, flex = fastrip_flexibility(area, table, shear_modulus)
+    x_c, y_c = ell.x_c, ell.y_c
+    xp, yp = reference
+    # creepages at the centroid (the rigid-slip identity, METHOD.md 3.2)
+    xi_c = xi + phi * (yp - y_c)
+    eta_c = eta - phi * (xp - x_c)
+    seg = strip_segments(area)
+    dx = area.dx
+    x = area.x
+    p = area.pressure
+    half = 0.5 * (seg.stop - seg.start) * dx                      # a_j
+    centre = 0.5 * (x[seg.start] + x[seg.stop - 1])               # x_j
+    csum = np.hstack([np.zeros((area.ny, 1)), np.cumsum(p, axis=1)])
+    load = (csum[seg.row, seg.stop] - csum[seg.row, seg.start]) * dx   # P_j (N/m)
+    p0 = 2.0 * load / (math.pi * half)
+    y_j = area.y[seg.row]
+    # (F3): the strips' normalised creepages times mu
+    qx = half**2 * (xi_c / flex.l1 - phi * (y_j - y_c) / flex.l3) / load
+    qy = half**2 * (eta_c / flex.l2 + phi * (centre - x_c) / flex.l3
+                    + phi * half / (3.0 * flex.l3)) / load
+    qn = np.hypot(qx, qy)
+    nu = qn / mu
+    # every cell in contact, with its segment
+    counts = seg.stop - seg.start
+    k_seg = np.repeat(np.arange(seg.row.size), counts)
+    offsets = np.arange(k_seg.size) - np.repeat(np.cumsum(counts) - counts, counts)
+    cols = seg.start[k_seg] + offsets
+    rows = seg.row[k_seg]
+    a_k, x_k, nu_k = half[k_seg], centre[k_seg], nu[k_seg]
+    s_lo = np.clip((x[cols] - 0.5 * dx - x_k) / a_k, -1.0, 1.0)
+    s_hi = np.clip((x[cols] + 0.5 * dx - x_k) / a_k, -1.0, 1.0)
+    t = np.minimum(2.0 * nu_k - 1.0, 1.0)                         # stick/slip boundary
+    # slip part of each cell: mu p0 int sqrt(1 - s^2) over [s_lo, min(s_hi, t)]
+    slip_hi = np.minimum(s_hi, t)
+    slip_int = np.where(slip_hi > s_lo, _half_disc(slip_hi) - _half_disc(s_lo), 0.0)
+    # stick part: over [max(s_lo, t), s_hi], in units of p0 (mu nu = |q| in the small branch)
+    st_lo = np.maximum(s_lo, t)
+    has_stick = s_hi > st_lo
+    k_rad = 1.0 - nu_k
+    with np.errstate(over="ignore", invalid="ignore"):  # only read where nu > SMALL_NU
+        exact_part = mu * ((_half_disc(s_hi) - _half_disc(st_lo))
+                           - (_disc(s_hi, nu_k, k_rad) - _disc(st_lo, nu_k, k_rad)))
+    small_part = qn[k_seg] * (_adhesion_shape(s_hi) - _adhesion_shape(st_lo))
+    stick_int = np.where(has_stick, np.where(nu_k > SMALL_NU, exact_part, small_part), 0.0)
+    scale = p0[k_seg] * a_k / dx                                  # mean over the cell
+    stick_mag = np.maximum(stick_int, 0.0) * scale
+    slip_mag = mu * slip_int * scale
+    # (F4): stick opposes q_j; the slip zone's direction is marched (see _slip_directions)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ux = np.where(qn > 0.0, qx / np.where(qn > 0.0, qn, 1.0), 0.0)[k_seg]
+        uy = np.where(qn > 0.0, qy / np.where(qn > 0.0, qn, 1.0), 0.0)[k_seg]
+    stick2 = np.zeros(p.shape)
+    slip2 = np.zeros(p.shape)
+    ux2 = np.zeros(p.shape)
+    uy2 = np.zeros(p.shape)
+    stick2[rows, cols] = stick_mag
+    slip2[rows, cols] = slip_mag
+    ux2[rows, cols] = ux
+    uy2[rows, cols] = uy
+    tau_x, tau_y = _slip_directions(area, stick2, slip2, ux2, uy2, xi_c, eta_c, phi,
+                                    (x_c, y_c), flex)
+    slip = np.zeros(p.shape, dtype=bool)
+    s_mid = (x[cols] - x_k) / a_k
+    slip[rows, cols] = s_mid < t
+    fx, fy, mz = resultants(area, tau_x, tau_y, reference)
+    return FastripResult(fx, fy, mz, ell, flex, Tractions(tau_x, tau_y, slip, fx, fy, mz))
+
+
+def fastrip_coefficients(area: GridArea, table: CoefficientTable, *,
+                         reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
+    """Return FaStrip's generalised coefficients at vanishing creepage (full adhesion).
+
+    Normalised with the area's own discrete area, as the exact theory's are.
+    """
+    unit_load = area.with_load(1.0)
+    # so large a friction coefficient that no strip has a slip zone: full adhesion
+    unit = tuple(fastrip(unit_load, *cr, mu=1e300, table=table, shear_modulus=1.0,
+                         reference=reference)
+                 for cr in UNIT_CREEPAGES)
+    return coefficients_from_unit_solutions(area.area, tuple((r.fx, r.fy, r.mz) for r in unit),
+                                            reference=reference)
