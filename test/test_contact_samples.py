@@ -57,3 +57,76 @@ def test_semi_ellipses_patch_keeps_the_shape_and_its_join_line(g1):
     assert ar.area == pytest.approx(1e-4, rel=0.05)
     # joined along y = 0: MAE's widest_strip split finds the join line (METHOD.md 6)
     assert mae_geometry(ar, "widest_strip").y_s == pytest.approx(0.0, abs=1e-12)
+
+
+def extents(ar):
+    """Return the cell-face extents ``(x_min, x_max, y_min, y_max)`` of the cells in contact."""
+    jj, ii = np.nonzero(ar.mask)
+    return (ar.x[ii].min() - ar.dx / 2, ar.x[ii].max() + ar.dx / 2,
+            ar.y[jj].min() - ar.dy / 2, ar.y[jj].max() + ar.dy / 2)
+
+
+def test_long_narrow_patch_is_long_narrow_and_not_an_ellipse():
+    ar = samples.long_narrow_patch(cells=40, scale=0.01, load=5e4)
+    x0, x1, y0, y1 = extents(ar)
+    assert (x1 - x0) / (y1 - y0) > 5.0
+    assert ar.area == pytest.approx(1e-4, rel=0.03)
+    # squarer than the ellipse of its extents: 18% more area (superellipse of order 4)
+    assert ar.area / (np.pi * (x1 - x0) * (y1 - y0) / 4) == pytest.approx(1.18, rel=0.03)
+    assert ar.load == pytest.approx(5e4)
+    with pytest.raises(samples.InvalidInputError):
+        samples.long_narrow_patch(cells=20, a_over_b=4.0)
+
+
+def test_crescent_is_bent_symmetric_and_not_convex():
+    ar = samples.crescent_patch(cells=40, scale=0.01, load=5e4)
+    np.testing.assert_array_equal(ar.mask, ar.mask[::-1, :])  # symmetric in y
+    rows = np.flatnonzero(ar.mask.any(axis=1))
+    centre = np.array([ar.x[np.flatnonzero(ar.mask[j])].mean() for j in rows])
+    y = ar.y[rows]
+    # the strips' centres lie on a parabola in y: the horns lead the middle
+    mid = centre[np.argmin(np.abs(y))]
+    a, b = (0.01 * v for v in areas.semi_ellipse_axes(0.3))
+    assert centre[0] - mid == pytest.approx(1.2 * a * (y[0] / b) ** 2, rel=0.1)
+    assert np.corrcoef(y**2, centre)[0, 1] > 0.99
+    # not convex: the point halfway between the horns' tips lies outside the patch
+    tip = ar.x[np.flatnonzero(ar.mask[rows[0]])].mean()
+    i = int(np.argmin(np.abs(ar.x - tip)))
+    j = int(np.argmin(np.abs(ar.y)))
+    assert not ar.mask[j, i]
+    assert ar.area == pytest.approx(1e-4, rel=0.03)
+
+
+def test_egg_is_asymmetric_in_x_only():
+    ratio = 1.8
+    ar = samples.egg_patch(cells=40, scale=0.01, load=5e4, lead_over_trail=ratio)
+    x0, x1, _, _ = extents(ar)
+    assert x1 / -x0 == pytest.approx(ratio, rel=0.05)
+    np.testing.assert_allclose(ar.pressure, ar.pressure[::-1, :], rtol=1e-12, atol=0)
+    jj, ii = np.nonzero(ar.mask)
+    w = ar.pressure[jj, ii]
+    assert np.average(ar.x[ii], weights=w) > 0.1 * x1  # the load leans forward
+    assert ar.area == pytest.approx(1e-4, rel=0.03)
+
+
+def test_profile_gap_patches_run_from_the_tread_to_the_flange_root():
+    patches = [samples.profile_gap_patch(u, cells=40) for u in samples.PROFILE_SHIFTS]
+    # on the tread the patch is Hertz's of the tread's curvatures
+    tread = hertz_ellipse(samples.WHEEL_RADIUS, 1.0 / samples.PROFILE_TREAD_CURVATURE, 5e4,
+                          shear_modulus=samples.STEEL_G, nu=samples.STEEL_NU)
+    x0, x1, y0, y1 = extents(patches[0])
+    assert patches[0].pressure.max() == pytest.approx(tread.p0, rel=0.03)
+    assert (y1 - y0) / 2 == pytest.approx(tread.b, abs=2 * patches[0].dy)
+    assert (x1 - x0) / 2 == pytest.approx(tread.a, abs=2 * patches[0].dx)
+    # towards the flange root: narrower, longer, more loaded
+    widths = [extents(p)[3] - extents(p)[2] for p in patches]
+    lengths = [extents(p)[1] - extents(p)[0] for p in patches]
+    peaks = [p.pressure.max() for p in patches]
+    assert widths[0] > widths[1] > widths[2]
+    assert lengths[0] < lengths[1] < lengths[2]
+    assert peaks[0] < peaks[1] < peaks[2]
+    # in the transition the patch reaches further onto the softer tread side
+    _, _, y0, y1 = extents(patches[1])
+    assert -y0 > 1.5 * y1
+    for p in patches:
+        assert p.load == pytest.approx(5e4, rel=1e-6)

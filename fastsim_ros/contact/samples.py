@@ -127,3 +127,119 @@ def flange_root_patch(*, cells: int, load: float = 5.0e4) -> GridArea:
 def unit_scale(area: GridArea) -> float:
     """Length scale ``sqrt(A/pi)`` of an area (m)."""
     return math.sqrt(area.area / math.pi)
+
+
+# ----------------------------------------------------------------------------- wider validation
+
+def long_narrow_patch(*, cells: int, scale: float = 1.0, load: float | None = None,
+                      a_over_b: float = 6.0) -> GridArea:
+    """Make a long narrow patch: the superellipse ``|x/a|^4 + |y/b|^4 < 1``, ``a/b = a_over_b``.
+
+    Area ``scale^2`` (the superellipse's area is ``4 a b Gamma(5/4)^2 /
+    Gamma(3/2)``); squarer than an ellipse, as where a narrow running band
+    is cut off laterally; pressure ``p0 sqrt(1 - |x/a|^4 - |y/b|^4)``.
+    """
+    if not a_over_b > 5.0:
+        raise InvalidInputError(f"a long narrow patch has a/b > 5, got {a_over_b}")
+    unit = 4.0 * math.gamma(1.25) ** 2 / math.gamma(1.5)  # area of a = b = 1
+    b = math.sqrt(1.0 / (unit * a_over_b))
+    a = a_over_b * b
+    x, y, dx, dy = _grid((-a, a), (-b, b), cells)
+    r4 = (x[None, :] / a) ** 4 + (y[:, None] / b) ** 4
+    p = np.sqrt(np.clip(1.0 - r4, 0.0, None))
+    return _finish(x, y, dx, dy, p, scale, load)
+
+
+def crescent_patch(*, cells: int, scale: float = 1.0, load: float | None = None,
+                   bend: float = 1.2) -> GridArea:
+    """Make a crescent: a hollow-worn tread's patch, an ellipse bent along its lateral axis.
+
+    The ellipse ``a/b = 0.3`` (area ``scale^2``) with each strip moved along
+    ``x`` by ``bend a (y/b)^2``: the horns lead the middle by ``bend a`` (a
+    patch on a hollow tread, whose contact runs ahead towards both of the
+    hollow's shoulders); Hertz-like pressure in the bent coordinates.
+    """
+    a, b = semi_ellipse_axes(0.3)
+    x, y, dx, dy = _grid((-a, a + bend * a), (-b, b), cells)
+    xx, yy = x[None, :], y[:, None]
+    p = _hertz_like(xx - bend * a * (yy / b) ** 2, yy, a, b)
+    return _finish(x, y, dx, dy, p, scale, load).cropped()
+
+
+def egg_patch(*, cells: int, scale: float = 1.0, load: float | None = None,
+              lead_over_trail: float = 1.8) -> GridArea:
+    """Make an egg: the leading half (``x > 0``) ``lead_over_trail`` times the trailing one.
+
+    Two half ellipses joined along ``x = 0``, semi-axes ``a_l`` (leading),
+    ``a_t`` (trailing) and ``b``, ``a_l = lead_over_trail a_t``, ``(a_l +
+    a_t)/(2 b) = 1``, area ``scale^2``; Hertz-like pressure per half, equal on
+    the join.  Asymmetric in ``x`` only: symmetric in ``y``.
+    """
+    if not (math.isfinite(lead_over_trail) and lead_over_trail > 0.0):
+        raise InvalidInputError(f"lead_over_trail must be positive, got {lead_over_trail}")
+    # area pi (a_l + a_t) b / 2 = 1 with a_l + a_t = 2 b
+    b = 1.0 / math.sqrt(math.pi)
+    a_t = 2.0 * b / (1.0 + lead_over_trail)
+    a_l = lead_over_trail * a_t
+    x, y, dx, dy = _grid((-a_t, a_l), (-b, b), cells)
+    xx, yy = x[None, :], y[:, None]
+    p = np.where(xx > 0.0, _hertz_like(xx, yy, a_l, b), _hertz_like(xx, yy, a_t, b))
+    return _finish(x, y, dx, dy, p, scale, load)
+
+
+#: the profile-gap sample: lateral relative curvature (1/m) on the tread and at the flange
+#: root, and the width (m) of the transition between them (from s = 0 to s = WIDTH)
+PROFILE_TREAD_CURVATURE = 1.0 / 0.3
+PROFILE_ROOT_CURVATURE = 1.0 / 0.03
+PROFILE_TRANSITION = 6.0e-3
+
+
+def _profile_height(s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return the lateral profile gap ``h(s)`` (m) of the profile-gap sample and ``h'(s)``."""
+    k0, k1, w = PROFILE_TREAD_CURVATURE, PROFILE_ROOT_CURVATURE, PROFILE_TRANSITION
+    t = np.asarray(s, dtype=float) / w
+    # q'' = smoothstep(t): 0 before the transition, 3t^2 - 2t^3 in it, 1 after
+    tc = np.clip(t, 0.0, 1.0)
+    q = np.where(t < 0.0, 0.0, np.where(t <= 1.0, tc**4 / 4 - tc**5 / 10,
+                                        0.15 + 0.5 * (t - 1.0) + 0.5 * (t - 1.0) ** 2))
+    dq = np.where(t < 0.0, 0.0, np.where(t <= 1.0, tc**3 - tc**4 / 2, 0.5 + (t - 1.0)))
+    return k0 * s**2 / 2 + (k1 - k0) * w**2 * q, k0 * s + (k1 - k0) * w * dq
+
+
+def profile_gap(x: np.ndarray, y: np.ndarray, shift: float) -> np.ndarray:
+    """Return the undeformed gap (m) at ``(x, y)`` (m) of a contact at lateral shift ``shift``.
+
+    A wheel profile whose lateral relative curvature rises smoothly from the
+    tread's (0.3 m radius, ``s < 0``) to the flange root's (0.03 m, ``s >
+    6 mm``): ``h''(s)`` is a smoothstep between them.  At a lateral shift
+    ``u`` the contact's centre is where the profile touches, ``s = u``; the
+    gap is ``h(u + y) - h(u) - h'(u) y`` (the contact plane tangent there)
+    plus the wheel radius along ``x``.
+    """
+    h_y, _ = _profile_height(shift + y)
+    h_u, dh_u = _profile_height(np.asarray(shift, dtype=float))
+    return x**2 / (2.0 * WHEEL_RADIUS) + (h_y - h_u - dh_u * y)
+
+
+#: lateral shifts (m) from the tread to the flange root used by the validation
+PROFILE_SHIFTS = (-4.0e-3, 1.5e-3, 4.5e-3)
+
+
+def profile_gap_patch(shift: float, *, cells: int, load: float = 5.0e4) -> GridArea:
+    """Solve the normal contact of :func:`profile_gap` at ``shift`` (m) under ``load`` (N).
+
+    Steel on steel, the exact normal solver on ``cells`` x ``cells`` cells
+    over a box of 18 mm x 13 mm (more of it on the tread side, ``y < 0``),
+    cropped to the cells in contact.
+    """
+    if not (math.isfinite(shift) and abs(shift) <= 2.0e-2):
+        raise InvalidInputError(f"shift must lie within 20 mm of the profile's origin, "
+                                f"got {shift}")
+    x, y, dx, dy = _grid((-9.0e-3, 9.0e-3), (-7.0e-3, 6.0e-3), cells)
+    gap = profile_gap(x[None, :], y[:, None], shift)
+    sol = solve_normal(float(x[0]), float(y[0]), dx, dy, gap, load=load,
+                       shear_modulus=STEEL_G, nu=STEEL_NU)
+    if sol.touches_edge:
+        raise InvalidInputError(f"the profile-gap box is too small for a load of {load:g} N "
+                                f"at shift {shift:g} m")
+    return sol.area.cropped()
