@@ -7,13 +7,14 @@ the equivalent ellipse on the flange-root patch
 (:func:`fastsim_ros.contact.samples.flange_root_patch`), for the law
 ``mu(v) = mu_s ((1 - A) exp(-B v) + A)`` at rolling speed ``V``.  Also the
 exact solver's grid check at one creepage near the peak (20, 30, 40 cells
-across), FastSim's peak on 30 to 240 cells and, at that creepage, the
-central strip of the ellipse: traction over its static bound and slip
-velocity along ``x``, exact against FastSim (the third panel of the figure;
+across), lateral creepage and longitudinal with spin on the ellipse,
+FastSim's peak on 30 to 240 cells and, at that creepage, the central strip
+of the ellipse: traction over its static bound and slip velocity along
+``x``, exact against FastSim (the third panel of the figure;
 ``docs/data/friction_strip.csv``).  Writes
 ``docs/figures/friction_creep_curves.png``, ``docs/data/friction_curves.csv``
 and ``docs/data/friction_strip.csv`` and prints the tables of
-docs/validation.md ("Slip-dependent friction").  About two minutes here.
+docs/validation.md ("Slip-dependent friction").  About a minute here.
 """
 
 from __future__ import annotations
@@ -127,8 +128,10 @@ def main() -> int:
     hertz = ellipse(*SEMI_AXES, nx=EXACT_CELLS, ny=EXACT_CELLS, load=1e5)
     flange = samples.flange_root_patch(cells=EXACT_CELLS)
     curves = {}
+    hertz_op = SteadyRollingOperator.of(hertz, nu=NU, shear_modulus=G)
     for name, area in (("hertz", hertz), ("flange_root", flange)):
-        op = SteadyRollingOperator.of(area, nu=NU, shear_modulus=G)
+        op = (hertz_op if area is hertz
+              else SteadyRollingOperator.of(area, nu=NU, shear_modulus=G))
         mun = MU_S * area.load
         for b in DECAYS:
             curves[(name, "exact", b)] = exact_curve(area, op, b) / mun
@@ -167,6 +170,26 @@ def main() -> int:
                       friction=law(b), speed=SPEED).fx / (MU_S * ar.load)
              for b in (CHECK_DECAY, 0.0)]
         print(f"| {n} | {f[0]:.4f} | {f[1]:.4f} |")
+    # beyond pure xi: lateral creepage, and xi with spin, on the ellipse
+    print("\nHertzian ellipse, other creepages (12 levels in [5e-4, 0.1]; xi + spin: phi = "
+          "20 xi 1/m): largest error in % of mu_s N, and the peak of |F|/(mu_s N)\n")
+    print("| creepage | B (s/m) | FastSim Fx error | Fy error | exact peak | FastSim peak |")
+    print("| --- | --- | --- | --- | --- | --- |")
+    levels = np.geomspace(XI[0], XI[-1], 12)
+    fast = EquivalentEllipseSolver(NU, G, cells=60)
+    for cname, creep in (("eta", lambda c: (0.0, c, 0.0)),
+                         ("xi + spin", lambda c: (c, 0.0, 20.0 * c))):
+        for b in (0.0, 1.0, 3.0):
+            ex = np.array([[r.fx, r.fy] for r in (
+                coulomb(hertz, *creep(c), nu=NU, shear_modulus=G, operator=hertz_op,
+                        friction=law(b), speed=SPEED) for c in levels)])
+            fa = np.array([[r.fx, r.fy] for r in (
+                fast.solve(hertz, *creep(c), friction=law(b), speed=SPEED, bound="parabolic")
+                for c in levels)])
+            err = 100 * np.abs(fa - ex).max(axis=0) / (MU_S * hertz.load)
+            pe, pf = (float(np.hypot(v[:, 0], v[:, 1]).max() / (MU_S * hertz.load))
+                      for v in (ex, fa))
+            print(f"| {cname} | {b:g} | {err[0]:.1f} | {err[1]:.1f} | {pe:.3f} | {pf:.3f} |")
     # FastSim's own grid convergence with the falling law (the peak on a finer xi grid)
     fine = np.geomspace(XI[0], XI[-1], 61)
     print("\nFastSim (Kalker's, parabolic bound) on n x n cells: peak Fx/(mu_s N) and its xi "
@@ -183,8 +206,7 @@ def main() -> int:
             cols.append(f"{f[k] / (MU_S * hertz.load):.4f} at {fine[k]:.3g}")
         print(f"| {n} | " + " | ".join(cols) + " |")
     # the central strip near the peak
-    op = SteadyRollingOperator.of(hertz, nu=NU, shear_modulus=G)
-    strips = {"exact": exact_strip(hertz, op, CHECK_DECAY, CHECK_XI),
+    strips = {"exact": exact_strip(hertz, hertz_op, CHECK_DECAY, CHECK_XI),
               "fastsim": fastsim_strip(hertz, CHECK_DECAY, CHECK_XI)}
     with open(ROOT / "docs" / "data" / "friction_strip.csv", "w", newline="") as f:
         w = csv.writer(f, lineterminator="\n")
