@@ -123,7 +123,8 @@ def test_parabolic_bound_is_refused():
 
 
 #: largest error (in % of mu N, where the exact force exceeds 5% of mu N) measured on the
-#: Hertzian ellipse a/b = 2/3 at 24 x 24 cells (docs/validation_wider.md): the test pins them
+#: Hertzian ellipse a/b = 2/3 at 24 x 24 cells: the test pins them (on 40 cells,
+#: docs/validation_wider.md: 2.6, 3.3, 13.8, 10.8)
 MEASURED_WORST = {"xi": 1.6, "eta": 2.2, "phi": 13.5, "combined": 10.5}
 
 
@@ -134,7 +135,8 @@ def test_force_creepage_curves_against_the_exact_theory():
     retrievable here); what is pinned is what this implementation measures:
     within 2.5% of mu N under pure xi and eta (Kalker's FastSim with the
     parabolic bound: 5.6 and 5.3 on the same grid), 14% under pure spin and
-    11% combined (FastSim: 9.3 and 2.3), docs/validation_wider.md.
+    11% combined (FastSim: 9.3 and 2.3): FaStrip's spin treatment is its weak
+    point (docs/validation_wider.md).
     """
     t = coefficient_table(NU)
     a, b = areas.semi_ellipse_axes(2.0 / 3.0)
