@@ -42,37 +42,48 @@ Per strip segment ``j`` (cells of one row in contact without a gap):
 (F3) the three-dimensional elastic constant: the strip's normalised creepage
      vector is ``nu_j = q_j / mu`` with
      ``q_x = a_j^2 (xi_c/L1 - phi (y_j - y_c)/L3) / P_j``,
-     ``q_y = a_j^2 (eta_c/L2 + phi (x_j - x_c)/L3 + phi a_j/(3 L3)) / P_j``,
+     ``q_y = a_j^2 (eta_c/L2 + phi (x_j - x_c)/L3) / P_j``,
      ``L1..L3`` Kalker's flexibilities (METHOD.md 2) of the patch's
      equivalent ellipse (:func:`~fastsim_ros.contact.equivalent.equivalent_ellipse`:
      area, centroid ``(x_c, y_c)``, second-moment ratio; Kalker's C from the
      package's tables), creepages moved to the centroid by the rigid-slip
-     identity.  Why: at vanishing creepage (F2) gives the strip force ``2 mu
-     P_j nu_j = 2 a_j^2 xi/L1``, which is FastSim's strip force in full
-     adhesion; on an ellipse, summed over strips, that is Kalker's ``G a b
-     C11 xi`` (and C22).  The lateral spin term varies along the strip; it
-     enters as the constant lateral creepage with the same full-adhesion
-     strip force as FastSim's ``phi x/L3`` (``2 a_j^3/(3 L3)`` about the
-     strip centre), which gives Kalker's C23.  Choice: Kalker's 1967 strip
-     theory takes the strip's constant from plane strain (its known 25%
-     error on round patches); FaStrip's point is to take it from the linear
-     theory, and FastSim's L's are the one set of constants that do so
-     strip by strip.
-(F4) directions: the stick zone's traction opposes ``q_j`` (the vector form of
-     Carter's solution, one direction per strip); in the slip zone the
-     traction opposes the local rigid slip ``w = (xi - phi (y - y_P), eta +
-     phi (x - x_P))`` at the cell centre (Coulomb's law with the elastic
-     part of the slip neglected there, which is what makes pure spin at
-     large creepage tend to ``-mu p w/|w|`` and a pure creepage to ``mu N``).
-     Choice: the strip solution itself has no direction field; the rigid
-     slip is the one the exact theory approaches as the slip zone grows.
+     identity: every creepage that is constant along the strip.  Why: at
+     vanishing creepage (F2) gives the strip force ``2 mu P_j nu_j = 2 a_j^2
+     xi/L1``, which is FastSim's strip force in full adhesion; on an ellipse,
+     summed over strips, that is Kalker's ``G a b C11 xi`` (and C22).
+     Choice: Kalker's 1967 strip theory takes the strip's constant from plane
+     strain (its known 25% error on round patches); FaStrip's point is to
+     take it from the linear theory, and FastSim's L's are the one set of
+     constants that do so strip by strip.
+(F3b) the spin within the strip (the lateral rigid slip ``phi (x - x_j)``,
+     which varies along it) is not strip theory's: FaStrip takes it from the
+     simplified theory, FastSim's adhesion traction ``tau_y = -(phi/L3)
+     (a_j^2 - (x - x_j)^2)/2``, so that the strips' lateral force under spin
+     is FastSim's and, on an ellipse, Kalker's C23.  Choice, by evidence: the
+     alternative of strip theory alone (the spin as the constant lateral
+     creepage of the same full-adhesion force, Carter's law for it) was
+     measured against the exact theory on the Hertzian ellipse a/b = 2/3
+     (24 cells): 13.5% of mu N under pure spin, against 1.8% with (F3b);
+     plane strain's answer to a creepage linear along the strip is the
+     semi-elliptic traction, which saturates a whole strip at once, the
+     spin error Kalker reported for strip theory.
+(F4) the sum: Carter's traction (F2) opposes ``q_j`` (the vector form of
+     Carter's solution, one direction per strip), (F3b) is added to it, and
+     where the sum exceeds the bound ``mu p_j`` the cell slips, on the bound,
+     in the simplified theory's direction (the strip marched from its
+     leading edge, the trial traction ``tau_prev - (xi_c/L1 - phi (y -
+     y_c)/L3, eta_c/L2 + phi (x - x_c)/L3) h``).  Without spin this is
+     Carter's solution exactly; a pure creepage tends to ``mu N``.  Choice:
+     strip theory has no direction field for the slip zone under spin; the
+     simplified theory's is the one that goes with (F3b).
 
-Discretisation: each cell's traction is the mean of (F2) over the cell (the
-stick/slip boundary may cut a cell), so a strip's force is the closed form
-whatever the cell size; a cell is reported as slipping when its centre lies
-in the slip zone.  Strips of several segments (a notch): each segment is a
-strip of its own, restarting at its own leading edge.  Units: SI (m, Pa, N,
-N m; ``phi`` in 1/m).
+Discretisation: each cell's traction is the mean of (F2) and of (F3b) over the
+cell (the stick/slip boundary may cut a cell), and the bound the mean of
+``mu p_j``, so a strip's force in adhesion and in full slip is the closed
+form whatever the cell size; a cell is reported as slipping when its centre
+lies in Carter's slip zone or its traction is on the bound by (F4).  Strips of
+several segments (a notch): each segment is a strip of its own, restarting at
+its own leading edge.  Units: SI (m, Pa, N, N m; ``phi`` in 1/m).
 """
 
 from __future__ import annotations
@@ -162,22 +173,23 @@ def _adhesion_shape(s: FloatArray) -> FloatArray:
     return np.sqrt(1.0 - s * s) + np.arcsin(s)
 
 
-def _slip_directions(area: GridArea, stick: FloatArray, slip: FloatArray, ux: FloatArray,
-                     uy: FloatArray, xi_c: float, eta_c: float, phi: float,
-                     centroid: tuple[float, float],
-                     flex: FastripFlexibility) -> tuple[FloatArray, FloatArray]:
-    """Return ``tau_x``, ``tau_y`` (Pa): the cells' stick and slip magnitudes with directions.
+def _combine(area: GridArea, carter: FloatArray, ux: FloatArray, uy: FloatArray,
+             spin: FloatArray, bound: FloatArray, xi_c: float, eta_c: float, phi: float,
+             centroid: tuple[float, float],
+             flex: FastripFlexibility) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+    """Return ``tau_x``, ``tau_y`` (Pa) and the slip flags: Carter's part plus spin's (F4).
 
-    ``stick``, ``slip``: each cell's mean traction magnitude (Pa) from its
-    stick and its slip part (F2); ``ux``, ``uy``: the unit vector of its
-    strip's ``q`` (the stick part opposes it).  The slip part's direction is
-    the simplified theory's (F4): march each strip from its leading edge,
-    the trial traction ``tau_prev - (xi_c/L1 - phi (y - y_c)/L3, eta_c/L2 +
-    phi (x - x_c)/L3) h`` (first step ``h = dx/2``, then ``dx``; ``phi x`` at
-    the middle of the step, METHOD.md 2), and take its direction.
+    ``carter``: each cell's mean traction magnitude of the strip's Carter
+    solution (F2), opposing ``(ux, uy)``; ``spin``: the cell's mean lateral
+    traction of the spin within the strip (F3b); ``bound``: the cell's mean
+    ``mu p_j``.  Where the sum exceeds the bound the cell slips, on the bound,
+    in the simplified theory's direction: each strip marched from its
+    leading edge, the trial traction ``tau_prev - (xi_c/L1 - phi (y -
+    y_c)/L3, eta_c/L2 + phi (x - x_c)/L3) h`` (first step ``h = dx/2``, then
+    ``dx``; ``phi x`` at the middle of the step, METHOD.md 2).
     """
     x_c, y_c = centroid
-    ny, nx = stick.shape
+    ny, nx = carter.shape
     dx = area.dx
     inside_all = area.mask
     rate_x = xi_c / flex.l1 - phi * (area.y - y_c) / flex.l3
@@ -185,24 +197,30 @@ def _slip_directions(area: GridArea, stick: FloatArray, slip: FloatArray, ux: Fl
     ty = np.zeros(ny)
     out_x = np.zeros((ny, nx))
     out_y = np.zeros((ny, nx))
+    slip = np.zeros((ny, nx), dtype=bool)
     prev_in = np.zeros(ny, dtype=bool)
     for i in range(nx - 1, -1, -1):
         inside = inside_all[:, i]
         step = np.where(prev_in, dx, 0.5 * dx)
         x_mid = area.x[i] - x_c + 0.5 * step
+        cand_x = -carter[:, i] * ux[:, i]
+        cand_y = -carter[:, i] * uy[:, i] + spin[:, i]
+        over = np.hypot(cand_x, cand_y) > bound[:, i] * (1.0 + 1e-9)
         trial_x = tx - rate_x * step
         trial_y = ty - (eta_c / flex.l2 + phi * x_mid / flex.l3) * step
         norm = np.hypot(trial_x, trial_y)
         ok = norm > 0.0
         safe = np.where(ok, norm, 1.0)
-        dir_x = np.where(ok, trial_x / safe, -ux[:, i])
-        dir_y = np.where(ok, trial_y / safe, -uy[:, i])
-        tx = np.where(inside, -stick[:, i] * ux[:, i] + slip[:, i] * dir_x, 0.0)
-        ty = np.where(inside, -stick[:, i] * uy[:, i] + slip[:, i] * dir_y, 0.0)
+        cn = np.maximum(np.hypot(cand_x, cand_y), 1e-300)
+        dir_x = np.where(ok, trial_x / safe, cand_x / cn)
+        dir_y = np.where(ok, trial_y / safe, cand_y / cn)
+        tx = np.where(inside, np.where(over, bound[:, i] * dir_x, cand_x), 0.0)
+        ty = np.where(inside, np.where(over, bound[:, i] * dir_y, cand_y), 0.0)
         out_x[:, i] = tx
         out_y[:, i] = ty
+        slip[:, i] = over & inside
         prev_in = inside
-    return out_x, out_y
+    return out_x, out_y, slip
 
 
 def fastrip_flexibility(area: GridArea, table: CoefficientTable,
@@ -248,8 +266,7 @@ def fastrip(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
     y_j = area.y[seg.row]
     # (F3): the strips' normalised creepages times mu
     qx = half**2 * (xi_c / flex.l1 - phi * (y_j - y_c) / flex.l3) / load
-    qy = half**2 * (eta_c / flex.l2 + phi * (centre - x_c) / flex.l3
-                    + phi * half / (3.0 * flex.l3)) / load
+    qy = half**2 * (eta_c / flex.l2 + phi * (centre - x_c) / flex.l3) / load
     qn = np.hypot(qx, qy)
     nu = qn / mu
     # every cell in contact, with its segment
@@ -277,23 +294,25 @@ def fastrip(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
     scale = p0[k_seg] * a_k / dx                                  # mean over the cell
     stick_mag = np.maximum(stick_int, 0.0) * scale
     slip_mag = mu * slip_int * scale
-    # (F4): stick opposes q_j; the slip zone's direction is marched (see _slip_directions)
+    # (F3b): the spin within each strip, FastSim's adhesion traction, cell means:
+    # tau_y = -(phi/L3) (a_j^2 - (x - x_j)^2)/2
+    u_lo = x[cols] - 0.5 * dx - x_k
+    u_hi = x[cols] + 0.5 * dx - x_k
+    lo_c = np.maximum(u_lo, -a_k)
+    hi_c = np.minimum(u_hi, a_k)
+    spin_mean = -(phi / flex.l3) * 0.5 * (a_k**2 * (hi_c - lo_c)
+                                          - (hi_c**3 - lo_c**3) / 3.0) / dx
+    bound_mean = mu * p0[k_seg] * (_half_disc(s_hi) - _half_disc(s_lo)) * a_k / dx
     with np.errstate(invalid="ignore", divide="ignore"):
         ux = np.where(qn > 0.0, qx / np.where(qn > 0.0, qn, 1.0), 0.0)[k_seg]
         uy = np.where(qn > 0.0, qy / np.where(qn > 0.0, qn, 1.0), 0.0)[k_seg]
-    stick2 = np.zeros(p.shape)
-    slip2 = np.zeros(p.shape)
-    ux2 = np.zeros(p.shape)
-    uy2 = np.zeros(p.shape)
-    stick2[rows, cols] = stick_mag
-    slip2[rows, cols] = slip_mag
-    ux2[rows, cols] = ux
-    uy2[rows, cols] = uy
-    tau_x, tau_y = _slip_directions(area, stick2, slip2, ux2, uy2, xi_c, eta_c, phi,
-                                    (x_c, y_c), flex)
-    slip = np.zeros(p.shape, dtype=bool)
+    grids = [np.zeros(p.shape) for _ in range(5)]
+    for g2, v in zip(grids, (stick_mag + slip_mag, ux, uy, spin_mean, bound_mean)):
+        g2[rows, cols] = v
+    tau_x, tau_y, slip = _combine(area, grids[0], grids[1], grids[2], grids[3], grids[4],
+                                  xi_c, eta_c, phi, (x_c, y_c), flex)
     s_mid = (x[cols] - x_k) / a_k
-    slip[rows, cols] = s_mid < t
+    slip[rows, cols] |= s_mid < t
     fx, fy, mz = resultants(area, tau_x, tau_y, reference)
     return FastripResult(fx, fy, mz, ell, flex, Tractions(tau_x, tau_y, slip, fx, fy, mz))
 
