@@ -134,7 +134,7 @@ def test_force_creepage_curves_against_the_exact_theory():
     Sichani et al.'s claim could not be checked against their text (not
     retrievable here); what is pinned is what this implementation measures:
     within 2.5% of mu N under pure xi and eta and pure spin (Kalker's FastSim
-    with the parabolic bound: 5.6, 5.3 and 9.3 on the same grid), 6.5%
+    with the parabolic bound: 5.6, 5.3 and 9.3 on the same grid), 6.0%
     combined (FastSim: 2.3), docs/validation_wider.md.
     """
     t = coefficient_table(NU)
