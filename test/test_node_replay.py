@@ -3,10 +3,11 @@
 They must equal the offline replay's (``fastsim_replay``) wrench for wrench:
 the node and the replay share one pipeline, and stamps come from the
 messages, so the same inputs in the same order give the same numbers.  The
-player publishes in the bag's log-time order at real time, which keeps each
-twist (2.5 ms ahead in the bundled bags) ahead of the patches stamped after
-it: different topics carry no order between them over DDS, so an unpaced
-player could reorder them.
+player publishes at real time in log-time order, except that twists go out
+``TWIST_LEAD`` early: different topics carry no order between them over DDS,
+and a twist that arrived after its patch would change the kinematics that
+patch is solved with; an early twist changes nothing, since a patch only
+uses twists stamped at or before it.
 """
 
 import time
@@ -24,6 +25,7 @@ from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
 
 BAGS = PACKAGE_ROOT / "bags"
 SPEED = 1.0
+TWIST_LEAD = 50_000_000  # ns of log time
 
 pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
                                 reason="fastsim_node is not installed (run colcon build)")
@@ -67,13 +69,16 @@ def test_node_fed_by_a_player_equals_the_offline_replay(bag, tmp_path):
                     pubs[conn.topic] = client.node.create_publisher(PointCloud2, conn.topic,
                                                                     qos)
             client.spin(0.5)
-            start, first = time.monotonic(), None
-            for conn, t_ns, raw in reader.messages():
-                first = t_ns if first is None else first
+            schedule = sorted(((t_ns - TWIST_LEAD if conn.topic.endswith("/twist") else t_ns,
+                                k, conn, bytes(raw))
+                               for k, (conn, t_ns, raw) in enumerate(reader.messages())),
+                              key=lambda item: item[:2])
+            start, first = time.monotonic(), schedule[0][0]
+            for t_ns, _, conn, raw in schedule:
                 due = start + (t_ns - first) * 1e-9 / SPEED
                 while time.monotonic() < due:
                     client.executor.spin_once(timeout_sec=max(0.0, due - time.monotonic()))
-                pubs[conn.topic].publish(bytes(raw))
+                pubs[conn.topic].publish(raw)
 
         def recorded():
             return sum(len(v) for v in client.wrenches.values())
