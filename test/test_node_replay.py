@@ -10,6 +10,7 @@ patch is solved with; an early twist changes nothing, since a patch only
 uses twists stamped at or before it.
 """
 
+import gc
 import time
 
 import pytest
@@ -55,6 +56,12 @@ def test_node_fed_by_a_player_equals_the_offline_replay(bag, tmp_path):
     contacts = load_params_file(BAGS / f"{bag}.params.yaml")["contacts"]
     proc = NodeProcess("--params-file", str(BAGS / f"{bag}.params.yaml"), log_dir=tmp_path)
     client = Client(tuple(contacts), name="player")
+    # a full pass of the cyclic collector over a whole test session's objects
+    # stalls this process for tens of ms: the player would then send a burst
+    # (the node's best-effort queue keeps 10 per topic) and the recorder fall
+    # behind the node's reliable keep-last-10 writers.  None while playing.
+    gc.collect()
+    gc.disable()
     try:
         client.wait_connected(proc)
         qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
@@ -85,6 +92,7 @@ def test_node_fed_by_a_player_equals_the_offline_replay(bag, tmp_path):
         client.wait_for(lambda: recorded() >= len(want), 10.0)
         got = {(c, stamp_ns(w)): force(w) for c, ws in client.wrenches.items() for w in ws}
     finally:
+        gc.enable()
         client.close()
         assert proc.stop() == 0
     assert len(want) > 300
