@@ -312,7 +312,17 @@ def report() -> None:
     _report_timing(add)
     _report_coefficients(add)
     _report_curves(add)
+    _report_more(add)
     (DOCS / "validation.md").write_text("\n".join(lines) + "\n")
+
+
+def _report_more(add: Callable[[str], None]) -> None:
+    """Point at the reports other scripts keep (this script rewrites only its own)."""
+    add("\n## More reports\n")
+    add("- `validation_friction.md`: slip-dependent friction (the falling law) against the exact\n"
+        "  theory, written by hand from what `scripts/validate_friction.py` prints and saves.")
+    add("- `validation_wider.md`: exact, the paper's MAE, FaStrip and the equivalent ellipse on\n"
+        "  fifteen areas, written by `scripts/validate_wider.py`.")
 
 
 def _report_summary(add: Callable[[str], None]) -> None:

@@ -14,7 +14,7 @@ of the ellipse: traction over its static bound and slip velocity along
 ``docs/data/friction_strip.csv``).  Writes
 ``docs/figures/friction_creep_curves.png``, ``docs/data/friction_curves.csv``
 and ``docs/data/friction_strip.csv`` and prints the tables of
-docs/validation.md ("Slip-dependent friction").  About a minute here.
+docs/validation_friction.md.  About a minute here.
 """
 
 from __future__ import annotations
