@@ -59,7 +59,8 @@ SCALE = 0.01  # unit-area shapes scaled to 1e-4 m^2 (about a wheel-rail contact)
 AreaMaker = Callable[[int], areas.GridArea]
 
 
-def _areas(loaded: bool) -> dict[str, AreaMaker]:
+def area_makers(loaded: bool) -> dict[str, AreaMaker]:
+    """Return the validation areas by name: ``make(cells)`` (loaded: 5e4 N on 1e-4 m^2)."""
     load = LOAD if loaded else None
     scale = SCALE if loaded else 1.0
     out: dict[str, AreaMaker] = {}
@@ -205,7 +206,7 @@ def part_coefficients() -> None:
     """C~ij about each area's origin: exact (extrapolated), MAE (both rules), FastSims."""
     t = coefficient_table(NU_COEF)
     res = {}
-    for name, make in _areas(loaded=False).items():
+    for name, make in area_makers(loaded=False).items():
         ex = _extrapolated(make, NU_COEF)
         ar = make(ONLINE_CELLS)
         entry: dict[str, Any] = {"exact": ex}
@@ -237,7 +238,7 @@ def part_curves() -> None:
     """Force-creepage curves of the three methods on every sample area (loaded)."""
     t = coefficient_table(NU)
     res = {}
-    for name, make in _areas(loaded=True).items():
+    for name, make in area_makers(loaded=True).items():
         ar = make(CURVE_CELLS)
         n_load = ar.load
         c = math.sqrt(ar.area / math.pi)

@@ -35,6 +35,7 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "scripts"))
 
 import matplotlib  # noqa: E402
 
@@ -51,11 +52,13 @@ from fastsim_ros.contact.fastrip import fastrip, fastrip_coefficients  # noqa: E
 from fastsim_ros.contact.mae import mae_fastsim_coefficients  # noqa: E402
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
 
+import validate  # noqa: E402  (scripts/validate.py: the report's own areas)
+
 DOCS = ROOT / "docs"
 DATA = DOCS / "data" / "validation_wider.json"
 FIG = DOCS / "figures"
-MU, G, NU, LOAD = 0.3, samples.STEEL_G, samples.STEEL_NU, 5.0e4
-SCALE = 0.01
+# the material, load and scale of scripts/validate.py, whose areas these extend
+MU, G, NU, LOAD, SCALE = validate.MU, validate.G, validate.NU, validate.LOAD, validate.SCALE
 #: cells across each area's bounding box for the curves (every method on the same grid)
 CURVE_CELLS = 40
 #: the finer grid of the curve grid check, and the areas it runs on
@@ -71,27 +74,18 @@ METHODS = ("mae", "fastrip", "ellipse")
 LABELS = {"mae": "paper's MAE", "fastrip": "FaStrip", "ellipse": "equivalent ellipse"}
 NEW = ("long narrow", "crescent", "egg")
 
-AreaMaker = Callable[[int], areas.GridArea]
+AreaMaker = validate.AreaMaker
 
 
 def area_makers(loaded: bool) -> dict[str, AreaMaker]:
-    """Return the validation areas by name: ``make(cells)`` (loaded: 5e4 N on 1e-4 m^2)."""
+    """Return the validation areas by name: ``make(cells)`` (loaded: 5e4 N on 1e-4 m^2).
+
+    The report's eight (and its Hertzian ellipse), as ``scripts/validate.py``
+    builds them, then the new ones.
+    """
     load = LOAD if loaded else None
     scale = SCALE if loaded else 1.0
-    out: dict[str, AreaMaker] = {}
-    a, b = areas.semi_ellipse_axes(2.0 / 3.0)
-    out["ellipse 2/3 (Hertz)"] = lambda n: (
-        areas.ellipse(a * scale, b * scale, nx=n, ny=n, load=load) if loaded
-        else areas.ellipse(a, b, nx=n, ny=n))
-    for g1 in (0.1, 0.5, 2.0, 5.0):
-        out[f"semi-ellipses {g1:g}/1"] = (
-            lambda n, g1=g1: samples.semi_ellipses_patch(g1, 1.0, cells=n, scale=scale,
-                                                         load=load))
-    out["notched ellipse"] = lambda n: samples.notched_ellipse(cells=n, scale=scale, load=load)
-    out["two lobes"] = lambda n: samples.two_lobes(cells=n, scale=scale, load=load)
-    out["truncated ellipse"] = lambda n: samples.truncated_ellipse(cells=n, scale=scale,
-                                                                   load=load)
-    out["flange root"] = lambda n: samples.flange_root_patch(cells=n, load=LOAD)
+    out = validate.area_makers(loaded)
     out["long narrow"] = lambda n: samples.long_narrow_patch(cells=n, scale=scale, load=load)
     out["crescent"] = lambda n: samples.crescent_patch(cells=n, scale=scale, load=load)
     out["egg"] = lambda n: samples.egg_patch(cells=n, scale=scale, load=load)
