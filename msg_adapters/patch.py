@@ -193,6 +193,32 @@ def _words(cloud: Cloud) -> tuple[NDArray[Any], int, int, NDArray[np.int64]]:
 _PLAIN_COLUMNS = np.arange(7, dtype=np.int64)
 
 
+Axes = tuple[tuple[float, float, float], tuple[float, float, float],
+             tuple[float, float, float]]
+
+
+def contact_axes(normal: tuple[float, float, float]) -> Axes:
+    """Return ``(e_x, e_y, e_z)`` of INTERFACE.md's contact frame for a normal (any length).
+
+    ``e_z`` along the normal, ``e_x`` the wheelset's ``x`` projected on the
+    contact plane, ``e_y = e_z x e_x``.  Raises ``degenerate`` for a zero
+    normal or one along the wheelset's ``x``.
+    """
+    n0, n1, n2 = normal
+    norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
+    if not norm > 0.0:
+        raise RejectedInput("degenerate", "the cells' normals cancel out")
+    ez = (n0 / norm, n1 / norm, n2 / norm)
+    exx, exy, exz = 1.0 - ez[0] * ez[0], -ez[0] * ez[1], -ez[0] * ez[2]
+    ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
+    if not ex_norm > 1e-6:
+        raise RejectedInput("degenerate", "the contact normal lies along the wheelset's x")
+    ex = (exx / ex_norm, exy / ex_norm, exz / ex_norm)
+    ey = (ez[1] * ex[2] - ez[2] * ex[1], ez[2] * ex[0] - ez[0] * ex[2],
+          ez[0] * ex[1] - ez[1] * ex[0])
+    return ex, ey, ez
+
+
 def _grid_axis(first: float, step: float, worst: float, n: int,
                what: str) -> tuple[float, float, int]:
     """Check one fitted grid axis; return ``(first, step, order)`` with ``step > 0``.
@@ -241,19 +267,7 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
                             f"(at least {MIN_CONTACT_CELLS} on a grid of 2 x 2 or more)")
     # origin: the pressure-weighted centroid; e_z along sum p n
     origin = (float(sums[0]) / total, float(sums[1]) / total, float(sums[2]) / total)
-    n0, n1, n2 = float(sums[3]), float(sums[4]), float(sums[5])
-    norm = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-    if not norm > 0.0:
-        raise RejectedInput("degenerate", "the cells' normals cancel out")
-    ez = (n0 / norm, n1 / norm, n2 / norm)
-    # e_x: the wheelset's x projected on the contact plane; e_y = e_z x e_x
-    exx, exy, exz = 1.0 - ez[0] * ez[0], -ez[0] * ez[1], -ez[0] * ez[2]
-    ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
-    if not ex_norm > 1e-6:
-        raise RejectedInput("degenerate", "the contact normal lies along the wheelset's x")
-    ex = (exx / ex_norm, exy / ex_norm, exz / ex_norm)
-    ey = (ez[1] * ex[2] - ez[2] * ex[1], ez[2] * ex[0] - ez[0] * ex[2],
-          ez[0] * ex[1] - ez[1] * ex[0])
+    ex, ey, ez = contact_axes((float(sums[3]), float(sums[4]), float(sums[5])))
     fx0, fdx, worst_x, fy0, fdy, worst_y = kernels.fit_grid(xyz, origin, ex, ey)
     # each checks the whole grid: x must not vary across strips, nor y along them
     x0, dx, column_order = _grid_axis(fx0, fdx, worst_x, nx, "along a strip")
@@ -296,14 +310,8 @@ def planar_points(origin: tuple[float, float, float], axes: ContactFrame | None,
 
 
 def frame_from_normal(normal: tuple[float, float, float]) -> ContactFrame:
-    """Return the contact axes of INTERFACE.md for a unit ``normal`` (origin at 0)."""
-    ez = np.asarray(normal, dtype=np.float64)
-    ez = ez / math.sqrt(float(ez @ ez))
-    ex = np.array([1.0, 0.0, 0.0]) - ez[0] * ez
-    ex /= math.sqrt(float(ex @ ex))
-    ey = np.cross(ez, ex)
-    return ContactFrame((0.0, 0.0, 0.0), (tuple(map(float, ex)), tuple(map(float, ey)),
-                                          tuple(map(float, ez))))  # type: ignore[arg-type]
+    """Return the contact frame of INTERFACE.md for a ``normal`` (origin at 0)."""
+    return ContactFrame((0.0, 0.0, 0.0), contact_axes(normal))
 
 
 def cloud_bytes(points: FloatArray, normals: FloatArray, pressure: FloatArray, *,
