@@ -22,6 +22,12 @@ front face of its first cell; tractions live at cell centres, so the first
 step is ``dx/2`` and every later one ``dx``; ``phi x`` is taken at the middle
 of each step.
 
+Slip rule of a cell over the bound: ``radial`` (Kalker's: the adhesion
+trial scaled back onto the bound) or ``rigid_slip`` (the traction opposite
+to the cell's slip with FastSim's compliance and the rigid slip,
+:func:`~fastsim_ros.contact.rules.rigid_slip_return`; the second MAE
+method's, :mod:`~fastsim_ros.contact.mae_calibrated`).
+
 Slip-dependent friction (:mod:`~fastsim_ros.contact.friction`, bound
 ``g(v) = g_s ratio(v)``, ``g_s = mu_s p`` the static bound): see
 :func:`slip_ratio` for the rule each slipping cell follows (its slip taken at
@@ -32,6 +38,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -39,9 +46,12 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import check_bound, check_creepages, check_friction
 from fastsim_ros.contact.friction import FrictionLaw, check_speed
+from fastsim_ros.contact.rules import rigid_slip_return
 from fastsim_ros.contact.traction import Tractions, resultants
 
 FloatArray = NDArray[np.float64]
+SlipRule = Literal["radial", "rigid_slip"]
+SLIP_RULES: tuple[SlipRule, ...] = ("radial", "rigid_slip")
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,8 +153,8 @@ def slip_ratio(m: FloatArray, level: FloatArray, q: FloatArray,
 
 def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
           eta: FloatArray | float, phi: float, flex: StripFlexibility, y_rel: FloatArray,
-          x_c: float, *, friction: FrictionLaw | None = None,
-          speed: float | None = None) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
+          x_c: float, *, friction: FrictionLaw | None = None, speed: float | None = None,
+          slip_rule: SlipRule = "radial") -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
     """March every strip from its leading edge; the readable reference of the kernel.
 
     ``bound``: ``g`` (Pa), ``(ny, nx)``, zero outside the contact (with a
@@ -153,9 +163,15 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     sweep's reference point (scalars or one per strip); ``y_rel``: ``y_j -
     y_s`` (m); ``speed``: the rolling speed ``|V|`` (m/s), needed by a
     slip-dependent law (each slipping cell then follows
-    :func:`slip_ratio`).  Returns ``tau_x``, ``tau_y`` (Pa) and the slip
-    flags.  Vectorised over the strips, marched over the columns.
+    :func:`slip_ratio`).  ``slip_rule``: how a cell over the bound is put
+    on it (module docstring; with ``rigid_slip`` and a slip-dependent law
+    the return at the kinetic level gives the direction and the slip, the
+    law at that slip the magnitude).  Returns ``tau_x``, ``tau_y`` (Pa) and
+    the slip flags.  Vectorised over the strips, marched over the columns.
     """
+    if slip_rule not in SLIP_RULES:
+        raise ValueError(f"slip_rule must be one of {SLIP_RULES}, got {slip_rule!r}")
+    rigid = slip_rule == "rigid_slip"
     law = friction if friction is not None and friction.slip_dependent else None
     v_roll = check_speed(speed) if law is not None else 0.0
     ny, nx = bound.shape
@@ -168,6 +184,9 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     rate_x = np.asarray(xi) / flex.l1 - phi * y_rel / flex.spin
     rate_y0 = np.asarray(eta) / flex.l2
     rate_yx = phi / flex.l3
+    # the rigid slip per unit rolling distance, x part (the y part varies along the strip)
+    w_x = np.asarray(xi) - phi * y_rel
+    w_y0 = np.asarray(eta) * np.ones(ny)
     prev_in = np.zeros(ny, dtype=bool)
     prev_slip = np.zeros(ny, dtype=bool)
     # each strip's friction ratio in its last cell (read only where that cell slipped)
@@ -178,11 +197,23 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
         # first cell of a segment: half a step from its front face
         step = np.where(prev_in, dx, 0.5 * dx)
         x_mid = x[i] - x_c + 0.5 * step
-        tx = np.where(inside, tx - rate_x * step, 0.0)
-        ty = np.where(inside, ty - (rate_y0 + rate_yx * x_mid) * step, 0.0)
+        # the traction one step upstream (zero at a segment's front face)
+        px = np.where(inside & prev_in, tx, 0.0)
+        py = np.where(inside & prev_in, ty, 0.0)
+        tx = np.where(inside, px - rate_x * step, 0.0)
+        ty = np.where(inside, py - (rate_y0 + rate_yx * x_mid) * step, 0.0)
         mag = np.hypot(tx, ty)
         if law is None:
             over = mag > g
+            if rigid:
+                for jj in np.flatnonzero(over):
+                    h = step[jj]
+                    rx, ry, ok = rigid_slip_return(
+                        px[jj], py[jj], w_x[jj] * h, (w_y0[jj] + phi * x_mid[jj]) * h,
+                        flex.l1[jj], flex.l2[jj], g[jj])
+                    if ok:
+                        # on the bound already: the scale below leaves it there
+                        tx[jj], ty[jj], mag[jj] = rx, ry, g[jj]
         else:
             # kinetic level: the upstream cell's friction ratio if it slipped, else static
             level = g * np.where(prev_slip, ratio, 1.0)
@@ -195,8 +226,26 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
                 ly = flex.l2[idx] * ty[idx]
                 q = v_roll / step[idx] * np.sqrt(lx * lx + ly * ly) / m
                 k = slip_ratio(m, level[idx], q, law)
+                returned = []
+                if rigid:
+                    for n_, jj in enumerate(idx):
+                        h = step[jj]
+                        lv = level[jj]
+                        wyh = (w_y0[jj] + phi * x_mid[jj]) * h
+                        rx, ry, ok = rigid_slip_return(px[jj], py[jj], w_x[jj] * h, wyh,
+                                                       flex.l1[jj], flex.l2[jj], lv)
+                        if ok:
+                            # the slip at the kinetic level, |V| |w h + L (tau_k - tau_p)| / h
+                            sx = w_x[jj] * h + flex.l1[jj] * (rx - px[jj])
+                            sy = wyh + flex.l2[jj] * (ry - py[jj])
+                            k[n_] = law.ratio(np.asarray(v_roll * math.hypot(sx, sy) / h))
+                            returned.append((n_, jj, rx, ry, lv))
                 r = g[idx] * k
                 slides = r < m
+                for n_, jj, rx, ry, lv in returned:
+                    if slides[n_]:
+                        # the return's direction; the scale below sets |tau| = g k
+                        tx[jj], ty[jj], mag[jj] = rx, ry, lv
                 g = g.copy()
                 g[idx] = r
                 ratio[idx] = k
@@ -215,14 +264,15 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
 def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
             flexibility: StripFlexibility, sweep_point: tuple[float, float] = (0.0, 0.0),
             reference: tuple[float, float] = (0.0, 0.0), friction: FrictionLaw | None = None,
-            speed: float | None = None) -> Tractions:
+            speed: float | None = None, slip_rule: SlipRule = "radial") -> Tractions:
     """Solve FastSim on ``area``, creepages ``xi``, ``eta``, ``phi`` (1/m) about ``reference``.
 
     ``sweep_point`` ``(x_c, y_s)`` is the point the strips' rates refer to
     (the reference point itself in plain FastSim, MAE's ``S``); creepages are
     moved to it by the rigid-slip identity.  ``Mz`` is about ``reference``.
     ``bound`` is the static bound ``g_s`` (Pa) of a slip-dependent
-    ``friction`` law (whose ``mu_s`` made it); ``speed``: ``|V|`` (m/s).
+    ``friction`` law (whose ``mu_s`` made it); ``speed``: ``|V|`` (m/s);
+    ``slip_rule``: :func:`sweep`'s.
     """
     check_creepages(xi, eta, phi)
     xc, ys = sweep_point
@@ -230,5 +280,5 @@ def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatAr
     xi_s = xi + phi * (yp - ys)
     eta_s = eta - phi * (xp - xc)
     tx, ty, slip = sweep(bound, area.x, area.dx, xi_s, eta_s, phi, flexibility,
-                         area.y - ys, xc, friction=friction, speed=speed)
+                         area.y - ys, xc, friction=friction, speed=speed, slip_rule=slip_rule)
     return Tractions(tx, ty, slip, *resultants(area, tx, ty, reference))

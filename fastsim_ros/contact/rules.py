@@ -13,6 +13,7 @@ after changing this file during development, clear the cache (or touch
 from __future__ import annotations
 
 import math
+from typing import Any
 
 #: friction-law codes of the kernels (:mod:`fastsim_ros.contact.friction`)
 LAW_CONSTANT = 0
@@ -43,3 +44,74 @@ def ellipse_grid(a: float, b: float, n: int, x_c: float,
     cell, with the same floating-point operations.
     """
     return (-a + (a - -a) / n * 0.5 + x_c, -b + (b - -b) / n * 0.5 + y_c, 2 * a / n, 2 * b / n)
+
+
+def rigid_slip_return(px: float, py: float, wxh: float, wyh: float, l1: float, l2: float,
+                      g: float) -> tuple[float, float, bool]:
+    """Return the traction of a slipping cell whose slip follows the rigid slip, and whether it applies.
+
+    Kalker's simplified theory with ``u = L tau`` componentwise (``L = (L1,
+    L2)``, m/Pa): over a step ``h`` (m) the slip of a cell is ``s h = w h +
+    L (tau - tau_p)`` (``w``: the rigid slip per unit rolling distance at
+    the step's middle, ``w h = (wxh, wyh)`` in m; ``tau_p`` = ``(px, py)``
+    the traction one step upstream, Pa), and Coulomb's law puts a slipping
+    cell on the bound ``g`` (Pa) opposite to its slip, ``tau = -g s/|s|``.
+    With ``t' = tau_p - w h / L`` that is ``t' = (g + lam / L) tau / g``
+    for some ``lam >= 0``: ``tau_k = g t'_k / (g + lam / L_k)``, ``lam``
+    the root of ``sum (t'_k / (g + lam / L_k))^2 = 1``, a decreasing convex
+    function of ``lam`` (Newton from the isotropic lower bound ``(|t'| - g)
+    min(L)`` converges monotonically).  With ``L1 = L2`` this is FastSim's
+    radial return of the adhesion trial; with unequal ``L`` (and MAE's spin
+    flexibilities, which the adhesion trial uses) radial return sends the
+    traction along ``w / L`` rather than ``w``, and in full sliding the
+    force off the rigid slip's direction (docs/validation_wider.md: the
+    paper's MAE's Fx under spin on a truncated ellipse, 18.6% of mu N).
+    Where ``|t'| <= g`` (the spin flexibilities made the trial slip where
+    the rigid slip with ``L1, L2`` would not) the third value is ``False``
+    and the caller keeps the radial return.
+    """
+    ttx = px - wxh / l1
+    tty = py - wyh / l2
+    tm = math.sqrt(ttx * ttx + tty * tty)
+    if not tm > g:
+        return 0.0, 0.0, False
+    m1 = 1.0 / l1
+    m2 = 1.0 / l2
+    lam = (tm - g) / max(m1, m2)
+    d1 = g + lam * m1
+    d2 = g + lam * m2
+    for _ in range(60):
+        f = (ttx / d1) ** 2 + (tty / d2) ** 2 - 1.0
+        if not f > 1e-14:
+            break
+        df = -2.0 * (ttx * ttx * m1 / (d1 * d1 * d1) + tty * tty * m2 / (d2 * d2 * d2))
+        lam = lam - f / df
+        d1 = g + lam * m1
+        d2 = g + lam * m2
+    ex = ttx / d1
+    ey = tty / d2
+    n = math.sqrt(ex * ex + ey * ey)
+    return g * ex / n, g * ey / n, True
+
+
+def pair_factor(knots: Any, values: Any, t_self: float, t_other: float) -> float:
+    """Bilinear interpolation of a pair-factor table at ``(log g_self, log g_other)``.
+
+    ``knots``: the table's ``log(a/b)`` nodes (increasing); ``values[i, j]``
+    the factor at ``(knots[i], knots[j])``.  Outside the nodes the nearest
+    edge value is taken (the factor is held constant beyond the table; the
+    zones' own coefficients still come from the half-ellipse tables).
+    """
+    n = len(knots)
+    ti = min(max(t_self, knots[0]), knots[n - 1])
+    tj = min(max(t_other, knots[0]), knots[n - 1])
+    i = 0
+    while i < n - 2 and ti > knots[i + 1]:
+        i += 1
+    j = 0
+    while j < n - 2 and tj > knots[j + 1]:
+        j += 1
+    u = (ti - knots[i]) / (knots[i + 1] - knots[i])
+    v = (tj - knots[j]) / (knots[j + 1] - knots[j])
+    return ((1.0 - u) * ((1.0 - v) * values[i, j] + v * values[i, j + 1])
+            + u * ((1.0 - v) * values[i + 1, j] + v * values[i + 1, j + 1]))
