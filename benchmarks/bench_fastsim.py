@@ -132,7 +132,7 @@ def _loop_solve(reps, p, x0, y0, dx, dy, shear_modulus, knots, polys, xi, eta, p
         fx += kernels.mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0,
                                 kernels.RULE_WIDEST_STRIP, False, shear_modulus, knots, polys,
                                 kernels.LAW_CONSTANT, np.zeros(2), 0.0, none_f, none_f, none_b,
-                                False)[2]
+                                False, False, np.zeros(2), np.ones((4, 2, 2)))[2]
     return fx
 
 

@@ -277,7 +277,7 @@ def test_sweep_equals_reference_fastsim(case, creep, unbounded):
     fx, fy, mz, nslip, ncontact = kernels.sweep(
         bound, 1.0, 1.0, envelopes(bound), ar.x0, ar.y0, ar.dx, ar.dy, xi_s, eta_s, phi,
         np.array([flex.l1, flex.l2, flex.l3, flex.spin]), point[0], point[1], reference[0],
-        reference[1], kernels.LAW_CONSTANT, np.zeros(2), 0.0, out[0], out[1], slip, True)
+        reference[1], kernels.LAW_CONSTANT, np.zeros(2), 0.0, out[0], out[1], slip, True, False)
     assert_forces(ContactForces(fx, fy, mz, 0.0, 0.0), ref.fx, ref.fy, ref.mz, size(ar))
     scale = max(np.abs(ref.tau_x).max(), np.abs(ref.tau_y).max())
     assert np.abs(out[0] - ref.tau_x).max() <= TOL * scale

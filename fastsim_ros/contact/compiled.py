@@ -11,6 +11,8 @@ a tiny patch).  Results equal the numpy reference
   ``solve_arrays(pressure, x0, y0, dx, dy, ...)`` without building one (the
   node's hot path), ``solve_batch(...)`` for many patches or creepages in one
   compiled loop, and ``geometry`` / ``flexibility`` for inspection.
+- :class:`CalibratedMaeSolver` ``(nu, shear_modulus, rule=...)``: the
+  calibrated MAE (:mod:`~fastsim_ros.contact.mae_calibrated`), the same calls.
 - :class:`EquivalentEllipseSolver` ``(nu, shear_modulus)``: the same calls.
 
 Friction: ``mu`` (Coulomb, as always), or ``friction=`` a law of
@@ -41,6 +43,7 @@ from fastsim_ros.contact.errors import (ContactError, EmptyContactError, Invalid
                                         OutOfTableError)
 from fastsim_ros.contact.friction import ExponentialFriction, FrictionLaw, check_speed, resolve
 from fastsim_ros.contact.mae import MaeGeometry, Zone, ZoneFlexibility
+from fastsim_ros.contact.pairs import pair_factors
 from fastsim_ros.contact.rules import ellipse_grid
 from fastsim_ros.contact.tables import coefficient_table
 
@@ -275,6 +278,10 @@ class MaeSolver(_Solver):
         super().__init__(nu, shear_modulus)
         self.rule: Rule = check_split_rule(rule)
         self._rule = _RULES[rule]
+        self._calibrated = False
+        # the pair factors (read by the calibrated method only; one argument type for both)
+        self._pair_knots = np.zeros(2)
+        self._pair_values = np.ones((4, 2, 2))
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
                eta: float, phi: float, law: tuple[int, FloatArray, float, float],
@@ -286,7 +293,8 @@ class MaeSolver(_Solver):
         result = k.mae_solve(p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta),
                              float(phi), float(mu), float(reference[0]), float(reference[1]),
                              self._rule, _bound(bound), self.shear_modulus, self._knots,
-                             self._polys, code, prm, speed, out[0], out[1], out[2], tractions)
+                             self._polys, code, prm, speed, out[0], out[1], out[2], tractions,
+                             self._calibrated, self._pair_knots, self._pair_values)
         return self._forces(result, grid, out, tractions)
 
     def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
@@ -309,7 +317,9 @@ class MaeSolver(_Solver):
         status, index, info = k.mae_batch(ps, grid[0], grid[1], grid[2], grid[3], cr, mus,
                                           float(reference[0]), float(reference[1]),
                                           self._rule, _bound(bound), self.shear_modulus,
-                                          self._knots, self._polys, code, prm, speeds, out)
+                                          self._knots, self._polys, code, prm, speeds, out,
+                                          self._calibrated, self._pair_knots,
+                                          self._pair_values)
         if status:
             _raise(status, info, self._knots, f"batch item {index}: ")
         return out
@@ -317,9 +327,14 @@ class MaeSolver(_Solver):
     def _prepare(self, area: GridArea) -> tuple[int, float, FloatArray]:
         geo = np.empty(k.GEO_SIZE)
         env = np.empty((2, area.nx), dtype=np.int64)
-        status, info = k.mae_prepare(_readonly(area.pressure), float(area.x0), float(area.y0),
-                                     float(area.dx), float(area.dy), self._rule,
-                                     self.shear_modulus, self._knots, self._polys, geo, env)
+        p = _readonly(area.pressure)
+        status, info = k.mae_prepare(p, float(area.x0), float(area.y0), float(area.dx),
+                                     float(area.dy), self._rule, self.shear_modulus,
+                                     self._knots, self._polys, geo, env)
+        if status == k.OK and self._calibrated:
+            k.calibrate(p, float(area.x0), float(area.y0), float(area.dx), float(area.dy), env,
+                        geo, self.shear_modulus, self._knots, self._polys, self._pair_knots,
+                        self._pair_values)
         return status, info, geo
 
     def geometry(self, area: GridArea) -> MaeGeometry:
@@ -341,6 +356,24 @@ class MaeSolver(_Solver):
         return tuple(None if geo[zone] <= 0.0 else  # type: ignore[return-value]
                      ZoneFlexibility(*(float(v) for v in geo[flex:flex + 4]))
                      for zone, flex in ((k.G_ZONE1, k.G_FLEX1), (k.G_ZONE2, k.G_FLEX2)))
+
+
+class CalibratedMaeSolver(MaeSolver):
+    """The calibrated MAE + FastSim, compiled (:mod:`fastsim_ros.contact.mae_calibrated`).
+
+    The paper's MAE geometry with pair factors, zone flexibilities calibrated
+    on the patch's own cells and the rigid-slip return; ``nu``,
+    ``shear_modulus`` (Pa) and ``rule`` as :class:`MaeSolver`, whose calls
+    it has (``flexibility`` gives the calibrated ``L1 .. L4``).
+    """
+
+    def __init__(self, nu: float, shear_modulus: float, *,
+                 rule: Rule = "auto") -> None:
+        super().__init__(nu, shear_modulus, rule=rule)
+        pairs = pair_factors(self.nu)  # refuses nu outside the pair factors' range
+        self._calibrated = True
+        self._pair_knots = np.array(pairs.knots, dtype=np.float64)
+        self._pair_values = np.ascontiguousarray(pairs.values, dtype=np.float64)
 
 
 class EquivalentEllipseSolver(_Solver):
@@ -422,7 +455,8 @@ def warm_up() -> float:
          [1.0, 2.0, 3.0, 2.0, 1.0], [0.0, 1.0, 2.0, 1.0, 0.0]]))
     creep = np.array([[1e-3, 0.0, 0.1], [0.0, -1e-3, 0.0]])
     falling = ExponentialFriction(0.3, 0.5, 0.5)
-    for solver in (MaeSolver(0.28, 8e10), EquivalentEllipseSolver(0.28, 8e10)):
+    for solver in (MaeSolver(0.28, 8e10), CalibratedMaeSolver(0.28, 8e10),
+                   EquivalentEllipseSolver(0.28, 8e10)):
         solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3)
         solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3, tractions=True)
         solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, creep, mu=0.3)

@@ -197,6 +197,8 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
         # first cell of a segment: half a step from its front face
         step = np.where(prev_in, dx, 0.5 * dx)
         x_mid = x[i] - x_c + 0.5 * step
+        # the rigid-slip return takes the slip where the traction lives: at the cell's centre
+        x_cell = np.full(ny, x[i] - x_c)
         # the traction one step upstream (zero at a segment's front face)
         px = np.where(inside & prev_in, tx, 0.0)
         py = np.where(inside & prev_in, ty, 0.0)
@@ -209,7 +211,7 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
                 for jj in np.flatnonzero(over):
                     h = step[jj]
                     rx, ry, ok = rigid_slip_return(
-                        px[jj], py[jj], w_x[jj] * h, (w_y0[jj] + phi * x_mid[jj]) * h,
+                        px[jj], py[jj], w_x[jj] * h, (w_y0[jj] + phi * x_cell[jj]) * h,
                         flex.l1[jj], flex.l2[jj], g[jj])
                     if ok:
                         # on the bound already: the scale below leaves it there
@@ -231,7 +233,7 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
                     for n_, jj in enumerate(idx):
                         h = step[jj]
                         lv = level[jj]
-                        wyh = (w_y0[jj] + phi * x_mid[jj]) * h
+                        wyh = (w_y0[jj] + phi * x_cell[jj]) * h
                         rx, ry, ok = rigid_slip_return(px[jj], py[jj], w_x[jj] * h, wyh,
                                                        flex.l1[jj], flex.l2[jj], lv)
                         if ok:

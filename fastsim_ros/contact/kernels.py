@@ -272,6 +272,11 @@ def kalker_flexibility(a, b, c11, c22, c23, shear_modulus):
 LAW_CONSTANT = rules.LAW_CONSTANT
 LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
 
+#: :func:`fastsim_ros.contact.rules.rigid_slip_return` and
+#: :func:`~fastsim_ros.contact.rules.pair_factor`, compiled: the reference's formulas, no copies
+rigid_slip_return = njit(cache=True, error_model="numpy")(rules.rigid_slip_return)
+pair_factor = njit(cache=True, error_model="numpy")(rules.pair_factor)
+
 
 @njit(cache=True, error_model="numpy")
 def law_ratio(law, prm, v):
@@ -292,7 +297,7 @@ def law_ratio(law, prm, v):
 
 @njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
-          law, prm, speed, out_x, out_y, slip, store):
+          law, prm, speed, out_x, out_y, slip, store, rigid):
     """March every strip from its leading edge; return ``(Fx, Fy, Mz, slipping, in contact)``.
 
     The kernel of :func:`fastsim_ros.contact.fastsim.sweep` and the
@@ -314,7 +319,9 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     exceeds its kinetic level (the upstream cell's friction ratio, if that
     one slipped, times the static bound), with the ratio of the slip it has
     at that level; :data:`LAW_CONSTANT` is the constant-friction path as it
-    always was.
+    always was.  ``rigid``: a cell over the bound slips along its slip
+    (:func:`rigid_slip_return`, the reference's ``slip_rule="rigid_slip"``)
+    instead of the radial return.
 
     Like the reference, the march goes column by column with the strips side
     by side: the strips are independent, so the CPU overlaps their chains of
@@ -325,9 +332,9 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     da = dx * dy
     half = 0.5 * dx
     # per-strip state, constants and partial sums in one block (one allocation)
-    w = np.empty((9, ny))
+    w = np.empty((10, ny))
     tx, ty, sx, sy, sm = w[0], w[1], w[2], w[3], w[4]
-    rate_x, rate_y0, rate_yx, yr = w[5], w[6], w[7], w[8]
+    rate_x, rate_y0, rate_yx, yr, w_x = w[5], w[6], w[7], w[8], w[9]
     # the column a strip's current segment continues into (else: a new segment)
     cont = np.empty(ny, dtype=np.int64)
     # slip-dependent laws: strip j's friction ratio in its last cell if that one slipped, else 1
@@ -339,6 +346,8 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
         rate_y0[j] = eta / flex[1, j]
         rate_yx[j] = phi / flex[2, j]
         yr[j] = y - yp
+        # the rigid slip per unit rolling distance along x (for the rigid-slip return)
+        w_x[j] = xi - phi * (y - y_s)
         sx[j] = 0.0
         sy[j] = 0.0
         sm[j] = 0.0
@@ -372,6 +381,8 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                 level[j] = 1.0
             cont[j] = i - 1
             x_mid = x_rel + 0.5 * s
+            p_x = t_x
+            p_y = t_y
             t_x = t_x - rate_x[j] * s
             t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s
             over = False
@@ -382,9 +393,18 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                     if abs(mag - g) <= _ON_BOUND * g:
                         mag = math.hypot(t_x, t_y)
                     if mag > g:
-                        scale = g / mag
-                        t_x = t_x * scale
-                        t_y = t_y * scale
+                        done = False
+                        if rigid:
+                            r_x, r_y, done = rigid_slip_return(
+                                p_x, p_y, w_x[j] * s, (eta + phi * x_rel) * s, flex[0, j],
+                                flex[1, j], g)
+                            if done:
+                                t_x = r_x
+                                t_y = r_y
+                        if not done:
+                            scale = g / mag
+                            t_x = t_x * scale
+                            t_y = t_y * scale
                         over = True
                         nslip += 1
             else:
@@ -400,13 +420,30 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                         lx = flex[0, j] * t_x
                         ly = flex[1, j] * t_y
                         vs = v_full if s == dx else v_half
-                        k = law_ratio(law, prm, vs * math.sqrt(lx * lx + ly * ly)
-                                      * ((mag - gk) * inv))
+                        done = False
+                        if rigid:
+                            wyh = (eta + phi * x_rel) * s
+                            r_x, r_y, done = rigid_slip_return(p_x, p_y, w_x[j] * s, wyh,
+                                                               flex[0, j], flex[1, j], gk)
+                            if done:
+                                # the slip at the kinetic level: |w h + L (tau_k - tau_p)| / h
+                                s_x = w_x[j] * s + flex[0, j] * (r_x - p_x)
+                                s_y = wyh + flex[1, j] * (r_y - p_y)
+                                k = law_ratio(law, prm, speed * math.sqrt(s_x * s_x + s_y * s_y)
+                                              / s)
+                        if not done:
+                            k = law_ratio(law, prm, vs * math.sqrt(lx * lx + ly * ly)
+                                          * ((mag - gk) * inv))
                         r = g * k
                         if r < mag:
-                            scale = r * inv
-                            t_x = t_x * scale
-                            t_y = t_y * scale
+                            if done:
+                                scale = r / gk
+                                t_x = r_x * scale
+                                t_y = r_y * scale
+                            else:
+                                scale = r * inv
+                                t_x = t_x * scale
+                                t_y = t_y * scale
                             over = True
                             nslip += 1
                             level[j] = k
@@ -656,6 +693,103 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
 
 
 @njit(cache=True, error_model="numpy")
+def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_knots,
+              pair_values):
+    """Overwrite ``geo``'s ``L1 .. L4`` with the calibrated MAE's (after :func:`mae_prepare`).
+
+    :func:`fastsim_ros.contact.mae_calibrated.calibrated_flexibilities`:
+    each zone's half-ellipse ``c11, c22, c23`` scaled by the pair's shared
+    factor and ``c13`` times its own pair factor (:func:`pair_factor` at
+    ``(log g_self, log g_other)``; 1 if the other zone is empty; as
+    :func:`fastsim_ros.contact.mae_calibrated.zone_coefficients`), and the
+    sweep's own integrals over the zone's cells,
+    ``D1 = sum d dA``, ``D3 = sum s3 dA``, ``D4 = |sum (y - y_s) d dA|``
+    (``d``: the length a cell's traction has grown over from its segment's
+    front face, ``s3``: the sum of ``(x_mid - x_c) h``), so that FastSim in
+    full adhesion gives those coefficients on these cells.  Where ``D3 <= 0``
+    the paper's ``L3`` (with the factored ``c23``) is kept.
+    """
+    ny, nx = p.shape
+    x_c = geo[G_XC]
+    y_s = geo[G_YS]
+    f = int(geo[G_FACE])
+    half = 0.5 * dx
+    # per strip: d and s3 of its current segment; per zone: D1, D3, D4
+    cd = np.zeros(ny)
+    cs = np.zeros(ny)
+    cont = np.full(ny, -2, dtype=np.int64)
+    sums = np.zeros((2, 3))
+    for i in range(nx - 1, -1, -1):
+        x_rel = x0 + dx * i - x_c
+        for j in range(env[0, i], env[1, i]):
+            if not p[j, i] > 0.0:
+                continue
+            if cont[j] == i:
+                s = dx
+            else:
+                s = half
+                cd[j] = 0.0
+                cs[j] = 0.0
+            cont[j] = i - 1
+            cd[j] += s
+            cs[j] += (x_rel + 0.5 * s) * s
+            z = 0 if j < f else 1
+            sums[z, 0] += cd[j]
+            sums[z, 1] += cs[j]
+            sums[z, 2] += (y0 + dy * j - y_s) * cd[j]
+    da = dx * dy
+    # each zone's lone half-ellipse c11, c22, c23, c13 and pair factors (1 if alone)
+    lone = np.empty((2, 4))
+    kf = np.ones((2, 4))
+    both = geo[G_ZONE1] > 0.0 and geo[G_ZONE2] > 0.0
+    for z in range(2):
+        zone = G_ZONE1 if z == 0 else G_ZONE2
+        if geo[zone] <= 0.0:
+            continue
+        t = math.log(geo[zone + 3])
+        lone[z, 0] = spline(knots, polys[I_H11], t)
+        lone[z, 1] = spline(knots, polys[I_H22], t)
+        lone[z, 2] = spline(knots, polys[I_H23], t)
+        lone[z, 3] = spline(knots, polys[I_H13], t)
+        if both:
+            t_other = math.log(geo[(G_ZONE2 if z == 0 else G_ZONE1) + 3])
+            for q in range(4):
+                kf[z, q] = pair_factor(pair_knots, pair_values[q], t, t_other)
+    # the pair's coefficient shared in the lone halves' proportion (c13: each zone's own)
+    share = np.ones(3)
+    if both:
+        total = geo[G_AREA]
+        w1 = 2.0 * geo[G_ZONE1] / total
+        w2 = 2.0 * geo[G_ZONE2] / total
+        for q in range(3):
+            pw = 1.5 if q == 2 else 1.0
+            alone = w1**pw * lone[0, q] + w2**pw * lone[1, q]
+            joined = w1**pw * lone[0, q] * kf[0, q] + w2**pw * lone[1, q] * kf[1, q]
+            share[q] = joined / alone
+    for z in range(2):
+        zone = G_ZONE1 if z == 0 else G_ZONE2
+        base = G_FLEX1 if z == 0 else G_FLEX2
+        if geo[zone] <= 0.0:
+            continue
+        c11 = lone[z, 0] * share[0]
+        c22 = lone[z, 1] * share[1]
+        c23 = lone[z, 2] * share[2]
+        c13 = lone[z, 3] * kf[z, 3]
+        ab = 2.0 * geo[zone] / math.pi
+        g = shear_modulus
+        d1 = sums[z, 0] * da
+        d3 = sums[z, 1] * da
+        d4 = abs(sums[z, 2]) * da
+        geo[base] = d1 / (g * ab * c11)
+        geo[base + 1] = d1 / (g * ab * c22)
+        if d3 > 0.0:
+            geo[base + 2] = d3 / (g * ab**1.5 * c23)
+        else:
+            geo[base + 2] = geo[base + 2] * lone[z, 2] / c23
+        geo[base + 3] = d4 / (g * ab**1.5 * c13) if c13 > 0.0 else math.inf
+
+
+@njit(cache=True, error_model="numpy")
 def mae_strip_flexibility(geo, flex):
     """Fill ``flex`` ``(4, ny)`` with each strip's zone ``L1, L2, L3, L4`` (m/Pa).
 
@@ -811,7 +945,7 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, law, prm,
     xi_s = xi + phi * (yp - y_c)
     eta_s = eta - phi * (xp - x_c)
     return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi,
-                 flex, x_c, y_c, xp, yp, law, prm, speed, out_x, out_y, slip, store)
+                 flex, x_c, y_c, xp, yp, law, prm, speed, out_x, out_y, slip, store, False)
 
 
 # ---------------------------------------------------------------- whole solves
@@ -819,10 +953,11 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, law, prm,
 
 @njit(cache=True, error_model="numpy")
 def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, phi, xp, yp,
-              law, prm, speed, out_x, out_y, slip, store):
+              law, prm, speed, out_x, out_y, slip, store, rigid):
     """MAE step 7: FastSim with each zone's ``L``'s, creepages moved to ``S = (x_c, y_s)``.
 
-    The bound is ``mu p``, or with ``parabolic`` the finished ``bound`` (Pa).
+    The bound is ``mu p``, or with ``parabolic`` the finished ``bound`` (Pa);
+    ``rigid``: the calibrated method's rigid-slip return (:func:`sweep`).
     """
     x_c = geo[G_XC]
     y_s = geo[G_YS]
@@ -830,21 +965,25 @@ def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, 
     eta_s = eta - phi * (xp - x_c)
     if parabolic:
         return sweep(bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s,
-                     xp, yp, law, prm, speed, out_x, out_y, slip, store)
+                     xp, yp, law, prm, speed, out_x, out_y, slip, store, rigid)
     return sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-                 law, prm, speed, out_x, out_y, slip, store)
+                 law, prm, speed, out_x, out_y, slip, store, rigid)
 
 
 @njit(cache=True, error_model="numpy")
 def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
-              shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store):
+              shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store,
+              calibrated, pair_knots, pair_values):
     """Solve MAE + FastSim on one patch (:func:`fastsim_ros.contact.mae.mae_fastsim`).
 
     ``p`` (Pa) on the grid ``x0, y0, dx, dy`` (m); creepages ``xi``, ``eta``
     (1), ``phi`` (1/m) about ``(xp, yp)`` (m); ``parabolic``: the
     parabolic bound ``mu N p^2 / sum(p^2 dA)`` instead of ``mu p``.
     Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells in
-    contact)`` (N, N, N m, N).
+    contact)`` (N, N, N m, N).  ``calibrated``: the calibrated MAE
+    (:func:`fastsim_ros.contact.mae_calibrated.mae_calibrated_fastsim`) with
+    the pair factors ``pair_values`` ``(4, n, n)`` on the nodes
+    ``pair_knots`` (``log(a/b)``); else the paper's (those arrays unread).
     """
     status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != OK:
@@ -855,6 +994,9 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env)
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
+    if calibrated:
+        calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_knots,
+                  pair_values)
     # the given bound is mu p, applied in the sweep: no array for it
     bound = np.empty((ny, nx) if parabolic else (0, 0))
     if parabolic:
@@ -863,7 +1005,7 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     mae_strip_flexibility(geo, flex)
     fx, fy, mz, nslip, _ = mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex,
                                      xi, eta, phi, xp, yp, law, prm, speed, out_x, out_y,
-                                     slip, store)
+                                     slip, store, calibrated)
     return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT])
 
 
@@ -919,7 +1061,7 @@ def _same_patch(b, pb, prev_pb, x0, y0, dx, dy):
 
 @njit(cache=True, error_model="numpy")
 def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modulus,
-              knots, polys, law, prm, speed, out):
+              knots, polys, law, prm, speed, out, calibrated, pair_knots, pair_values):
     """MAE + FastSim on a batch; write ``Fx, Fy, Mz`` (N, N, N m) of item ``b`` to ``out[b]``.
 
     ``ps`` ``(P, ny, nx)`` (Pa) with ``P`` = batch size, or ``P = 1`` for one
@@ -929,6 +1071,7 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
     geometry, look-ups and bound are redone only when the patch (or, for the
     parabolic bound, ``mu``) changes from one item to the next.  Return
     ``(status, index of the failing item, info)``; stops at the first error.
+    ``calibrated``, ``pair_knots``, ``pair_values``: as :func:`mae_solve`.
     """
     nb = creep.shape[0]
     ny, nx = ps.shape[1], ps.shape[2]
@@ -952,13 +1095,16 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
                                        knots, polys, geo, env)
             if status != OK:
                 return status, b, info
+            if calibrated:
+                calibrate(p, x0[b], y0[b], dx[b], dy[b], env, geo, shear_modulus, knots,
+                          polys, pair_knots, pair_values)
             mae_strip_flexibility(geo, flex)
         if parabolic and not (same and mu[b] == mu[b - 1]):
             parabolic_bound(p, dx[b], dy[b], mu[b], geo[G_LOAD], bound)
         prev_pb = pb
         fx, fy, mz, _, _ = mae_sweep(p, mu[b], parabolic, bound, env, x0[b], y0[b], dx[b],
                                      dy[b], geo, flex, xi, eta, phi, xp, yp, law, prm,
-                                     speed[b], empty_f, empty_f, empty_b, False)
+                                     speed[b], empty_f, empty_f, empty_b, False, calibrated)
         out[b, 0] = fx
         out[b, 1] = fy
         out[b, 2] = mz

@@ -53,7 +53,10 @@ def rigid_slip_return(px: float, py: float, wxh: float, wyh: float, l1: float, l
     Kalker's simplified theory with ``u = L tau`` componentwise (``L = (L1,
     L2)``, m/Pa): over a step ``h`` (m) the slip of a cell is ``s h = w h +
     L (tau - tau_p)`` (``w``: the rigid slip per unit rolling distance at
-    the step's middle, ``w h = (wxh, wyh)`` in m; ``tau_p`` = ``(px, py)``
+    the cell's centre, where its traction lives, ``w h = (wxh, wyh)`` in m:
+    taken at the step's middle, as the adhesion trial takes it, it would
+    turn the sliding traction by half a cell's rotation of the slip, 3
+    degrees a cell near a spin pole on 30 cells; ``tau_p`` = ``(px, py)``
     the traction one step upstream, Pa), and Coulomb's law puts a slipping
     cell on the bound ``g`` (Pa) opposite to its slip, ``tau = -g s/|s|``.
     With ``t' = tau_p - w h / L`` that is ``t' = (g + lam / L) tau / g``
@@ -95,12 +98,17 @@ def rigid_slip_return(px: float, py: float, wxh: float, wyh: float, l1: float, l
 
 
 def pair_factor(knots: Any, values: Any, t_self: float, t_other: float) -> float:
-    """Bilinear interpolation of a pair-factor table at ``(log g_self, log g_other)``.
+    """Interpolate a pair-factor table at ``(log g_self, log g_other)``, exactly 1 where they meet.
 
     ``knots``: the table's ``log(a/b)`` nodes (increasing); ``values[i, j]``
-    the factor at ``(knots[i], knots[j])``.  Outside the nodes the nearest
-    edge value is taken (the factor is held constant beyond the table; the
-    zones' own coefficients still come from the half-ellipse tables).
+    the factor at ``(knots[i], knots[j])``.  Linear on the triangles that
+    split each cell of the node grid along its ``(i, j) - (i+1, j+1)``
+    diagonal: on the line ``g_self = g_other`` only diagonal nodes take part,
+    so two equal halves get the factor 1 of the table's diagonal between
+    the nodes too (bilinear interpolation would mix in off-diagonal nodes:
+    1.034 at ``a/b = 6`` on both sides).  Outside the nodes the nearest edge
+    value is taken (the factor held constant beyond the table; the zones'
+    own coefficients still come from the half-ellipse tables).
     """
     n = len(knots)
     ti = min(max(t_self, knots[0]), knots[n - 1])
@@ -113,5 +121,6 @@ def pair_factor(knots: Any, values: Any, t_self: float, t_other: float) -> float
         j += 1
     u = (ti - knots[i]) / (knots[i + 1] - knots[i])
     v = (tj - knots[j]) / (knots[j + 1] - knots[j])
-    return ((1.0 - u) * ((1.0 - v) * values[i, j] + v * values[i, j + 1])
-            + u * ((1.0 - v) * values[i + 1, j] + v * values[i + 1, j + 1]))
+    if u >= v:
+        return (1.0 - u) * values[i, j] + (u - v) * values[i + 1, j] + v * values[i + 1, j + 1]
+    return (1.0 - v) * values[i, j] + (v - u) * values[i, j + 1] + u * values[i + 1, j + 1]

@@ -1,0 +1,252 @@
+"""The calibrated MAE: its three rules, its compiled path against the numpy reference, its physics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import exact, samples
+from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver, warm_up
+from fastsim_ros.contact.errors import OutOfTableError
+from fastsim_ros.contact.fastsim import traction_bound
+from fastsim_ros.contact.friction import ExponentialFriction
+from fastsim_ros.contact.mae import mae_coefficients, mae_geometry
+from fastsim_ros.contact.mae_calibrated import (calibrated_flexibilities,
+                                                mae_calibrated_coefficients,
+                                                mae_calibrated_fastsim, sweep_integrals,
+                                                zone_coefficients)
+from fastsim_ros.contact.pairs import PAIR_NAMES, pair_factors
+from fastsim_ros.contact.rules import rigid_slip_return
+from fastsim_ros.contact.tables import coefficient_table
+
+from test_contact_compiled import (AREAS, CREEPAGES, MU, NU, G, assert_forces,  # noqa: F401
+                                   assert_tractions, case, size)
+
+
+@pytest.fixture(scope="module")
+def table():
+    return coefficient_table(NU)
+
+
+@pytest.fixture(scope="module")
+def pairs():
+    return pair_factors(NU)
+
+
+@pytest.fixture(scope="module")
+def solver():
+    warm_up()
+    return CalibratedMaeSolver(NU, G)
+
+
+# ---------------------------------------------------------------- the pair factors
+
+
+def test_pair_factors_are_one_for_equal_halves(pairs):
+    # two equal halves are one ellipse: no correction, at the nodes and between them
+    for g in (0.07, 0.1, 0.5, 1.0, 3.0, 13.0):
+        for name in PAIR_NAMES:
+            assert pairs.factor(name, g, g) == pytest.approx(1.0, abs=3e-3)
+
+
+def test_pair_factors_say_the_short_half_carries_more(pairs):
+    # the exact theory: a short half (a/b = 5) joined to a round one carries more than alone,
+    # the round one less, and the effect grows with the difference
+    assert pairs.factor("c23", 5.0, 1.0) > 1.15 > 1.0 > 0.9 > pairs.factor("c23", 1.0, 5.0)
+    assert pairs.factor("c11", 4.0, 1.0) > pairs.factor("c11", 2.0, 1.0) > 1.0
+
+
+def test_pair_factors_interpolate_in_nu_exactly_at_the_nodes():
+    low, mid, high = pair_factors(0.0), pair_factors(0.25), pair_factors(0.5)
+    between = pair_factors(0.28)
+    v = [p.factor("c11", 4.0, 0.25) for p in (low, mid, high, between)]
+    assert min(v[:3]) <= v[3] <= max(v[:3])
+    with pytest.raises(OutOfTableError, match="pair factors' range"):
+        pair_factors(0.6)
+
+
+# ---------------------------------------------------------------- the rigid-slip return
+
+
+def test_rigid_slip_return_is_radial_with_equal_flexibilities():
+    px, py, l1 = 1.0e5, -2.0e4, 3e-11
+    wxh, wyh = 2e-6, 5e-6
+    tx, ty, ok = rigid_slip_return(px, py, wxh, wyh, l1, l1, 8e4)
+    trial = np.array([px - wxh / l1, py - wyh / l1])
+    assert ok
+    np.testing.assert_allclose([tx, ty], 8e4 * trial / np.hypot(*trial), rtol=1e-12)
+
+
+@pytest.mark.parametrize("l2_over_l1", [0.3, 1.7, 6.0])
+def test_rigid_slip_return_opposes_the_slip(l2_over_l1):
+    px, py, l1, g = -3e4, 6e4, 2e-11, 9e4
+    l2 = l1 * l2_over_l1
+    wxh, wyh = 1e-6, -2.5e-6
+    tx, ty, ok = rigid_slip_return(px, py, wxh, wyh, l1, l2, g)
+    assert ok and math.hypot(tx, ty) == pytest.approx(g, rel=1e-12)
+    # the slip over the step, s h = w h + L (tau - tau_p), is opposite to the traction
+    sx, sy = wxh + l1 * (tx - px), wyh + l2 * (ty - py)
+    assert sx * ty - sy * tx == pytest.approx(0.0, abs=1e-9 * math.hypot(sx, sy) * g)
+    assert sx * tx + sy * ty < 0.0
+
+
+def test_rigid_slip_return_declines_inside_the_bound():
+    assert rigid_slip_return(1e4, 0.0, 1e-8, 0.0, 1e-11, 2e-11, 1e5)[2] is False
+
+
+# ---------------------------------------------------------------- the calibration
+
+
+def _zone_sums(ar, table, pairs):
+    """MAE's eq. 7 sums of the method's zone coefficients: C~11, C~22, C~23 about S."""
+    geo = mae_geometry(ar)
+    (w1, w2), (c1, c2) = geo.weights, zone_coefficients(geo, table, pairs)
+    return (w1 * c1["c11"] + w2 * c2["c11"], w1 * c1["c22"] + w2 * c2["c22"],
+            w1**1.5 * c1["c23"] + w2**1.5 * c2["c23"])
+
+
+@pytest.mark.parametrize("cells", [12, 20, 41])
+def test_fastsim_gives_the_zone_coefficients_on_any_grid(table, pairs, cells):
+    # the paper's flexibilities reproduce a zone's coefficients on the continuous
+    # semi-ellipse only (+2% at 30 cells, METHOD.md 2); calibrated on the cells, FastSim
+    # gives them on any grid (an ellipse centred on x = 0: C~23 about S is about the origin)
+    ar = areas.ellipse(6e-3, 4e-3, nx=cells, ny=cells + 3)
+    c = mae_calibrated_coefficients(ar, table, pairs)
+    for name, value in zip(("C11", "C22", "C23"), _zone_sums(ar, table, pairs)):
+        assert getattr(c, name) == pytest.approx(value, rel=1e-9)
+
+
+@pytest.mark.parametrize("cells", [12, 20, 40])
+def test_ellipse_gives_maes_own_coefficients(table, pairs, cells):
+    # an even number of strips: two equal zones, pair factor 1, MAE's (Kalker's) C exactly
+    ar = areas.ellipse(6e-3, 4e-3, nx=cells, ny=cells + 4)
+    c = mae_calibrated_coefficients(ar, table, pairs)
+    own = mae_coefficients(mae_geometry(ar), table)
+    for name in ("C11", "C22", "C23"):
+        assert getattr(c, name) == pytest.approx(getattr(own, name), rel=1e-9)
+    assert abs(c.C13) <= 1e-9 * c.C11
+
+
+def test_notch_behind_a_gap_keeps_the_zone_coefficients(table, pairs):
+    # FastSim restarts behind the notch; the calibrated flexibilities make up for it, so the
+    # method's C~11 is its zones' sum (the paper's MAE + FastSim is 9% under MAE's own here)
+    ar = samples.notched_ellipse(cells=40)
+    c = mae_calibrated_coefficients(ar, table, pairs)
+    assert c.C11 == pytest.approx(_zone_sums(ar, table, pairs)[0], rel=1e-9)
+    paper = MaeSolver(NU, 1.0).solve(ar, 1e-12, 0.0, 0.0, mu=1e3).fx / (-ar.area / math.pi * 1e-12)
+    assert paper < 0.93 * c.C11
+
+
+def test_sweep_integrals_of_one_strip():
+    # one strip of 4 cells: d = h/2, 3h/2, 5h/2, 7h/2 from the front face
+    p = np.zeros((1, 6))
+    p[0, 1:5] = 1.0
+    ar = areas.GridArea(0.0, 0.0, 0.5, 1.0, p)
+    d, s3 = sweep_integrals(ar, x_c=1.25)
+    np.testing.assert_allclose(d[0], [0.0, 1.75, 1.25, 0.75, 0.25, 0.0])
+    # s3 = sum (x_mid - x_c) h with x_mid each step's middle: ((x_lead - x_c)^2 - (x - x_c)^2)/2
+    x_lead = 2.25
+    expected = [((x_lead - 1.25) ** 2 - (x - 1.25) ** 2) / 2 for x in ar.x]
+    np.testing.assert_allclose(s3[0, 1:5], expected[1:5], atol=1e-15)
+
+
+# ---------------------------------------------------------------- compiled = reference
+
+
+@pytest.mark.parametrize("bound", ["given", "parabolic"])
+@pytest.mark.parametrize("creep", sorted(CREEPAGES))
+def test_compiled_equals_reference(solver, table, pairs, case, creep, bound):
+    _, ar, reference = case
+    xi, eta, phi = CREEPAGES[creep]
+    ref = mae_calibrated_fastsim(ar, xi, eta, phi, bound=traction_bound(ar, MU, bound=bound),
+                                 table=table, pairs=pairs, shear_modulus=G,
+                                 reference=reference)
+    mine = solver.solve(ar, xi, eta, phi, mu=MU, reference=reference, bound=bound,
+                        tractions=True)
+    assert_forces(mine, ref.fx, ref.fy, ref.mz, size(ar))
+    assert_tractions(mine, ref.traction)
+    arrays = solver.solve_arrays(np.array(ar.pressure), ar.x0, ar.y0, ar.dx, ar.dy, xi, eta,
+                                 phi, MU, reference=reference, bound=bound)
+    assert (arrays.fx, arrays.fy, arrays.mz) == (mine.fx, mine.fy, mine.mz)
+
+
+@pytest.mark.parametrize("creep", ["partial_spin", "full_slip", "partial"])
+def test_compiled_equals_reference_with_falling_friction(solver, table, pairs, case, creep):
+    _, ar, reference = case
+    law = ExponentialFriction(0.4, 0.4, 1.0)
+    xi, eta, phi = CREEPAGES[creep]
+    ref = mae_calibrated_fastsim(ar, xi, eta, phi, bound=traction_bound(ar, law.mu_s),
+                                 table=table, pairs=pairs, shear_modulus=G,
+                                 reference=reference, friction=law, speed=20.0)
+    mine = solver.solve(ar, xi, eta, phi, friction=law, speed=20.0, reference=reference,
+                        tractions=True)
+    assert_forces(mine, ref.fx, ref.fy, ref.mz, size(ar))
+    assert_tractions(mine, ref.traction)
+
+
+def test_compiled_flexibilities_equal_reference(solver, table, pairs, case):
+    _, ar, _ = case
+    geo = mae_geometry(ar)
+    ref = calibrated_flexibilities(ar, geo, table, pairs, G)
+    mine = solver.flexibility(ar)
+    for r, m in zip(ref, mine):
+        assert (r is None) == (m is None)
+        if r is not None:
+            for name in ("l1", "l2", "l3", "l4"):
+                assert getattr(m, name) == pytest.approx(getattr(r, name), rel=1e-11)
+
+
+def test_batch_equals_one_by_one(solver):
+    ar = samples.semi_ellipses_patch(5.0, 1.0, cells=30, scale=0.01, load=3e4)
+    creep = np.column_stack([np.linspace(-2e-3, 2e-3, 7), np.linspace(1e-3, -1e-3, 7),
+                             np.linspace(-3.0, 3.0, 7)])
+    out = solver.solve_batch(ar.pressure, ar.x0, ar.y0, ar.dx, ar.dy, creep, mu=MU)
+    for row, c in zip(out, creep):
+        one = solver.solve(ar, *c, mu=MU)
+        assert tuple(row) == (one.fx, one.fy, one.mz)
+
+
+# ---------------------------------------------------------------- physics
+
+
+@pytest.mark.parametrize("make", [
+    lambda: samples.truncated_ellipse(cells=30, scale=0.01, load=2e4),
+    lambda: samples.semi_ellipses_patch(5.0, 1.0, cells=30, scale=0.01, load=3e4),
+    lambda: samples.crescent_patch(cells=30, scale=0.01, load=3e4),
+], ids=["truncated", "semi_5_1", "crescent"])
+def test_full_sliding_force_follows_the_rigid_slip(solver, make):
+    # at creepages far beyond saturation every cell slides opposite to its rigid slip:
+    # F = -mu sum p w/|w| dA (spin about the origin, with some lateral creepage)
+    ar = make()
+    xi, eta, phi = 0.0, 0.05, 400.0
+    x, y = ar.x[None, :], ar.y[:, None]
+    wx, wy = xi - phi * y, eta + phi * x
+    wn = np.hypot(wx, wy)
+    p = np.asarray(ar.pressure)
+    fx = -MU * float((p * wx / wn).sum()) * ar.cell_area
+    fy = -MU * float((p * wy / wn).sum()) * ar.cell_area
+    mine = solver.solve(ar, xi, eta, phi, mu=MU)
+    paper = MaeSolver(NU, G).solve(ar, xi, eta, phi, mu=MU)
+    scale = MU * ar.load
+    assert abs(mine.fx - fx) < 0.01 * scale and abs(mine.fy - fy) < 0.01 * scale
+    # the paper's radial return misses the direction where the zones' L differ
+    assert abs(paper.fx - fx) + abs(paper.fy - fy) > abs(mine.fx - fx) + abs(mine.fy - fy)
+
+
+def test_full_slip_along_x_gives_mu_n(solver, case):
+    _, ar, _ = case
+    r = solver.solve(ar, -2.0, 0.0, 0.0, mu=MU)
+    assert r.fx == pytest.approx(MU * ar.load, rel=1e-9) and abs(r.fy) <= 1e-9 * r.fx
+    assert r.slip_fraction == 1.0
+
+
+def test_semi_ellipses_5_1_coefficients_near_exact(table, pairs):
+    # the validation area the pair factors were made for, not fitted on (nodes 4 and 7, 0.7
+    # and 1.3): the paper's MAE is 26% low in C~23 here, the calibrated method within 5%
+    exact_c = exact.extrapolated_coefficients("semi-ellipses", (5.0, 1.0), nu=NU, finest=60)
+    c = mae_calibrated_coefficients(areas.semi_ellipses(5.0, 1.0, cells=60), table, pairs)
+    for name in ("C11", "C22", "C23"):
+        assert getattr(c, name) == pytest.approx(getattr(exact_c, name), rel=0.05)
