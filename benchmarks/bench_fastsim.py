@@ -16,6 +16,8 @@ each call, after a warm-up; the three compiled calls interleaved in blocks):
   whole compiled solve (``mae_solve`` in the same loop),
 - the numpy reference ``mae_fastsim`` (with its traction bound; fewer calls),
 - ``EquivalentEllipseSolver.solve`` (the baseline, same patch),
+- ``CalibratedMaeSolver.solve`` (the second MAE method, same patch; the
+  target is at most 1.5x ``MaeSolver.solve``, TARGETS.md),
 
 then the batched throughput (patch solves per second, one core) of
 ``solve_batch`` on distinct patches and on one patch under many creepages.
@@ -40,7 +42,8 @@ from numba import njit
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import kernels
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver, warm_up
+from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipseSolver,
+                                          MaeSolver, warm_up)
 from fastsim_ros.contact.fastsim import traction_bound
 from fastsim_ros.contact.mae import mae_fastsim
 from fastsim_ros.contact.tables import coefficient_table
@@ -173,6 +176,7 @@ def main() -> None:
     print(f"creepages xi, eta, phi = {CREEP} (phi in 1/m), mu = {MU}, N = {LOAD:g} N, "
           f"G = {G:g} Pa, nu = {NU}; times in us, median / p99 over {args.calls} calls\n")
     mae = MaeSolver(NU, G)
+    calibrated = CalibratedMaeSolver(NU, G)
     baseline = EquivalentEllipseSolver(NU, G)
     table = coefficient_table(NU)
     knots, polys = mae._knots, mae._polys
@@ -181,7 +185,7 @@ def main() -> None:
 
     head = (f"{'patch':<14}{'grid':>6}{'cells':>6}{'slip':>6}  {'solve':>13}  "
             f"{'solve_arrays':>13}  {'geometry':>8}{'share':>7}  {'numpy ref':>10}  "
-            f"{'equivalent':>13}{'eq/mae':>7}")
+            f"{'equivalent':>13}{'eq/mae':>7}  {'calibrated':>13}{'cal/mae':>8}")
     print(head)
     print("-" * len(head))
     rates = []
@@ -194,8 +198,10 @@ def main() -> None:
             t = per_call({
                 "solve": lambda: mae.solve(ar, xi, eta, phi, mu=MU),
                 "arrays": lambda: mae.solve_arrays(p, *grid, xi, eta, phi, MU),
-                "equivalent": lambda: baseline.solve(ar, xi, eta, phi, mu=MU)}, args.calls)
+                "equivalent": lambda: baseline.solve(ar, xi, eta, phi, mu=MU),
+                "calibrated": lambda: calibrated.solve(ar, xi, eta, phi, mu=MU)}, args.calls)
             t_solve, t_arrays, t_eq = t["solve"], t["arrays"], t["equivalent"]
+            t_cal = t["calibrated"]
             kargs = (ar.pressure, *grid, G, knots, polys)
             t_geo = in_kernel(_loop_prepare, *kargs)
             t_whole = in_kernel(_loop_solve, *kargs, xi, eta, phi, MU)
@@ -207,7 +213,8 @@ def main() -> None:
                   f"{100 * res.slip_fraction:>5.0f}%  {t_solve[0]:>6.1f} /{t_solve[1]:>5.1f}  "
                   f"{t_arrays[0]:>6.1f} /{t_arrays[1]:>5.1f}  {t_geo:>8.2f}"
                   f"{100 * t_geo / t_whole:>6.0f}%  {t_ref[0]:>10.0f}  "
-                  f"{t_eq[0]:>6.1f} /{t_eq[1]:>5.1f}{t_eq[0] / t_solve[0]:>7.2f}")
+                  f"{t_eq[0]:>6.1f} /{t_eq[1]:>5.1f}{t_eq[0] / t_solve[0]:>7.2f}  "
+                  f"{t_cal[0]:>6.1f} /{t_cal[1]:>5.1f}{t_cal[0] / t_solve[0]:>8.2f}")
             # batches: distinct patches (load and a fore-aft tilt of the pressure vary
             # smoothly from patch to patch, as from a normal solver) and creepages
             b = args.batch
@@ -218,14 +225,15 @@ def main() -> None:
                                      phi * (0.5 + rng.random(b))])
             rates.append((name, f"{ar.nx}x{ar.ny}", [
                 throughput(lambda: s.solve_batch(pp, *grid, creep, mu=MU), b)
-                for s in (mae, baseline) for pp in (ps, p)]))
+                for s in (mae, baseline, calibrated) for pp in (ps, p)]))
     print("\ngeometry: MAE geometry + table look-ups alone (kernel mae_prepare, in a compiled "
           "loop);\nshare: of the whole compiled MAE solve (mae_solve, same loop); numpy ref: "
           "mae_fastsim,\nmedian of fewer calls; eq/mae: median of EquivalentEllipseSolver.solve "
-          "over MaeSolver.solve.\n")
+          "over MaeSolver.solve;\ncalibrated: CalibratedMaeSolver.solve, cal/mae its median over "
+          "MaeSolver.solve's.\n")
     print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
     head = (f"{'patch':<14}{'grid':>6}  {'MAE distinct':>13}{'MAE 1 patch':>13}"
-            f"{'eq distinct':>13}{'eq 1 patch':>13}")
+            f"{'eq distinct':>13}{'eq 1 patch':>13}{'cal distinct':>13}{'cal 1 patch':>13}")
     print(head)
     print("-" * len(head))
     for name, size, r in rates:

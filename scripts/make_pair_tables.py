@@ -157,7 +157,8 @@ def main() -> int:
         "# k_ij = c_ij of the half a/b = g_self joined to the half g_other / c_ij of the lone"
         " half (fastsim_ros/data tables); *_err: change of C0 without the coarsest grid,"
         " over the lone half's c_ij.",
-        f"# Diagonal check (k = 1 by symmetry) at a/b {', '.join(f'{g:g}' for g in DIAGONAL_CHECK)}:"
+        "# Diagonal check (k = 1 by symmetry) at a/b "
+        + ", ".join(f"{g:g}" for g in DIAGONAL_CHECK) + ":"
         f" largest |k - 1| = {worst_diag:.4f} (the extrapolation's and the tables' error);"
         " every diagonal entry is set to 1.",
     ]
@@ -167,8 +168,8 @@ def main() -> int:
         for line in header:
             f.write(line + "\n")
         w = csv.writer(f)
-        w.writerow(["g_self", "g_other", "nu"] + [s for k in KEYS for s in
-                                                 (f"k{k[1:]}", f"k{k[1:]}_err")])
+        names = [s for k in KEYS for s in (f"k{k[1:]}", f"k{k[1:]}_err")]
+        w.writerow(["g_self", "g_other", "nu"] + names)
         w.writerows(rows)
     tmp.replace(out)
     print(f"wrote {out} in {time.time() - start:.0f} s; diagonal |k - 1| <= {worst_diag:.4f}",

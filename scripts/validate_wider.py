@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Wider validation: exact vs the paper's MAE, FaStrip and the equivalent ellipse on 15 areas.
+"""Wider validation: exact vs the calibrated and the paper's MAE, FaStrip and the ellipse.
 
 Writes ``docs/data/validation_wider.json``, ``docs/figures/wider_*.png`` and
 ``docs/validation_wider.md`` (issue 12, first part).  The areas: the nine of
@@ -10,10 +10,13 @@ profile gap at three lateral shifts from the tread to the flange root.
 
 For each area: force-creepage curves under ``xi``, ``eta``, ``phi`` and
 combined (the levels of ``scripts/validate.py``) from the exact theory
-(Coulomb friction, given pressure) and the three online methods on one
+(Coulomb friction, given pressure) and the four online methods on one
 grid; the linear-range ``C~11, C~22, C~23`` (exact: extrapolated over four
 grids, METHOD.md 5; the methods on 60 cells); the cost per solve; and a grid
-check of the curves on a finer grid for two areas.
+check of the curves on a finer grid for two areas.  Besides, the selection
+areas (pairs of semi-ellipses at the pair-factor table's nodes and two
+notches: fit data, not validation areas) on which the calibrated MAE's
+pair-factor rule was chosen, with the alternatives.
 
 Usage: ``python scripts/validate_wider.py [--report-only]``.  About 8 minutes
 on 2 cores (the exact Coulomb solves dominate).
@@ -44,12 +47,16 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import exact, samples  # noqa: E402
-from fastsim_ros.contact.compiled import (EquivalentEllipseSolver, MaeSolver,  # noqa: E402
-                                          warm_up)
+from fastsim_ros.contact.compiled import (CalibratedMaeSolver,  # noqa: E402
+                                          EquivalentEllipseSolver, MaeSolver, warm_up)
 from fastsim_ros.contact.equivalent import equivalent_coefficients  # noqa: E402
 from fastsim_ros.contact.errors import ContactError  # noqa: E402
 from fastsim_ros.contact.fastrip import fastrip, fastrip_coefficients  # noqa: E402
+from fastsim_ros.contact.fastsim import traction_bound  # noqa: E402
 from fastsim_ros.contact.mae import mae_fastsim_coefficients  # noqa: E402
+from fastsim_ros.contact.mae_calibrated import (mae_calibrated_coefficients,  # noqa: E402
+                                                mae_calibrated_fastsim)
+from fastsim_ros.contact.pairs import PairFactors, pair_factors  # noqa: E402
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
 
 import validate  # noqa: E402  (scripts/validate.py: the report's own areas)
@@ -70,8 +77,11 @@ ONLINE_CELLS = 60
 CURVES = {"xi": (1.0, 0.0, 0.0), "eta": (0.0, 1.0, 0.0), "phi": (0.0, 0.0, 1.0),
           "combined": (0.5, 0.5, 0.5)}
 LEVELS = (0.05, 0.15, 0.3, 0.5, 0.8, 1.2, 2.0, 3.5)
-METHODS = ("mae", "fastrip", "ellipse")
-LABELS = {"mae": "paper's MAE", "fastrip": "FaStrip", "ellipse": "equivalent ellipse"}
+METHODS = ("mae_calibrated", "mae", "fastrip", "ellipse")
+LABELS = {"mae_calibrated": "calibrated MAE", "mae": "paper's MAE", "fastrip": "FaStrip",
+          "ellipse": "equivalent ellipse"}
+#: bar offsets of the methods in the figures
+BAR = 0.2
 NEW = ("long narrow", "crescent", "egg")
 
 AreaMaker = validate.AreaMaker
@@ -119,6 +129,7 @@ def curves_on(ar: areas.GridArea) -> dict[str, Any]:
     """Return the curves of exact and the three methods on ``ar``, with each solve's cost."""
     t = coefficient_table(NU)
     mae = MaeSolver(NU, G)
+    calibrated = CalibratedMaeSolver(NU, G)
     ell = EquivalentEllipseSolver(NU, G)
     sat = _saturation(ar)
     op = exact.SteadyRollingOperator.of(ar, nu=NU, shear_modulus=G)
@@ -135,6 +146,7 @@ def curves_on(ar: areas.GridArea) -> dict[str, Any]:
             cost["exact"].append(time.perf_counter() - t0)
             point["exact"] = [ex.fx, ex.fy, ex.mz]
             solvers: dict[str, Callable[[], Any]] = {
+                "mae_calibrated": lambda cr=cr: calibrated.solve(ar, *cr, mu=MU),
                 "mae": lambda cr=cr: mae.solve(ar, *cr, mu=MU),
                 "fastrip": lambda cr=cr: fastrip(ar, *cr, mu=MU, table=t, shear_modulus=G),
                 "ellipse": lambda cr=cr: ell.solve(ar, *cr, mu=MU)}
@@ -167,10 +179,13 @@ def _extrapolated(make: AreaMaker) -> dict[str, float]:
 def coefficients_of(make: AreaMaker) -> dict[str, Any]:
     """Return the linear-range coefficients about each area's origin: exact and the methods."""
     t = coefficient_table(NU)
+    pairs = pair_factors(NU)
     ar = make(ONLINE_CELLS)
     out: dict[str, Any] = {"exact": _extrapolated(make)}
-    for m, f in (("mae", mae_fastsim_coefficients), ("fastrip", fastrip_coefficients),
-                 ("ellipse", equivalent_coefficients)):
+    calibrated: Callable[[Any, Any], Any] = (
+        lambda a, tab: mae_calibrated_coefficients(a, tab, pairs))
+    for m, f in (("mae_calibrated", calibrated), ("mae", mae_fastsim_coefficients),
+                 ("fastrip", fastrip_coefficients), ("ellipse", equivalent_coefficients)):
         try:
             c = f(ar, t)
             out[m] = {k: getattr(c, k) for k in ("C11", "C22", "C23", "C13")}
@@ -178,6 +193,58 @@ def coefficients_of(make: AreaMaker) -> dict[str, Any]:
             out[m] = None
             out[m + "_error"] = str(e)
     return out
+
+
+def selection_makers() -> dict[str, AreaMaker]:
+    """Return the areas the calibrated MAE's pair-factor rule was chosen on (fit data, loaded).
+
+    Semi-ellipse pairs at nodes of the pair-factor table (made from their
+    full-adhesion solutions) and two notches other than the validation's;
+    none of them is a validation area.
+    """
+    out: dict[str, AreaMaker] = {}
+    for g1, g2 in ((4.0, 0.7), (7.0, 1.3), (0.13, 1.3), (2.5, 0.4)):
+        out[f"pair {g1:g}/{g2:g}"] = (lambda n, g1=g1, g2=g2: samples.semi_ellipses_patch(
+            g1, g2, cells=n, scale=SCALE, load=LOAD))
+    for ratio, half_width, depth in ((1.5, 0.2, 0.3), (1.2, 0.45, 0.1)):
+        out[f"notch {ratio:g}/{half_width:g}/{depth:g}"] = (
+            lambda n, r=ratio, w=half_width, d=depth: _notch(r, w, d, n))
+    return out
+
+
+def _notch(ratio: float, half_width: float, depth: float, cells: int) -> areas.GridArea:
+    """Ellipse ``a/b = ratio`` (1e-4 m^2, 5e4 N) without ``|x| < half_width a, y > depth b``."""
+    a, b = areas.semi_ellipse_axes(ratio)
+    x = -a + 2 * a / cells * (np.arange(cells) + 0.5)
+    y = -b + 2 * b / cells * (np.arange(cells) + 0.5)
+    xx, yy = x[None, :], y[:, None]
+    p = np.sqrt(np.clip(1.0 - (xx / a) ** 2 - (yy / b) ** 2, 0.0, None))
+    p = p * ~((np.abs(xx) < half_width * a) & (yy > depth * b))
+    ar = areas.GridArea(float(x[0]) * SCALE, float(y[0]) * SCALE, 2 * a / cells * SCALE,
+                        2 * b / cells * SCALE, p)
+    return ar.with_load(LOAD)
+
+
+#: the pair-factor rules compared on the selection areas (numpy reference)
+SHARES = {"shared": "shared factor (the method)", "zone": "each half its own factor",
+          "none": "no pair factor"}
+
+
+def selection_on(ar: areas.GridArea) -> dict[str, Any]:
+    """Return exact curves on a selection area and the calibrated MAE's under each rule."""
+    entry = curves_on(ar)
+    t = coefficient_table(NU)
+    ones = PairFactors(NU, np.log(np.array([0.05, 20.0])), np.ones((4, 2, 2)))
+    bound = traction_bound(ar, MU)
+    for rule in SHARES:
+        for curve in CURVES:
+            for p in entry[curve]:
+                r = mae_calibrated_fastsim(
+                    ar, *p["creepage"], bound=bound, table=t,
+                    pairs=ones if rule == "none" else pair_factors(NU), shear_modulus=G,
+                    share="zone" if rule == "zone" else "shared")
+                p["rule_" + rule] = [r.fx, r.fy, r.mz]
+    return entry
 
 
 def compute() -> dict[str, Any]:
@@ -199,6 +266,11 @@ def compute() -> dict[str, Any]:
         t0 = time.time()
         res["grid_check"][name] = curves_on(loaded[name](CHECK_CELLS))
         print(f"grid check {name}: {time.time() - t0:.0f} s", flush=True)
+    res["selection"] = {}
+    for name, make in selection_makers().items():
+        t0 = time.time()
+        res["selection"][name] = selection_on(make(CURVE_CELLS))
+        print(f"selection {name}: {time.time() - t0:.0f} s", flush=True)
     res["seconds"] = time.time() - start
     return res
 
@@ -308,7 +380,7 @@ def report(res: dict[str, Any]) -> None:
     xs = np.arange(len(names))
     for k, m in enumerate(METHODS):
         vals = [100 * (worst_error(d[n], m)[0] or 0.0) for n in names]
-        ax.bar(xs + 0.27 * (k - 1), vals, 0.27, label=LABELS[m])
+        ax.bar(xs + BAR * (k - 1.5), vals, BAR, label=LABELS[m])
     ax.axhline(10, color="k", lw=0.8, ls="--", label="target 10% of mu N")
     ax.set_xticks(xs, names, rotation=30, ha="right", fontsize=7)
     ax.set_ylabel("worst curve error (% of mu N)")
@@ -376,7 +448,7 @@ def report(res: dict[str, Any]) -> None:
         for k, m in enumerate(METHODS):
             vals = [100 * (d[n]["coefficients"][m][key] / d[n]["coefficients"]["exact"][key]
                            - 1) if d[n]["coefficients"][m] else 0.0 for n in names]
-            ax.bar(xs + 0.27 * (k - 1), vals, 0.27, label=LABELS[m])
+            ax.bar(xs + BAR * (k - 1.5), vals, BAR, label=LABELS[m])
         ax.axhspan(-5, 5, color="0.92")
         ax.set_xticks(xs, names, rotation=40, ha="right", fontsize=6)
         ax.set_title(f"{key}: deviation from exact (%)")
@@ -493,7 +565,8 @@ def _curve_figure(name: str, e: dict[str, Any]) -> None:
     mu_n = MU * e["N"]
     for ax, curve in zip(axs, CURVES):
         lv = [p["level"] for p in e[curve]]
-        for m, style, label in (("exact", "k-", "exact"), ("mae", "C0o--", "MAE"),
+        for m, style, label in (("exact", "k-", "exact"), ("mae_calibrated", "C1D-", "calibrated"),
+                                ("mae", "C0o--", "MAE"),
                                 ("fastrip", "C2^-.", "FaStrip"),
                                 ("ellipse", "C3s:", "ellipse")):
             for idx, comp in ((0, "Fx"), (1, "Fy")):

@@ -1,4 +1,4 @@
-"""The calibrated MAE: its three rules, its compiled path against the numpy reference, its physics."""
+"""The calibrated MAE: its three rules, its compiled path against the reference, its physics."""
 
 from __future__ import annotations
 
@@ -22,8 +22,15 @@ from fastsim_ros.contact.pairs import PAIR_NAMES, pair_factors
 from fastsim_ros.contact.rules import rigid_slip_return
 from fastsim_ros.contact.tables import coefficient_table
 
-from test_contact_compiled import (AREAS, CREEPAGES, MU, NU, G, assert_forces,  # noqa: F401
-                                   assert_tractions, case, size)
+from test_contact_compiled import (AREAS, CREEPAGES, MU, NU, G, assert_forces,
+                                   assert_tractions, size)
+
+
+@pytest.fixture(scope="module", params=sorted(AREAS))
+def case(request):
+    """Give the compiled path's test areas (test_contact_compiled.AREAS): name, area, point."""
+    make, reference = AREAS[request.param]
+    return request.param, make(), reference
 
 
 @pytest.fixture(scope="module")
@@ -101,7 +108,7 @@ def test_rigid_slip_return_declines_inside_the_bound():
 
 
 def _zone_sums(ar, table, pairs):
-    """MAE's eq. 7 sums of the method's zone coefficients: C~11, C~22, C~23 about S."""
+    """Return the method's zone coefficients summed as MAE's eq. 7: C~11, C~22, C~23 about S."""
     geo = mae_geometry(ar)
     (w1, w2), (c1, c2) = geo.weights, zone_coefficients(geo, table, pairs)
     return (w1 * c1["c11"] + w2 * c2["c11"], w1 * c1["c22"] + w2 * c2["c22"],

@@ -49,6 +49,7 @@ couplings ``c12``, ``c21`` are left out, as in the paper.
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -97,9 +98,12 @@ def sweep_integrals(area: GridArea, x_c: float) -> tuple[FloatArray, FloatArray]
     return d, s3
 
 
-def zone_coefficients(geometry: MaeGeometry, table: CoefficientTable,
-                      pairs: PairFactors) -> tuple[dict[str, float] | None,
-                                                   dict[str, float] | None]:
+PairShare = Literal["shared", "zone"]
+
+
+def zone_coefficients(geometry: MaeGeometry, table: CoefficientTable, pairs: PairFactors, *,
+                      share: PairShare = "shared") -> tuple[dict[str, float] | None,
+                                                            dict[str, float] | None]:
     """Each zone's ``c11, c22, c23, c13`` with the pair's interaction (rule 1).
 
     The pair factors give each half's share of the joined pair's force; their
@@ -112,10 +116,15 @@ def zone_coefficients(geometry: MaeGeometry, table: CoefficientTable,
     early and the other too late: on the pairs 4/0.7 and 7/1.3 (the
     selection areas of ``scripts/validate_wider.py``, not validation areas)
     the worst curve error was 12.1 and 17.0% of mu N with each half's own
-    factor, 3.9 and 6.2% with the shared one, 7.8 and 7.3% without any.  ``c13``, a difference of the zones'
-    terms, takes each zone's own factor.  ``None`` for an empty zone; with
-    the other zone empty the lone values stand.
+    factor, 3.9 and 6.2% with the shared one, 7.8 and 7.3% without any.
+    ``c13``, a difference of the zones' terms, takes each zone's own factor.
+    ``share="zone"``: each half its own factor (the alternative, kept for
+    the validation's comparison; the compiled path has the shared rule
+    only).  ``None`` for an empty zone;
+    with the other zone empty the lone values stand.
     """
+    if share not in ("shared", "zone"):
+        raise ValueError(f"share must be 'shared' or 'zone', got {share!r}")
     zones = (geometry.zone1, geometry.zone2)
     if zones[0].empty or zones[1].empty:
         return tuple(None if z.empty else {n: table.half(z.a_over_b)[n] for n in PAIR_NAMES}
@@ -124,6 +133,9 @@ def zone_coefficients(geometry: MaeGeometry, table: CoefficientTable,
     lone = [table.half(z.a_over_b) for z in zones]
     k = [pairs.factors(zones[0].a_over_b, zones[1].a_over_b),
          pairs.factors(zones[1].a_over_b, zones[0].a_over_b)]
+    if share == "zone":
+        return tuple({n: lone[i][n] * k[i][n] for n in PAIR_NAMES}  # type: ignore[return-value]
+                     for i in range(2))
     out = [{"c13": lone[i]["c13"] * k[i]["c13"]} for i in range(2)]
     for name, power in (("c11", 1.0), ("c22", 1.0), ("c23", 1.5)):
         alone = sum(w[i] ** power * lone[i][name] for i in range(2))
@@ -137,7 +149,7 @@ def calibrated_zone_flexibility(area: GridArea, geometry: MaeGeometry, zone: Zon
                                 lower: bool, c: dict[str, float], table: CoefficientTable,
                                 shear_modulus: float, d: FloatArray,
                                 s3: FloatArray) -> ZoneFlexibility:
-    """Return the zone's ``L1 .. L4`` (m/Pa) with which FastSim gives ``c`` on its cells (rule 2)."""
+    """Return the zone's ``L1 .. L4`` (m/Pa): FastSim then gives ``c`` on its cells (rule 2)."""
     rows = (area.y < geometry.y_s) if lower else ~(area.y < geometry.y_s)
     cells = area.mask & rows[:, None]
     da = area.cell_area
@@ -156,10 +168,11 @@ def calibrated_zone_flexibility(area: GridArea, geometry: MaeGeometry, zone: Zon
 
 
 def calibrated_flexibilities(area: GridArea, geometry: MaeGeometry, table: CoefficientTable,
-                             pairs: PairFactors, shear_modulus: float) -> ZonePair:
+                             pairs: PairFactors, shear_modulus: float, *,
+                             share: PairShare = "shared") -> ZonePair:
     """Return both zones' calibrated flexibilities (``None`` for an empty zone)."""
     d, s3 = sweep_integrals(area, geometry.x_c)
-    c1, c2 = zone_coefficients(geometry, table, pairs)
+    c1, c2 = zone_coefficients(geometry, table, pairs, share=share)
     z1 = None if c1 is None else calibrated_zone_flexibility(
         area, geometry, geometry.zone1, True, c1, table, shear_modulus, d, s3)
     z2 = None if c2 is None else calibrated_zone_flexibility(
@@ -171,14 +184,15 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
                            bound: FloatArray, table: CoefficientTable, pairs: PairFactors,
                            shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                            rule: SplitRule = DEFAULT_SPLIT, friction: FrictionLaw | None = None,
-                           speed: float | None = None) -> MaeResult:
-    """Solve the calibrated MAE + FastSim; arguments as :func:`~fastsim_ros.contact.mae.mae_fastsim`.
+                           speed: float | None = None, share: PairShare = "shared") -> MaeResult:
+    """Solve the calibrated MAE + FastSim; arguments as :func:`.mae.mae_fastsim`.
 
     ``pairs``: the pair factors at the table's ``nu``
-    (:func:`~fastsim_ros.contact.pairs.pair_factors`).
+    (:func:`~fastsim_ros.contact.pairs.pair_factors`); ``share``:
+    :func:`zone_coefficients`'.
     """
     geometry = mae_geometry(area, rule)
-    zones = calibrated_flexibilities(area, geometry, table, pairs, shear_modulus)
+    zones = calibrated_flexibilities(area, geometry, table, pairs, shear_modulus, share=share)
     flex: StripFlexibility = strip_flexibility(area, geometry, zones)
     res = fastsim(area, xi, eta, phi, bound=bound, flexibility=flex,
                   sweep_point=(geometry.x_c, geometry.y_s), reference=reference,

@@ -48,7 +48,7 @@ def ellipse_grid(a: float, b: float, n: int, x_c: float,
 
 def rigid_slip_return(px: float, py: float, wxh: float, wyh: float, l1: float, l2: float,
                       g: float) -> tuple[float, float, bool]:
-    """Return the traction of a slipping cell whose slip follows the rigid slip, and whether it applies.
+    """Return a slipping cell's traction, opposite to its slip, and whether the rule applies.
 
     Kalker's simplified theory with ``u = L tau`` componentwise (``L = (L1,
     L2)``, m/Pa): over a step ``h`` (m) the slip of a cell is ``s h = w h +
