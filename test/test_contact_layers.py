@@ -32,7 +32,7 @@ ALLOWED = {
     "equivalent": {"numpy", "area", "checks", "coefficients", "fastsim", "friction", "rules",
                    "tables", "traction"},
     "mae_calibrated": {"numpy", "area", "checks", "coefficients", "fastsim", "friction", "mae",
-                       "pairs", "tables"},
+                       "pairs", "rules", "tables"},
     "fastrip": {"numpy", "area", "checks", "coefficients", "equivalent", "errors", "fastsim",
                 "tables", "traction"},
     "kernels": {"numpy", "numba", "rules"},

@@ -272,6 +272,9 @@ def kalker_flexibility(a, b, c11, c22, c23, shear_modulus):
 LAW_CONSTANT = rules.LAW_CONSTANT
 LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
 
+#: :data:`fastsim_ros.contact.rules.MIN_OFFSET_C23_SHARE` (frozen into the kernels)
+MIN_OFFSET_C23_SHARE = rules.MIN_OFFSET_C23_SHARE
+
 #: :func:`fastsim_ros.contact.rules.rigid_slip_return` and
 #: :func:`~fastsim_ros.contact.rules.pair_factor`, compiled: the reference's formulas, no copies
 rigid_slip_return = njit(cache=True, error_model="numpy")(rules.rigid_slip_return)
@@ -706,8 +709,9 @@ def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_kno
     ``D1 = sum d dA``, ``D3 = sum s3 dA``, ``D4 = |sum (y - y_s) d dA|``
     (``d``: the length a cell's traction has grown over from its segment's
     front face, ``s3``: the sum of ``(x_mid - x_c) h``), so that FastSim in
-    full adhesion gives those coefficients on these cells.  Where ``D3 <= 0``
-    the paper's ``L3`` (with the factored ``c23``) is kept.
+    full adhesion gives those coefficients on these cells; ``c23`` with the
+    zone's strip offsets (the reference's ``offset_c23``).  Where ``D3 <= 0``
+    the paper's ``L3`` (with the method's ``c23``) is kept.
     """
     ny, nx = p.shape
     x_c = geo[G_XC]
@@ -719,11 +723,17 @@ def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_kno
     cs = np.zeros(ny)
     cont = np.full(ny, -2, dtype=np.int64)
     sums = np.zeros((2, 3))
+    # each strip's leading (first seen) and trailing contact column
+    lead = np.full(ny, -1, dtype=np.int64)
+    trail = np.full(ny, -1, dtype=np.int64)
     for i in range(nx - 1, -1, -1):
         x_rel = x0 + dx * i - x_c
         for j in range(env[0, i], env[1, i]):
             if not p[j, i] > 0.0:
                 continue
+            if lead[j] < 0:
+                lead[j] = i
+            trail[j] = i
             if cont[j] == i:
                 s = dx
             else:
@@ -738,6 +748,14 @@ def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_kno
             sums[z, 1] += cs[j]
             sums[z, 2] += (y0 + dy * j - y_s) * cd[j]
     da = dx * dy
+    # rule 4: each zone's mean strip centre, every strip counted once
+    centre = np.zeros(2)
+    strips = np.zeros(2)
+    for j in range(ny):
+        if lead[j] >= 0:
+            z = 0 if j < f else 1
+            centre[z] += x0 + dx * 0.5 * (lead[j] + trail[j])
+            strips[z] += 1.0
     # each zone's lone half-ellipse c11, c22, c23, c13 and pair factors (1 if alone)
     lone = np.empty((2, 4))
     kf = np.ones((2, 4))
@@ -773,9 +791,12 @@ def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_kno
             continue
         c11 = lone[z, 0] * share[0]
         c22 = lone[z, 1] * share[1]
-        c23 = lone[z, 2] * share[2]
         c13 = lone[z, 3] * kf[z, 3]
         ab = 2.0 * geo[zone] / math.pi
+        # rule 4 (the reference's offset_c23): the strips' offsets from x_c
+        c23 = lone[z, 2] * share[2]
+        x_eta = centre[z] / strips[z]
+        c23 = max(c23 + c22 * (x_eta - x_c) / math.sqrt(ab), MIN_OFFSET_C23_SHARE * c23)
         g = shear_modulus
         d1 = sums[z, 0] * da
         d3 = sums[z, 1] * da

@@ -78,9 +78,9 @@ class MaeGeometry:
         return 2.0 * self.zone1.area / self.area, 2.0 * self.zone2.area / self.area
 
 
-def _row_extents(mask: NDArray[np.bool_]) -> tuple[NDArray[np.int_], NDArray[np.int_],
-                                                   NDArray[np.int_]]:
-    """Per row: cells in contact, index of the first and of the last contact cell."""
+def row_extents(mask: NDArray[np.bool_]) -> tuple[NDArray[np.int_], NDArray[np.int_],
+                                                  NDArray[np.int_]]:
+    """Return per row: cells in contact, index of the first and of the last contact cell."""
     count = mask.sum(axis=1)
     nx = mask.shape[1]
     first = np.where(count > 0, np.argmax(mask, axis=1), 0)
@@ -105,7 +105,7 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
     semi-ellipses), where the split takes the band's face on that side.
     """
     mask = area.mask
-    count, _, _ = _row_extents(mask)
+    count, _, _ = row_extents(mask)
     if rule == "auto":
         f = split_face(area, "widest_strip")
         share = float(count[:f].sum()) / float(count.sum())
@@ -145,7 +145,7 @@ def _zone(area: GridArea, rows: NDArray[np.bool_], x_c: float, y_s: float,
     n = int(np.count_nonzero(mask))
     if n == 0:
         return Zone(0.0, math.nan, math.nan, math.nan, math.nan, math.nan)
-    count, first, last = _row_extents(mask)
+    count, first, last = row_extents(mask)
     used = count > 0
     x = area.x
     lead = x[last[used]] + 0.5 * area.dx - x_c

@@ -23,6 +23,10 @@ LAW_EXPONENTIAL = 1
 #: ``auto`` split rule (:func:`fastsim_ros.contact.mae.split_face`)
 MIN_ZONE_SHARE = 0.15
 
+#: the calibrated MAE's rule 4 keeps at least this share of a zone's ``c23``
+#: (a zone bent far backwards; :func:`fastsim_ros.contact.mae_calibrated.offset_c23`)
+MIN_OFFSET_C23_SHARE = 0.25
+
 
 def ellipse_cells(cells_in_contact: float) -> int:
     """Return the cells across the ellipse's box giving as many cells in contact as the patch.
