@@ -6,7 +6,9 @@ units throughout.  ``--json`` prints exactly one JSON object on stdout.  Bad
 input gives one line on stderr and exit status 2, never a traceback, and no
 non-finite number is ever printed as a result.
 
-``forces --method mae`` and ``fastsim_ellipse`` run the compiled solvers of
+``forces --method mae_calibrated`` (the default: the calibrated MAE, better than
+the paper's MAE on every area of docs/validation_wider.md), ``mae`` (the paper's)
+and ``fastsim_ellipse`` run the compiled solvers of
 :mod:`fastsim_ros.contact.compiled`, the code the node runs; ``exact`` runs
 the exact theory (:mod:`fastsim_ros.contact.exact`); ``fastrip`` the numpy
 FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path).
@@ -41,9 +43,16 @@ from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, 
 
 #: cells across the bounding box of a shape, per method: exact coefficients are
 #: extrapolated from grids up to this; FastSim's discretisation error at 60
-#: cells is 0.1% on ellipses (docs/validation.md).
-DEFAULT_CELLS = {"exact": 100, "mae": 100, "fastsim": 60, "exact_forces": 60,
-                 "mae_forces": 60, "fastsim_ellipse_forces": 60, "fastrip_forces": 60}
+#: cells is 0.1% on ellipses (docs/validation.md).  The calibrated MAE's
+#: flexibilities make FastSim give its zones' coefficients on any grid (Kalker's
+#: on an ellipse, to rounding): the grid enters through the zones' geometry
+#: only, as for ``mae``, hence the same 100 cells.
+DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
+                 "exact_forces": 60, "mae_forces": 60, "mae_calibrated_forces": 60,
+                 "fastsim_ellipse_forces": 60, "fastrip_forces": 60}
+#: the methods of ``coefficients`` and of ``forces`` (the first: ``forces``' default)
+COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim")
+FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -134,8 +143,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     co = sub.add_parser("coefficients", help="generalised creepage coefficients C~ij")
     _add_area(co, forces=False)
-    co.add_argument("--method", choices=("exact", "mae", "fastsim"), default="exact",
-                    help="exact solver, MAE's coefficients, or MAE + FastSim in adhesion")
+    co.add_argument("--method", choices=COEFFICIENT_METHODS, default="exact",
+                    help="exact solver (default), MAE's coefficients, the calibrated MAE's "
+                    "(its FastSim in full adhesion), or MAE + FastSim in full adhesion")
     co.add_argument("--nu", type=_finite, default=0.25, help="Poisson ratio (default 0.25)")
     fo = sub.add_parser("forces", help="creep forces at given creepages")
     _add_area(fo, forces=True)
@@ -156,8 +166,9 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
     fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
-    fo.add_argument("--method", choices=("mae", "fastsim_ellipse", "exact", "fastrip"),
-                    default="mae")
+    fo.add_argument("--method", choices=FORCE_METHODS, default="mae_calibrated",
+                    help="mae_calibrated (default: the calibrated MAE), mae (the paper's), "
+                    "fastsim_ellipse, exact or fastrip")
     fo.add_argument("--bound", choices=BOUNDS, default="given",
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch)")
@@ -345,6 +356,8 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``coefficients``: a dict of the results."""
     from fastsim_ros.contact import exact
     from fastsim_ros.contact.mae import mae_coefficients, mae_fastsim_coefficients, mae_geometry
+    from fastsim_ros.contact.mae_calibrated import mae_calibrated_coefficients
+    from fastsim_ros.contact.pairs import pair_factors
     from fastsim_ros.contact.tables import coefficient_table
 
     _check_material(args.nu)
@@ -364,6 +377,10 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
             c = exact.creep_coefficients(ar, nu=args.nu)
         elif args.method == "mae":
             c = mae_coefficients(mae_geometry(ar), coefficient_table(args.nu))
+        elif args.method == "mae_calibrated":
+            # full adhesion, about the area's origin (as every method here)
+            c = mae_calibrated_coefficients(ar, coefficient_table(args.nu),
+                                            pair_factors(args.nu))
         else:
             c = mae_fastsim_coefficients(ar, coefficient_table(args.nu))
         # MAE gives no C~3j: reported as null
@@ -414,9 +431,10 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
                             friction=law, speed=speed)
         result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
             np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
-    elif args.method == "mae":
-        from fastsim_ros.contact.compiled import MaeSolver
-        mae = MaeSolver(args.nu, args.shear_modulus)
+    elif args.method in ("mae", "mae_calibrated"):
+        from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
+        solver = CalibratedMaeSolver if args.method == "mae_calibrated" else MaeSolver
+        mae = solver(args.nu, args.shear_modulus)
         res = mae.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
         g = mae.geometry(patch)
         result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,

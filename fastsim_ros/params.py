@@ -17,8 +17,10 @@ from typing import Any
 
 import yaml
 
-#: the methods of the library the node offers (INTERFACE.md: ``method``)
-METHODS = ("mae", "fastsim_ellipse")
+#: the methods of the library the node offers (INTERFACE.md: ``method``): the paper's
+#: MAE, the calibrated MAE (the default since docs/validation_wider.md shows it better
+#: than the paper's on every validation area) and FastSim on the equivalent ellipse
+METHODS = ("mae", "mae_calibrated", "fastsim_ellipse")
 #: friction laws (:mod:`fastsim_ros.contact.friction`): Coulomb, and the falling
 #: mu(v) = mu_s ((1 - A) exp(-B v) + A) of the local slip velocity v
 FRICTION_LAWS = ("constant", "exponential")
@@ -104,9 +106,12 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_coefficient", "double", 0.3,
                   "friction coefficient mu (the static mu_s of a slip-dependent law)",
                   low=1.0e-3, high=5.0, dynamic=True),
-    ParameterSpec("method", "string", "mae",
-                  "tangential solver: mae (MAE + FastSim, Alonso & Gimenez 2007) or "
-                  "fastsim_ellipse (FastSim on the equivalent ellipse)",
+    ParameterSpec("method", "string", "mae_calibrated",
+                  "tangential solver: mae (the paper's MAE + FastSim, Alonso & Gimenez 2007), "
+                  "mae_calibrated (MAE with pair factors from the exact theory, flexibilities "
+                  "calibrated on the patch's cells and slip along the rigid slip, "
+                  "docs/validation_wider.md) or fastsim_ellipse (FastSim on the equivalent "
+                  "ellipse)",
                   choices=METHODS, dynamic=True),
     ParameterSpec("traction_bound", "string", "given",
                   "traction bound: given (mu p) or parabolic (mu N p^2 / sum(p^2 dA))",

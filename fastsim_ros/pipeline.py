@@ -28,7 +28,8 @@ from typing import Any
 import numpy as np
 
 from fastsim_ros import params as parameters
-from fastsim_ros.contact.compiled import ContactForces, EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
+                                          EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from msg_adapters import outputs as out
@@ -212,8 +213,10 @@ class Pipeline:
     def __init__(self, config: PipelineConfig) -> None:
         self.config = config
         nu, g = config["poisson_ratio"], config["shear_modulus"]
+        # one solver per method of parameters.METHODS (CalibratedMaeSolver is a MaeSolver)
         self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver] = {
-            "mae": MaeSolver(nu, g), "fastsim_ellipse": EquivalentEllipseSolver(nu, g)}
+            "mae": MaeSolver(nu, g), "mae_calibrated": CalibratedMaeSolver(nu, g),
+            "fastsim_ellipse": EquivalentEllipseSolver(nu, g)}
         self._wheel: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
         self._rail: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
         self._contacts = {name: _ContactState() for name in config.contacts}

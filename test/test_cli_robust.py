@@ -157,7 +157,7 @@ def test_coefficient_shapes_out_of_range(capsys, argv, match):
     assert_refused(*run(capsys, "coefficients", *argv), match)
 
 
-@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse", "exact"])
+@pytest.mark.parametrize("method", ["mae_calibrated", "mae", "fastsim_ellipse", "exact"])
 @pytest.mark.parametrize("extra", [["--xi", "100", "--eta", "-100", "--phi", "1e6"],
                                    ["--mu", "100"], ["--mu", "1e-6"],
                                    ["--load", "1e-2", "--a", "1", "--b", "1"]])
@@ -214,7 +214,9 @@ def test_a_bom_is_accepted(tmp_path, capsys):
 def test_bad_patch_files(tmp_path, capsys, content, match):
     path = tmp_path / "p.csv"
     path.write_bytes(content)
-    for command in (["coefficients", "--method", "mae"], ["forces", *CREEP]):
+    for command in (["coefficients", "--method", "mae"],
+                    ["coefficients", "--method", "mae_calibrated"], ["forces", *CREEP],
+                    ["forces", *CREEP, "--method", "mae"]):
         assert_refused(*run(capsys, *command, "--patch", path), match)
 
 
@@ -272,16 +274,21 @@ def test_grid_bound_of_the_library_is_checked_before_allocation(monkeypatch):
 def test_tiny_or_huge_coordinates(tmp_path, capsys, scale, match):
     path = write(tmp_path / "p.csv", ["x,y,pressure", *cell_rows(hertz(), scale)])
     for command in (["coefficients"], ["coefficients", "--method", "mae"],
-                    ["coefficients", "--method", "fastsim"], ["forces", *CREEP]):
+                    ["coefficients", "--method", "mae_calibrated"],
+                    ["coefficients", "--method", "fastsim"], ["forces", *CREEP],
+                    ["forces", *CREEP, "--method", "mae"]):
         assert_refused(*run(capsys, *command, "--patch", path), match)
 
 
-def test_scaled_patch_inside_the_limits_gives_the_scaled_answer(tmp_path, capsys):
+@pytest.mark.parametrize("method", ["mae", "mae_calibrated"])
+def test_scaled_patch_inside_the_limits_gives_the_scaled_answer(tmp_path, capsys, method):
     # lengths x 1e3 (metres read as millimetres): coefficients are scale-free
     a = write(tmp_path / "a.csv", ["x,y,pressure", *cell_rows(hertz())])
     b = write(tmp_path / "b.csv", ["x,y,pressure", *cell_rows(hertz(), 1e3)])
-    ca = assert_answered(*run(capsys, "coefficients", "--patch", a, "--method", "mae", "--json"))
-    cb = assert_answered(*run(capsys, "coefficients", "--patch", b, "--method", "mae", "--json"))
+    ca = assert_answered(*run(capsys, "coefficients", "--patch", a, "--method", method,
+                              "--json"))
+    cb = assert_answered(*run(capsys, "coefficients", "--patch", b, "--method", method,
+                              "--json"))
     for key in ("C11", "C22", "C23"):
         assert cb[key] == pytest.approx(ca[key], rel=1e-9)
 
@@ -298,7 +305,7 @@ def test_patch_pressures_out_of_range_are_named(tmp_path, capsys, pressures, mat
     assert_answered(*run(capsys, "forces", "--patch", path, *CREEP, "--load", "100", "--json"))
 
 
-@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse", "exact"])
+@pytest.mark.parametrize("method", ["mae_calibrated", "mae", "fastsim_ellipse", "exact"])
 @pytest.mark.parametrize("bound", ["given", "parabolic"])
 def test_one_cell_in_contact_gives_valid_json(tmp_path, capsys, method, bound):
     if method == "exact" and bound == "parabolic":
@@ -309,8 +316,9 @@ def test_one_cell_in_contact_gives_valid_json(tmp_path, capsys, method, bound):
                              "--bound", bound, "--json"))
     assert f["N"] == pytest.approx(1e3)
     assert math.hypot(f["Fx"], f["Fy"]) <= 0.3 * f["N"] * (1 + 1e-9)
-    c = assert_answered(*run(capsys, "coefficients", "--patch", path, "--method", "mae",
-                             "--json"))
+    coefficients = method if method in cli.COEFFICIENT_METHODS else "mae"
+    c = assert_answered(*run(capsys, "coefficients", "--patch", path, "--method",
+                             coefficients, "--json"))
     assert c["C11"] > 0.0
 
 
@@ -320,8 +328,8 @@ def test_one_cell_in_contact_gives_valid_json(tmp_path, capsys, method, bound):
 @pytest.mark.parametrize("bound", ["given", "parabolic"])
 def test_every_method_gives_the_same_keys(capsys, bound):
     keys = None
-    for method in ("mae", "fastsim_ellipse", "exact"):
-        if method == "exact" and bound == "parabolic":
+    for method in cli.FORCE_METHODS:
+        if method in ("exact", "fastrip") and bound == "parabolic":
             continue
         f = assert_answered(*run(capsys, "forces", "--patch", EXAMPLE, *CREEP, "--method",
                                  method, "--bound", bound, "--json"))
@@ -332,7 +340,8 @@ def test_every_method_gives_the_same_keys(capsys, bound):
         assert common == keys
 
 
-@pytest.mark.parametrize("method, solver", [("mae", "MaeSolver"),
+@pytest.mark.parametrize("method, solver", [("mae_calibrated", "CalibratedMaeSolver"),
+                                            ("mae", "MaeSolver"),
                                             ("fastsim_ellipse", "EquivalentEllipseSolver")])
 def test_forces_run_the_compiled_path(capsys, method, solver):
     from fastsim_ros.contact import compiled
@@ -342,6 +351,22 @@ def test_forces_run_the_compiled_path(capsys, method, solver):
                              "--json"))
     assert (f["Fx"], f["Fy"], f["Mz"]) == (ref.fx, ref.fy, ref.mz)
     assert f["slip_fraction"] == ref.slip_fraction
+
+
+def strip_patch(path):
+    """Write a strip 101 cells long and 2 wide: MAE zones of a/b about 50, beyond the tables."""
+    rows = [f"{(i - 50) * 1e-3!r},{(j - 0.5) * 1e-3!r},1e9" for j in range(2) for i in range(101)]
+    return write(path, ["x,y,pressure", *rows])
+
+
+@pytest.mark.parametrize("method", ["mae_calibrated", "mae"])
+def test_outside_the_tables_is_refused_in_one_line(tmp_path, capsys, method):
+    path = strip_patch(tmp_path / "strip.csv")
+    for command in (["forces", *CREEP], ["coefficients"]):
+        assert_refused(*run(capsys, *command, "--patch", path, "--method", method),
+                       "outside the tables' range")
+    assert_refused(*run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "500",
+                        "--method", method), "a/b = 500 lies outside the tables' range")
 
 
 def test_readable_table_never_prints_non_finite_numbers(capsys):

@@ -15,7 +15,7 @@ import pytest
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import samples
-from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
 from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
 from ros_messages import WHEEL_RADIUS as R
 from ros_messages import cloud_msg, in_plane_area, rolling_twist, twist_msg
@@ -35,8 +35,14 @@ def ellipse():
     return areas.ellipse(6e-3, 4e-3, nx=20, ny=20).with_load(5e4)
 
 
+#: the library's compiled solver of each method the node offers; the first is the default
+SOLVERS = {"mae_calibrated": CalibratedMaeSolver, "mae": MaeSolver,
+           "fastsim_ellipse": EquivalentEllipseSolver}
+DEFAULT_METHOD = "mae_calibrated"
+
+
 def library(method, area, xi, eta, phi, mu=0.3):
-    solver = MaeSolver(0.28, 8e10) if method == "mae" else EquivalentEllipseSolver(0.28, 8e10)
+    solver = SOLVERS[method](0.28, 8e10)
     a = in_plane_area(area)
     return solver.solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy, xi, eta, phi, mu)
 
@@ -85,15 +91,15 @@ def assert_library_equal(w, ref):
 
 
 @pytest.mark.parametrize("contacts", [("left",), ("left", "right"), ("a", "b", "c", "d")])
-def test_wrenches_equal_the_library_for_both_methods(run_node, contacts):
+def test_wrenches_equal_the_library_for_every_method(run_node, contacts):
     names = "[" + ", ".join(f'"{c}"' for c in contacts) + "]"
     _, client = run_node("-p", f"contacts:={names}", contacts=contacts)
     xi = 1.5e-3
     send_twist(client, rolling_twist(xi, stamp_ns=T0))
     shapes = [egg(), ellipse(), egg(6e-3).mirrored_y(), egg(1e-2)]
     stamp = T0 + MS
-    for method in ("mae", "fastsim_ellipse"):
-        if method != "mae":
+    for method in SOLVERS:  # the default first, then each set while running
+        if method != DEFAULT_METHOD:
             (result,) = client.set_parameters(method=method)
             assert result.successful, result.reason
         for k, c in enumerate(contacts):
@@ -107,7 +113,7 @@ def test_wrenches_equal_the_library_for_both_methods(run_node, contacts):
             assert_library_equal(got[0], library(method, shapes[k], xi, 0.0, 0.0))
     # one wheelset wrench per rig cycle: the sum once every contact had a new wrench
     client.spin(0.2)
-    assert len(client.wheelset) == 2
+    assert len(client.wheelset) == len(SOLVERS)
     assert client.wheelset[-1].header.frame_id == "wheelset"
     assert client.wheelset[-1].wrench.force.z == pytest.approx(
         sum(w[-1].wrench.force.z for w in client.wrenches.values()), rel=1e-12)
@@ -131,7 +137,8 @@ def test_roller_rig_config(run_node):
     assert len(got) == 1
     speed = (15.0 + 15.03) / 2
     xi = (15.03 - 15.0) / speed  # the roller's surface is faster: as a braked wheel
-    assert_library_equal(got[0], library("mae", ellipse(), xi, 0.0, 0.0))
+    # roller_rig.yaml's method: the calibrated MAE
+    assert_library_equal(got[0], library("mae_calibrated", ellipse(), xi, 0.0, 0.0))
     assert got[0].wrench.force.x < 0
     client.wait_for(lambda: client.diagnostic_values("wheel").get(
         "rejected/stale_kinematics") == "1", 3.0)
@@ -277,7 +284,7 @@ def test_sigterm_and_sigint_end_cleanly(tmp_path):
             client.close()
         assert proc.stop(sig) == 0
         out = proc.output()
-        assert "Traceback" not in out and "solving left, right with mae" in out
+        assert "Traceback" not in out and "solving left, right with mae_calibrated " in out
 
 
 @pytest.mark.parametrize("args, name", [

@@ -9,8 +9,8 @@ from rclpy.serialization import deserialize_message
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import samples
-from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver
-from fastsim_ros.params import ParameterError
+from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.params import METHODS, ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from ros_messages import WHEEL_RADIUS as R
 from ros_messages import cdr, cloud_msg, contact_normal, in_plane_area, rolling_twist, twist_msg
@@ -45,13 +45,27 @@ def solve(pipe, area, *, stamp=T0 + 10 * MS, contact="left", **cloud):
     return pipe.on_patch(contact, cdr(cloud_msg(area, stamp_ns=stamp, **cloud)))
 
 
+#: the library's compiled solver of each method the node offers
+SOLVERS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
+           "fastsim_ellipse": EquivalentEllipseSolver}
+DEFAULT_METHOD = "mae_calibrated"
+
+
+def solver_of(method):
+    return SOLVERS[method](0.28, 8e10)
+
+
 def library(method, area, xi, eta, phi, mu=0.3):
-    solver = MaeSolver(0.28, 8e10) if method == "mae" else EquivalentEllipseSolver(0.28, 8e10)
+    solver = solver_of(method)
     a = in_plane_area(area)
     return solver.solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy, xi, eta, phi, mu)
 
 
-@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse"])
+def test_every_method_is_offered():
+    assert set(METHODS) == set(SOLVERS)
+
+
+@pytest.mark.parametrize("method", METHODS)
 @pytest.mark.parametrize("xi", [2e-4, 3e-3])
 def test_wrench_equals_the_library(method, xi):
     pipe = make(method=method)
@@ -75,7 +89,7 @@ def test_spin_from_the_contact_angle_reaches_the_solver():
     phi = -(20.0 / R) * math.sin(gamma) / out.creepage.speed
     assert out.creepage.phi == pytest.approx(phi, rel=1e-9)
     c = out.creepage
-    ref = library("mae", egg(), c.xi, c.eta, c.phi)
+    ref = library(DEFAULT_METHOD, egg(), c.xi, c.eta, c.phi)
     assert out.forces.fx == pytest.approx(ref.fx, rel=1e-9)
     assert out.forces.fy == pytest.approx(ref.fy, rel=1e-9)
     assert abs(out.forces.fx) > 100.0  # spin alone gives Fx on this asymmetric area
@@ -88,7 +102,7 @@ def turned(area):
                           area.pressure[::-1, ::-1])
 
 
-@pytest.mark.parametrize("method", ["mae", "fastsim_ellipse"])
+@pytest.mark.parametrize("method", METHODS)
 def test_reverse_running_solves_the_turned_patch_and_opposes_the_slip(method):
     # backing up at 20 m/s, braked (|omega R| < |v0|), with spin from a contact angle
     v0, omega_r, gamma = -20.0, -19.96, 0.2
@@ -99,7 +113,7 @@ def test_reverse_running_solves_the_turned_patch_and_opposes_the_slip(method):
     assert c.speed < 0 and c.xi > 0
     # INTERFACE.md: solve on the turned cells with (xi, eta, -phi); report (-Fx', -Fy', Mz')
     a = in_plane_area(fore_aft_egg())
-    solver = MaeSolver(0.28, 8e10) if method == "mae" else EquivalentEllipseSolver(0.28, 8e10)
+    solver = solver_of(method)
     t = turned(a)
     ref = solver.solve_arrays(t.pressure, t.x0, t.y0, t.dx, t.dy, c.xi, c.eta, -c.phi, 0.3)
     assert out.forces.fx == pytest.approx(-ref.fx, rel=1e-9)
@@ -114,7 +128,7 @@ def test_reverse_running_solves_the_turned_patch_and_opposes_the_slip(method):
     fwd.on_wheel_twist(cdr(twist_msg((-v0, 0, 0), (0, -omega_r / R, 0), stamp_ns=T0)))
     forward = solve(fwd, fore_aft_egg(), normal=contact_normal(gamma, "left"))
     assert forward.forces.fx < 0
-    if method == "mae":  # the equivalent ellipse is symmetric whatever the patch
+    if method != "fastsim_ellipse":  # the equivalent ellipse is symmetric whatever the patch
         assert abs(forward.forces.fx + out.forces.fx) > 1e-3 * abs(out.forces.fx)
 
 
@@ -210,10 +224,11 @@ def test_patch_rejections_then_the_next_good_patch_is_served():
     assert solve(pipe, egg(), stamp=T0 + 30 * MS).status == "solved"
 
 
-def test_out_of_table_patch():
+@pytest.mark.parametrize("method", ["mae", "mae_calibrated"])
+def test_out_of_table_patch(method):
     # a strip 101 cells long and 2 wide: MAE zones of a/b about 50, beyond the tables' 20
     area = areas.GridArea(-50e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 101)) * 1e9)
-    pipe = make()
+    pipe = make(method=method)
     pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
     out = solve(pipe, area)
     assert out.status == "out_of_table"
@@ -291,6 +306,21 @@ def test_update_friction_and_method_while_running():
     pipe.update({"friction_coefficient": 0.4, "method": "fastsim_ellipse"})
     after = solve(pipe, egg(), stamp=T0 + 2 * MS).forces
     assert math.hypot(after.fx, after.fy) == pytest.approx(0.4 * after.n, rel=0.05)
+    # every method may be chosen while running: the wrench is then that method's, the
+    # diagnostics name it; the paper's MAE and the calibrated one differ here
+    xi = 2e-3
+    pipe.on_wheel_twist(cdr(rolling_twist(xi, stamp_ns=T0 + 3 * MS)))
+    fx = {}
+    for k, method in enumerate(("mae", "mae_calibrated", "fastsim_ellipse")):
+        pipe.update({"method": method})
+        got = solve(pipe, egg(), stamp=T0 + (4 + k) * MS)
+        ref = library(method, egg(), got.creepage.xi, got.creepage.eta, got.creepage.phi,
+                      mu=0.4)
+        assert got.forces.fx == pytest.approx(ref.fx, rel=1e-9)
+        assert got.forces.fy == pytest.approx(ref.fy, abs=1e-9 * ref.n)
+        assert dict(out_values(pipe))["method"] == method
+        fx[method] = got.forces.fx
+    assert abs(fx["mae_calibrated"] - fx["mae"]) > 1e-3 * abs(fx["mae"])
     with pytest.raises(ParameterError, match="start only"):
         pipe.update({"poisson_ratio": 0.3})
     with pytest.raises(ParameterError, match="friction_coefficient"):
@@ -306,7 +336,7 @@ def test_diagnostics_name_every_reason():
     assert names == ["fastsim: left", "fastsim: right"]  # one status per contact
     values = {kv.key: kv.value for kv in diag.status[0].values}
     assert values["rejected/no_kinematics"] == "1"
-    assert values["method"] == "mae" and values["friction_law"] == "constant"
+    assert values["method"] == DEFAULT_METHOD and values["friction_law"] == "constant"
     for key in ("solve_time_p50_us", "solve_time_p99_us", "input_rate_hz", "no_contact",
                 "rejected/too_large", "rejected/out_of_table", "rejected/standstill"):
         assert key in values
@@ -325,7 +355,7 @@ def test_falling_friction_reaches_the_solver_at_the_rolling_speed(speed):
     out = solve(pipe, egg())
     assert out.status == "solved" and out.creepage.speed * speed > 0.0
     a = in_plane_area(egg())
-    solver = MaeSolver(0.28, 8e10)
+    solver = solver_of(DEFAULT_METHOD)
     if speed > 0:
         ref = solver.solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy, out.creepage.xi,
                                   out.creepage.eta, out.creepage.phi,
