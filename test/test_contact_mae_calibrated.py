@@ -87,17 +87,48 @@ def test_rigid_slip_return_is_radial_with_equal_flexibilities():
     np.testing.assert_allclose([tx, ty], 8e4 * trial / np.hypot(*trial), rtol=1e-12)
 
 
-@pytest.mark.parametrize("l2_over_l1", [0.3, 1.7, 6.0])
-def test_rigid_slip_return_opposes_the_slip(l2_over_l1):
-    px, py, l1, g = -3e4, 6e4, 2e-11, 9e4
+def _converged_direction(px, py, wxh, wyh, l1, l2, g):
+    """Iterate ``e <- (U - g D e)/|...|`` to its fixed point: the exact rule's direction."""
+    u = np.array([l1 * px - wxh, l2 * py - wyh])
+    d = np.array([0.5 * (l1 - l2), -0.5 * (l1 - l2)])
+    e = u / np.hypot(*u)
+    for _ in range(200):
+        v = u - g * d * e
+        e = v / np.hypot(*v)
+    return e
+
+
+@pytest.mark.parametrize("l2_over_l1", [0.7, 0.9, 1.2, 1.4])
+def test_rigid_slip_return_is_near_the_converged_rule(l2_over_l1):
+    rng = np.random.default_rng(5)
+    g, l1 = 1.0, 1.0
     l2 = l1 * l2_over_l1
-    wxh, wyh = 1e-6, -2.5e-6
-    tx, ty, ok = rigid_slip_return(px, py, wxh, wyh, l1, l2, g)
-    assert ok and math.hypot(tx, ty) == pytest.approx(g, rel=1e-12)
-    # the slip over the step, s h = w h + L (tau - tau_p), is opposite to the traction
-    sx, sy = wxh + l1 * (tx - px), wyh + l2 * (ty - py)
-    assert sx * ty - sy * tx == pytest.approx(0.0, abs=1e-9 * math.hypot(sx, sy) * g)
-    assert sx * tx + sy * ty < 0.0
+    worst = 0.0
+    for _ in range(500):
+        px, py = 0.7 * rng.standard_normal(2)
+        wxh, wyh = rng.standard_normal(2) * rng.uniform(0.05, 3.0)
+        tx, ty, ok = rigid_slip_return(px, py, wxh, wyh, l1, l2, g)
+        if ok:
+            assert math.hypot(tx, ty) == pytest.approx(g, rel=1e-12)
+            e = _converged_direction(px, py, wxh, wyh, l1, l2, g)
+            worst = max(worst, math.hypot(tx - g * e[0], ty - g * e[1]))
+            # the converged direction is opposite to the slip s h = w h + L (tau - tau_p)
+            sx, sy = wxh + l1 * (g * e[0] - px), wyh + l2 * (g * e[1] - py)
+            assert sx * e[1] - sy * e[0] == pytest.approx(0.0, abs=1e-9 * math.hypot(sx, sy))
+            assert sx * e[0] + sy * e[1] < 0.0
+    # rules.rigid_slip_return's docstring: within 1.7% of g for L2/L1 in 0.7..1.4
+    assert worst <= 0.017 * g
+
+
+@pytest.mark.parametrize("l2_over_l1", [0.3, 1.7, 6.0])
+def test_rigid_slip_return_in_full_sliding_opposes_the_rigid_slip(l2_over_l1):
+    # |w h| >> L g: the traction is opposite to the rigid slip, whatever the flexibilities, up
+    # to the elastic part L tau_p of the slip (here 5e-5 of w h)
+    l1, g = 2e-11, 9e4
+    w = np.array([1e-2, -2.5e-2])
+    tx, ty, ok = rigid_slip_return(-3e4, 6e4, *w, l1, l1 * l2_over_l1, g)
+    assert ok
+    np.testing.assert_allclose([tx, ty], -g * w / np.hypot(*w), rtol=0.0, atol=2e-4 * g)
 
 
 def test_rigid_slip_return_declines_inside_the_bound():

@@ -81,6 +81,8 @@ _NO_SLIP = 1.0 - 1e-12
 # within this relative distance of the bound the slip test uses hypot, as the
 # reference does, so that the slip flags agree even on the bound
 _ON_BOUND = 1e-12
+# |tau|^2 > (1 + 1e-9) g^2 proves |tau| > g: the slip test needs no square root there
+_CLEARLY_OVER = 1.0 + 1e-9
 
 
 # ---------------------------------------------------------------- input checks
@@ -392,9 +394,13 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
             m2 = t_x * t_x + t_y * t_y
             if law == LAW_CONSTANT:
                 if not m2 <= _NO_SLIP * g * g:
-                    mag = math.sqrt(m2)
-                    if abs(mag - g) <= _ON_BOUND * g:
-                        mag = math.hypot(t_x, t_y)
+                    # clearly over the bound: the rigid-slip return needs no |t*|
+                    if rigid and m2 > _CLEARLY_OVER * g * g:
+                        mag = g + g
+                    else:
+                        mag = math.sqrt(m2)
+                        if abs(mag - g) <= _ON_BOUND * g:
+                            mag = math.hypot(t_x, t_y)
                     if mag > g:
                         done = False
                         if rigid:
@@ -405,6 +411,9 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                                 t_x = r_x
                                 t_y = r_y
                         if not done:
+                            if rigid:
+                                # the return declined: the radial return, with the true |t*|
+                                mag = math.sqrt(m2)
                             scale = g / mag
                             t_x = t_x * scale
                             t_y = t_y * scale
@@ -632,6 +641,15 @@ def ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy):
 
 @njit(cache=True, error_model="numpy")
 def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
+    """MAE steps 1-3 and 6 (:func:`mae_prepare_strips` without its strips' output)."""
+    strips = np.empty((3, p.shape[0]), dtype=np.int64)
+    return mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
+                              strips)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
+                       strips):
     """MAE steps 1-3 and 6: validate, split, size the zones, look up, give ``L1 .. L4``.
 
     Writes ``geo`` (length :data:`GEO_SIZE`): centroid ``x_c, y_c``, split
@@ -639,17 +657,16 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
     dA`` (N), contact area (m^2), then each zone's ``area, a, b, a/b, a_eq,
     b_eq``, each zone's ``L1, L2, L3, L4`` (m/Pa; ``nan`` for an empty
     zone) and the patch's equivalent ellipse ``x_c, y_c, a, b`` (m); and the
-    column envelopes ``env`` ``(2, nx)``.  Return ``(status, info)``;
-    ``info`` is the offending ``a/b`` of a zone outside the table (the
-    geometry is complete then, the flexibilities are not).
+    column envelopes ``env`` ``(2, nx)``; ``strips`` ``(3, ny)``: each
+    strip's cells in contact, first and last of them (:func:`scan_patch`).
+    Return ``(status, info)``; ``info`` is the offending ``a/b`` of a zone
+    outside the table (the geometry is complete then, the flexibilities are
+    not).
     """
     status = check_grid(x0, y0, dx, dy)
     if status != OK:
         return status, 0.0
-    ny = p.shape[0]
-    count = np.empty(ny, dtype=np.int64)
-    first = np.empty(ny, dtype=np.int64)
-    last = np.empty(ny, dtype=np.int64)
+    count, first, last = strips[0], strips[1], strips[2]
     status, n, si, sj, sii, sjj, total = scan_patch(p, count, first, last, env)
     if status != OK:
         return status, 0.0
@@ -696,7 +713,7 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
 
 
 @njit(cache=True, error_model="numpy")
-def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_knots,
+def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_knots,
               pair_values):
     """Overwrite ``geo``'s ``L1 .. L4`` with the calibrated MAE's (after :func:`mae_prepare`).
 
@@ -711,102 +728,122 @@ def calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_kno
     front face, ``s3``: the sum of ``(x_mid - x_c) h``), so that FastSim in
     full adhesion gives those coefficients on these cells; ``c23`` with the
     zone's strip offsets (the reference's ``offset_c23``).  Where ``D3 <= 0``
-    the paper's ``L3`` (with the method's ``c23``) is kept.
+    the paper's ``L3`` (with the method's ``c23``) is kept.  ``strips``: as
+    :func:`mae_prepare_strips` leaves it.  A strip of one segment is summed
+    in closed form (the midpoint sums of a linear integrand are exact: a
+    cell ``m`` cells behind the front face has ``d = (m + 1/2) dx`` and
+    ``s3 = ((x_lead - x_c)^2 - (x - x_c)^2)/2``); a strip of several, cell by
+    cell as the sweep marches it.
     """
-    ny, nx = p.shape
+    ny = p.shape[0]
     x_c = geo[G_XC]
     y_s = geo[G_YS]
     f = int(geo[G_FACE])
     half = 0.5 * dx
-    # per strip: d and s3 of its current segment; per zone: D1, D3, D4
-    cd = np.zeros(ny)
-    cs = np.zeros(ny)
-    cont = np.full(ny, -2, dtype=np.int64)
-    sums = np.zeros((2, 3))
-    # each strip's leading (first seen) and trailing contact column
-    lead = np.full(ny, -1, dtype=np.int64)
-    trail = np.full(ny, -1, dtype=np.int64)
-    for i in range(nx - 1, -1, -1):
-        x_rel = x0 + dx * i - x_c
-        for j in range(env[0, i], env[1, i]):
-            if not p[j, i] > 0.0:
-                continue
-            if lead[j] < 0:
-                lead[j] = i
-            trail[j] = i
-            if cont[j] == i:
-                s = dx
-            else:
-                s = half
-                cd[j] = 0.0
-                cs[j] = 0.0
-            cont[j] = i - 1
-            cd[j] += s
-            cs[j] += (x_rel + 0.5 * s) * s
-            z = 0 if j < f else 1
-            sums[z, 0] += cd[j]
-            sums[z, 1] += cs[j]
-            sums[z, 2] += (y0 + dy * j - y_s) * cd[j]
-    da = dx * dy
-    # rule 4: each zone's mean strip centre, every strip counted once
-    centre = np.zeros(2)
-    strips = np.zeros(2)
+    # per zone: D1, D3 and D4 sums (before dA); rule 4: strip centres and strips
+    d1_1 = d3_1 = d4_1 = cen_1 = 0.0
+    d1_2 = d3_2 = d4_2 = cen_2 = 0.0
+    n_1 = n_2 = 0
     for j in range(ny):
-        if lead[j] >= 0:
-            z = 0 if j < f else 1
-            centre[z] += x0 + dx * 0.5 * (lead[j] + trail[j])
-            strips[z] += 1.0
-    # each zone's lone half-ellipse c11, c22, c23, c13 and pair factors (1 if alone)
-    lone = np.empty((2, 4))
-    kf = np.ones((2, 4))
-    both = geo[G_ZONE1] > 0.0 and geo[G_ZONE2] > 0.0
-    for z in range(2):
-        zone = G_ZONE1 if z == 0 else G_ZONE2
-        if geo[zone] <= 0.0:
+        n = strips[0, j]
+        if n == 0:
             continue
-        t = math.log(geo[zone + 3])
-        lone[z, 0] = spline(knots, polys[I_H11], t)
-        lone[z, 1] = spline(knots, polys[I_H22], t)
-        lone[z, 2] = spline(knots, polys[I_H23], t)
-        lone[z, 3] = spline(knots, polys[I_H13], t)
-        if both:
-            t_other = math.log(geo[(G_ZONE2 if z == 0 else G_ZONE1) + 3])
-            for q in range(4):
-                kf[z, q] = pair_factor(pair_knots, pair_values[q], t, t_other)
+        i_first = strips[1, j]
+        i_last = strips[2, j]
+        y_rel = y0 + dy * j - y_s
+        if i_last - i_first + 1 == n:
+            # one segment: m = 0 .. n-1 cells behind the front face x_last + dx/2
+            x_lead = x0 + dx * i_last + half - x_c
+            a = x0 + dx * i_last - x_c
+            sum_d = 0.5 * dx * n * n
+            sum_x2 = n * a * a - a * dx * n * (n - 1) + dx * dx * (n - 1) * n * (2 * n - 1) / 6.0
+            sum_s3 = 0.5 * (n * x_lead * x_lead - sum_x2)
+        else:
+            sum_d = 0.0
+            sum_s3 = 0.0
+            cd = 0.0
+            cs = 0.0
+            inside = False
+            for i in range(i_last, i_first - 1, -1):
+                if not p[j, i] > 0.0:
+                    inside = False
+                    continue
+                s = dx if inside else half
+                if not inside:
+                    cd = 0.0
+                    cs = 0.0
+                inside = True
+                cd += s
+                cs += (x0 + dx * i - x_c + 0.5 * s) * s
+                sum_d += cd
+                sum_s3 += cs
+        centre = x0 + dx * 0.5 * (i_first + i_last)
+        if j < f:
+            d1_1 += sum_d
+            d3_1 += sum_s3
+            d4_1 += y_rel * sum_d
+            cen_1 += centre
+            n_1 += 1
+        else:
+            d1_2 += sum_d
+            d3_2 += sum_s3
+            d4_2 += y_rel * sum_d
+            cen_2 += centre
+            n_2 += 1
+    da = dx * dy
+    both = geo[G_ZONE1] > 0.0 and geo[G_ZONE2] > 0.0
+    t1 = math.log(geo[G_ZONE1 + 3]) if geo[G_ZONE1] > 0.0 else 0.0
+    t2 = math.log(geo[G_ZONE2 + 3]) if geo[G_ZONE2] > 0.0 else 0.0
     # the pair's coefficient shared in the lone halves' proportion (c13: each zone's own)
-    share = np.ones(3)
+    s11 = s22 = s23 = 1.0
+    k13_1 = k13_2 = 1.0
     if both:
-        total = geo[G_AREA]
-        w1 = 2.0 * geo[G_ZONE1] / total
-        w2 = 2.0 * geo[G_ZONE2] / total
-        for q in range(3):
-            pw = 1.5 if q == 2 else 1.0
-            alone = w1**pw * lone[0, q] + w2**pw * lone[1, q]
-            joined = w1**pw * lone[0, q] * kf[0, q] + w2**pw * lone[1, q] * kf[1, q]
-            share[q] = joined / alone
+        w1 = 2.0 * geo[G_ZONE1] / geo[G_AREA]
+        w2 = 2.0 * geo[G_ZONE2] / geo[G_AREA]
+        v1 = w1**1.5
+        v2 = w2**1.5
+        a11 = spline(knots, polys[I_H11], t1)
+        b11 = spline(knots, polys[I_H11], t2)
+        a22 = spline(knots, polys[I_H22], t1)
+        b22 = spline(knots, polys[I_H22], t2)
+        a23 = spline(knots, polys[I_H23], t1)
+        b23 = spline(knots, polys[I_H23], t2)
+        s11 = ((w1 * a11 * pair_factor(pair_knots, pair_values[0], t1, t2)
+                + w2 * b11 * pair_factor(pair_knots, pair_values[0], t2, t1))
+               / (w1 * a11 + w2 * b11))
+        s22 = ((w1 * a22 * pair_factor(pair_knots, pair_values[1], t1, t2)
+                + w2 * b22 * pair_factor(pair_knots, pair_values[1], t2, t1))
+               / (w1 * a22 + w2 * b22))
+        s23 = ((v1 * a23 * pair_factor(pair_knots, pair_values[2], t1, t2)
+                + v2 * b23 * pair_factor(pair_knots, pair_values[2], t2, t1))
+               / (v1 * a23 + v2 * b23))
+        k13_1 = pair_factor(pair_knots, pair_values[3], t1, t2)
+        k13_2 = pair_factor(pair_knots, pair_values[3], t2, t1)
     for z in range(2):
         zone = G_ZONE1 if z == 0 else G_ZONE2
         base = G_FLEX1 if z == 0 else G_FLEX2
         if geo[zone] <= 0.0:
             continue
-        c11 = lone[z, 0] * share[0]
-        c22 = lone[z, 1] * share[1]
-        c13 = lone[z, 3] * kf[z, 3]
+        t = t1 if z == 0 else t2
+        c11 = spline(knots, polys[I_H11], t) * s11
+        c22 = spline(knots, polys[I_H22], t) * s22
+        lone23 = spline(knots, polys[I_H23], t)
+        c13 = spline(knots, polys[I_H13], t) * (k13_1 if z == 0 else k13_2)
         ab = 2.0 * geo[zone] / math.pi
         # rule 4 (the reference's offset_c23): the strips' offsets from x_c
-        c23 = lone[z, 2] * share[2]
-        x_eta = centre[z] / strips[z]
+        c23 = lone23 * s23
+        x_eta = cen_1 / n_1 if z == 0 else cen_2 / n_2
         c23 = max(c23 + c22 * (x_eta - x_c) / math.sqrt(ab), MIN_OFFSET_C23_SHARE * c23)
         g = shear_modulus
-        d1 = sums[z, 0] * da
-        d3 = sums[z, 1] * da
-        d4 = abs(sums[z, 2]) * da
+        d1 = (d1_1 if z == 0 else d1_2) * da
+        d3 = (d3_1 if z == 0 else d3_2) * da
+        d4 = abs(d4_1 if z == 0 else d4_2) * da
         geo[base] = d1 / (g * ab * c11)
         geo[base + 1] = d1 / (g * ab * c22)
         if d3 > 0.0:
             geo[base + 2] = d3 / (g * ab**1.5 * c23)
         else:
-            geo[base + 2] = geo[base + 2] * lone[z, 2] / c23
+            geo[base + 2] = geo[base + 2] * lone23 / c23
         geo[base + 3] = d4 / (g * ab**1.5 * c13) if c13 > 0.0 else math.inf
 
 
@@ -1012,11 +1049,13 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     ny, nx = p.shape
     geo = np.empty(GEO_SIZE)
     env = np.empty((2, nx), dtype=np.int64)
-    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env)
+    strips = np.empty((3, ny), dtype=np.int64)
+    status, info = mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo,
+                                      env, strips)
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
     if calibrated:
-        calibrate(p, x0, y0, dx, dy, env, geo, shear_modulus, knots, polys, pair_knots,
+        calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_knots,
                   pair_values)
     # the given bound is mu p, applied in the sweep: no array for it
     bound = np.empty((ny, nx) if parabolic else (0, 0))
@@ -1098,6 +1137,7 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
     ny, nx = ps.shape[1], ps.shape[2]
     geo = np.empty(GEO_SIZE)
     env = np.empty((2, nx), dtype=np.int64)
+    strips = np.empty((3, ny), dtype=np.int64)
     bound = np.empty((ny, nx))
     flex = np.empty((4, ny))
     empty_f = np.empty((0, 0))
@@ -1112,12 +1152,12 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
         p = ps[pb]
         same = _same_patch(b, pb, prev_pb, x0, y0, dx, dy)
         if not same:
-            status, info = mae_prepare(p, x0[b], y0[b], dx[b], dy[b], rule, shear_modulus,
-                                       knots, polys, geo, env)
+            status, info = mae_prepare_strips(p, x0[b], y0[b], dx[b], dy[b], rule,
+                                              shear_modulus, knots, polys, geo, env, strips)
             if status != OK:
                 return status, b, info
             if calibrated:
-                calibrate(p, x0[b], y0[b], dx[b], dy[b], env, geo, shear_modulus, knots,
+                calibrate(p, x0[b], y0[b], dx[b], dy[b], strips, geo, shear_modulus, knots,
                           polys, pair_knots, pair_values)
             mae_strip_flexibility(geo, flex)
         if parabolic and not (same and mu[b] == mu[b - 1]):
