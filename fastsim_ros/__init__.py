@@ -2,8 +2,9 @@
 
 Importing the package points numba's on-disk cache of the compiled kernels
 at a writable place shared by every run of the same installed files
-(``$NUMBA_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/fastsim_ros/numba/<digest
-of the kernel sources>``, ``~/.cache`` by default): numba's own default, ``__pycache__`` beside the
+(``$NUMBA_CACHE_DIR`` if the user set it, else ``$XDG_CACHE_HOME/fastsim_ros/numba/<digest
+of the kernel sources>``, ``~/.cache`` by default, chosen again by every process
+for the files it imports): numba's own default, ``__pycache__`` beside the
 source, is not writable in a read-only install tree, and a node that
 compiles its kernels at start takes about 18 s to reach its first wrench.
 numba keys each entry on the source file's path and time stamp, so the
@@ -47,9 +48,17 @@ def _sources_digest() -> str:
     return digest.hexdigest()[:16]
 
 
-if "NUMBA_CACHE_DIR" not in os.environ:
+#: the directory an import of this package chose, exported with it: a child process
+#: (the installed node started by a test) inherits ``NUMBA_CACHE_DIR`` and would
+#: otherwise cache its own tree's kernels under its parent's digest (a checkout's
+#: parent starting the installed node: a cold compile whenever the checkout's kernel
+#: sources differ from the install's); a directory the user set is kept
+_CHOSEN = "FASTSIM_ROS_NUMBA_CACHE_DIR"
+
+if "NUMBA_CACHE_DIR" not in os.environ or (
+        os.environ["NUMBA_CACHE_DIR"] == os.environ.get(_CHOSEN)):
     _cache = _numba_cache_dir()
     if _cache:
         _cache = os.path.join(_cache, _sources_digest())
         os.makedirs(_cache, exist_ok=True)
-        os.environ["NUMBA_CACHE_DIR"] = _cache
+        os.environ["NUMBA_CACHE_DIR"] = os.environ[_CHOSEN] = _cache

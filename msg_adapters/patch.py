@@ -284,11 +284,18 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
 
 
 def warm_up() -> None:
-    """Compile (or load from numba's disk cache) the adapter's loops for both float widths."""
+    """Compile (or load from numba's disk cache) the adapter's loops for both float widths.
+
+    Each width read-only too: the usual layout's words are a view of the
+    message's buffer (read-only, its own numba specialisation), a copy
+    (another byte order, gathered fields) is writeable.
+    """
     for width in (np.float32, np.float64):
-        words = np.zeros(4 * 7, dtype=width)
-        kernels.scan_points(words, 2, 2, 14, 7, _PLAIN_COLUMNS, np.empty((2, 2)),
-                            np.empty((2, 2, 3)))
+        for writeable in (False, True):
+            words = np.zeros(4 * 7, dtype=width)
+            words.setflags(write=writeable)
+            kernels.scan_points(words, 2, 2, 14, 7, _PLAIN_COLUMNS, np.empty((2, 2)),
+                                np.empty((2, 2, 3)))
     kernels.fit_grid(np.zeros((2, 2, 3)), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
 
 

@@ -287,6 +287,36 @@ def test_sigterm_and_sigint_end_cleanly(tmp_path):
         assert "Traceback" not in out and "solving left, right with mae_calibrated " in out
 
 
+def test_the_installed_node_keeps_its_own_kernel_cache(tmp_path):
+    """A node started from this (checkout) process caches the installed kernels in its own place.
+
+    Importing ``fastsim_ros`` here exported this tree's NUMBA_CACHE_DIR; a child
+    importing the install tree must choose its own (keyed on its own kernel
+    sources), not compile the installed kernels afresh under the checkout's
+    digest whenever the checkout's sources differ; a directory the user set
+    is kept.
+    """
+    import os
+    import sys
+
+    import fastsim_ros  # noqa: F401  (this process has chosen its directory)
+    probe = [sys.executable, "-c", "import os, fastsim_ros; "
+             "print(fastsim_ros.__file__); print(os.environ['NUMBA_CACHE_DIR'])"]
+    own = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "FASTSIM_ROS_NUMBA_CACHE_DIR")}
+
+    def child(env):
+        done = subprocess.run(probe, env=env, cwd="/", capture_output=True, text=True,
+                              timeout=60, check=True)
+        return done.stdout.split()
+
+    alone = child(own)
+    assert alone[0].startswith(str(PACKAGE_ROOT / "install"))  # the installed package
+    assert child(dict(os.environ)) == alone
+    chosen = str(tmp_path / "mine")
+    assert child(dict(own, NUMBA_CACHE_DIR=chosen))[1] == chosen
+
+
 @pytest.mark.parametrize("args, name", [
     (["-p", "friction_coefficient:=-1.0"], "friction_coefficient"),
     (["-p", "method:=exact_please"], "method"),

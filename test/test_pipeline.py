@@ -384,3 +384,52 @@ def test_falling_friction_reaches_the_solver_at_the_rolling_speed(speed):
 def out_values(pipe):
     status = pipe.diagnostics(T0 + 30 * MS)
     return [(kv.key, kv.value) for kv in status.status[0].values]
+
+
+WARM_PATH_PROBE = """
+import numba
+from fastsim_ros.contact import compiled, kernels, samples
+from fastsim_ros.params import METHODS
+from fastsim_ros.pipeline import Pipeline, PipelineConfig
+from msg_adapters import patch, patch_kernels
+from ros_messages import cdr, cloud_msg, rolling_twist
+
+compiled.warm_up()
+patch.warm_up()
+
+
+def signatures():
+    return {(mod.__name__, name): len(f.signatures) for mod in (kernels, patch_kernels)
+            for name, f in vars(mod).items() if isinstance(f, numba.core.registry.CPUDispatcher)}
+
+
+before = signatures()
+area = samples.semi_ellipses_patch(0.5, 2.0, cells=12, scale=8e-3, load=6e4)
+for method in METHODS:
+    for traction in (False, True):
+        pipe = Pipeline(PipelineConfig.from_values({"contacts": ["left"], "method": method,
+                                                    "publish_traction": traction}))
+        pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=0)))
+        for k, dtype in enumerate(("<f4", "<f8", ">f8")):
+            out = pipe.on_patch("left", cdr(cloud_msg(area, stamp_ns=k + 1, dtype=dtype)))
+            assert out.status == "solved", out.status
+print(sorted(key for key, n in signatures().items() if n != before.get(key)))
+"""
+
+
+def test_the_warm_ups_cover_the_hot_path():
+    # numba compiles one specialisation per argument type: after the warm-ups the
+    # node runs at start, its per-patch path (every method, both float widths, a
+    # buffer view or a copy, with or without tractions) compiles nothing more, so
+    # a node on a fresh cache never compiles at its first patch (seconds under load)
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+    here = Path(__file__).resolve().parent
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+        [str(here.parent), str(here), os.environ.get("PYTHONPATH", "")]))
+    done = subprocess.run([sys.executable, "-c", WARM_PATH_PROBE], cwd=here.parent, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split("\n")[-2] == "[]", done.stdout
