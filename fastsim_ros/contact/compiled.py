@@ -373,8 +373,10 @@ class CalibratedMaeSolver(MaeSolver):
         super().__init__(nu, shear_modulus, rule=rule)
         pairs = pair_factors(self.nu)  # refuses nu outside the pair factors' range
         self._calibrated = True
+        # private, writeable copies (the pair factors are read-only): the kernels' argument
+        # types are then the paper's MAE's, one compiled specialisation for both
         self._pair_knots = np.array(pairs.knots, dtype=np.float64)
-        self._pair_values = np.ascontiguousarray(pairs.values, dtype=np.float64)
+        self._pair_values = np.array(pairs.values, dtype=np.float64, order="C")
 
 
 class EquivalentEllipseSolver(_Solver):
