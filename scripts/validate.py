@@ -322,9 +322,9 @@ def _report_more(add: Callable[[str], None]) -> None:
     add("\n## More reports\n")
     add("- `validation_friction.md`: slip-dependent friction (the falling law) against the exact\n"
         "  theory, written by hand from what `scripts/validate_friction.py` prints and saves.")
-    add("- `validation_wider.md`: exact, the calibrated MAE (the second MAE method, the default),\n"
-        "  the paper's MAE, FaStrip and the equivalent ellipse on fifteen areas, written by\n"
-        "  `scripts/validate_wider.py`.")
+    add("- `validation_wider.md`: exact, the calibrated MAE (the second MAE method, the"
+        " default),\n  the paper's MAE, FaStrip and the equivalent ellipse on fifteen areas,"
+        " written by\n  `scripts/validate_wider.py`.")
 
 
 def _report_summary(add: Callable[[str], None]) -> None:
