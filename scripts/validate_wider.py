@@ -257,6 +257,31 @@ def selection_on(ar: areas.GridArea) -> dict[str, Any]:
     return entry
 
 
+#: the grids of the coefficient grid check (the calibrated MAE's C~11, C~22, C~23 where missed)
+COEF_CHECK_GRIDS = (40, 60, 100, 160)
+
+
+def coefficient_grid_check(names: list[str]) -> dict[str, Any]:
+    """Return the calibrated MAE's coefficients of the named areas on COEF_CHECK_GRIDS cells.
+
+    A normal-solver patch is solved again on each grid (its contact area changes with the
+    grid), an analytic shape is the same shape on a finer staircase.
+    """
+    t = coefficient_table(NU)
+    pairs = pair_factors(NU)
+    unit = area_makers(False)
+    out: dict[str, Any] = {}
+    for name in names:
+        rows = {}
+        for n in COEF_CHECK_GRIDS:
+            ar = unit[name](n)
+            c = mae_calibrated_coefficients(ar, t, pairs)
+            rows[str(n)] = {"strips": int(np.count_nonzero(ar.mask.any(axis=1))),
+                            **{k: getattr(c, k) for k in ("C11", "C22", "C23")}}
+        out[name] = rows
+    return out
+
+
 def cost_ratio(calls: int = 3000) -> dict[str, Any]:
     """Time the calibrated and the paper's MAE side by side on 30x30 patches (TARGETS.md).
 
@@ -536,6 +561,12 @@ def report(res: dict[str, Any]) -> None:
     (DOCS / "validation_wider.md").write_text("\n".join(lines) + "\n")
 
 
+def _coefficient_misses(d: dict[str, Any]) -> list[str]:
+    """Return the areas where the calibrated MAE's C~11, C~22 or C~23 is over 5% off exact."""
+    return sorted(n for n in d if any(abs(_coef_dev(d[n], "mae_calibrated", k)) > 0.05
+                                      for k in ("C11", "C22", "C23")))
+
+
 def _coef_dev(e: dict[str, Any], m: str, key: str) -> float:
     co = e["coefficients"]
     return float(co[m][key] / co["exact"][key] - 1)
@@ -609,6 +640,23 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
         + ("met" if ratios and max(ratios.values()) <= 1.5 else "missed") + " |\n")
     if coef_miss:
         add("Where the coefficient target is missed: " + _coef_miss_why(d, coef_miss) + "\n")
+        check = res.get("coefficient_grid_check") or {}
+        if check:
+            add("The calibrated MAE's coefficients of these areas on other grids (deviation from"
+                " the exact extrapolation, %; strips in contact in brackets):\n")
+            add("| area | " + " | ".join(f"{n} cells" for n in COEF_CHECK_GRIDS) + " |")
+            add("| --- | " + " | ".join("---" for _ in COEF_CHECK_GRIDS) + " |")
+            for name, rows in check.items():
+                ex = d[name]["coefficients"]["exact"]
+                add(f"| {name} | " + " | ".join(
+                    ", ".join(f"{k} {100 * (rows[str(n)][k] / ex[k] - 1):+.1f}"
+                              for k in ("C11", "C22", "C23")) + f" ({rows[str(n)]['strips']})"
+                    for n in COEF_CHECK_GRIDS) + " |")
+            add("\nOn an analytic shape the method's coefficients do not move with the grid"
+                " (rule 2 makes them the zones' own); a normal-solver patch is solved anew on each"
+                " grid, and with it its contact area, so its coefficients move by a few % from"
+                " grid to grid: where that spread straddles the target, the miss on "
+                f"{ONLINE_CELLS} cells is not resolved.\n")
     better = [n for n in d if (worst_error(d[n], m)[0] or 0.0) < (worst_error(d[n], "mae")[0]
                                                                   or 0.0)]
     add(f"**Default.** The calibrated MAE's worst curve error is smaller than the paper's MAE's"
@@ -807,6 +855,10 @@ def main() -> int:
             warm_up()
             res["cost_ratio"] = cost_ratio()
             DATA.write_text(json.dumps(res, indent=1))
+    missed = _coefficient_misses(res["areas"])
+    if sorted(res.get("coefficient_grid_check") or {}) != missed:
+        res["coefficient_grid_check"] = coefficient_grid_check(missed)
+        DATA.write_text(json.dumps(res, indent=1))
     else:
         res = compute()
         DATA.parent.mkdir(parents=True, exist_ok=True)
