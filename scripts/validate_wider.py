@@ -854,15 +854,14 @@ def main() -> int:
         if "cost_ratio" not in res:
             warm_up()
             res["cost_ratio"] = cost_ratio()
-            DATA.write_text(json.dumps(res, indent=1))
+    else:
+        res = compute()
+    # the grid check of the coefficients the target misses (cheap: the method's only)
     missed = _coefficient_misses(res["areas"])
     if sorted(res.get("coefficient_grid_check") or {}) != missed:
         res["coefficient_grid_check"] = coefficient_grid_check(missed)
-        DATA.write_text(json.dumps(res, indent=1))
-    else:
-        res = compute()
-        DATA.parent.mkdir(parents=True, exist_ok=True)
-        DATA.write_text(json.dumps(res, indent=1))
+    DATA.parent.mkdir(parents=True, exist_ok=True)
+    DATA.write_text(json.dumps(res, indent=1))
     report(res)
     return 0
 
