@@ -18,7 +18,7 @@ areas (pairs of semi-ellipses other than the validation's and two
 notches: neither validation areas nor the pair-factor table's own) on which the calibrated MAE's
 pair-factor rule was chosen, with the alternatives.
 
-Usage: ``python scripts/validate_wider.py [--report-only]``.  About 8 minutes
+Usage: ``python scripts/validate_wider.py [--report-only]``.  About 6 minutes
 on 2 cores (the exact Coulomb solves dominate).
 """
 
