@@ -245,7 +245,12 @@ def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
         values = client.diagnostic_values("left")
         return values and values["no_contact"] == "1" and all(
             values[f"rejected/{r}"] == str(n) for r, n in expected.items())
-    assert client.wait_for(counted, 4.0), client.diagnostic_values("left")
+    if not client.wait_for(counted, 4.0):
+        values = client.diagnostic_values("left") or {}
+        wrong = {r: (n, values.get(f"rejected/{r}")) for r, n in expected.items()
+                 if values.get(f"rejected/{r}") != str(n)}
+        pytest.fail(f"rejection counts (expected, seen) differ: {wrong}; no_contact"
+                    f" {values.get('no_contact')}; all: {values}")
     values = client.diagnostic_values("left")
     assert values["solved"] == str(len(bad_inputs()))
 
