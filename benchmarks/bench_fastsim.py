@@ -120,9 +120,11 @@ def per_call(fns: dict[str, Callable[[], Any]], calls: int,
 def _loop_prepare(reps, p, x0, y0, dx, dy, shear_modulus, knots, polys):
     geo = np.empty(kernels.GEO_SIZE)
     env = np.empty((2, p.shape[1]), dtype=np.int64)
+    strips = np.empty((3, p.shape[0]), dtype=np.int64)
     for _ in range(reps):
         kernels.mae_prepare(p, x0, y0, dx, dy, kernels.RULE_WIDEST_STRIP, shear_modulus,
-                            knots, polys, geo, env)
+                            knots, polys, geo, env, strips, False, np.zeros(2),
+                            np.ones((4, 2, 2)))
     return geo[0]
 
 

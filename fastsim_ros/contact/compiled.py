@@ -329,13 +329,10 @@ class MaeSolver(_Solver):
         env = np.empty((2, area.nx), dtype=np.int64)
         strips = np.empty((3, area.ny), dtype=np.int64)
         p = _readonly(area.pressure)
-        status, info = k.mae_prepare_strips(p, float(area.x0), float(area.y0), float(area.dx),
-                                            float(area.dy), self._rule, self.shear_modulus,
-                                            self._knots, self._polys, geo, env, strips)
-        if status == k.OK and self._calibrated:
-            k.calibrate(p, float(area.x0), float(area.y0), float(area.dx), float(area.dy),
-                        strips, geo, self.shear_modulus, self._knots, self._polys,
-                        self._pair_knots, self._pair_values)
+        status, info = k.mae_prepare(p, float(area.x0), float(area.y0), float(area.dx),
+                                     float(area.dy), self._rule, self.shear_modulus,
+                                     self._knots, self._polys, geo, env, strips,
+                                     self._calibrated, self._pair_knots, self._pair_values)
         return status, info, geo
 
     def geometry(self, area: GridArea) -> MaeGeometry:

@@ -640,16 +640,8 @@ def ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy):
 
 
 @njit(cache=True, error_model="numpy")
-def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env):
-    """MAE steps 1-3 and 6 (:func:`mae_prepare_strips` without its strips' output)."""
-    strips = np.empty((3, p.shape[0]), dtype=np.int64)
-    return mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
-                              strips)
-
-
-@njit(cache=True, error_model="numpy")
-def mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
-                       strips):
+def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, strips,
+                calibrated, pair_knots, pair_values):
     """MAE steps 1-3 and 6: validate, split, size the zones, look up, give ``L1 .. L4``.
 
     Writes ``geo`` (length :data:`GEO_SIZE`): centroid ``x_c, y_c``, split
@@ -659,9 +651,11 @@ def mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo
     zone) and the patch's equivalent ellipse ``x_c, y_c, a, b`` (m); and the
     column envelopes ``env`` ``(2, nx)``; ``strips`` ``(3, ny)``: each
     strip's cells in contact, first and last of them (:func:`scan_patch`).
-    Return ``(status, info)``; ``info`` is the offending ``a/b`` of a zone
-    outside the table (the geometry is complete then, the flexibilities are
-    not).
+    With ``calibrated`` the ``L1 .. L4`` are the calibrated MAE's
+    (:func:`calibrate`, pair factors ``pair_values`` on the nodes
+    ``pair_knots``; unread otherwise).  Return ``(status, info)``; ``info`` is
+    the offending ``a/b`` of a zone outside the table (the geometry is
+    complete then, the flexibilities are not).
     """
     status = check_grid(x0, y0, dx, dy)
     if status != OK:
@@ -709,13 +703,16 @@ def mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo
         geo[flex + 1] = l2
         geo[flex + 2] = l3
         geo[flex + 3] = l4
+    if calibrated:
+        calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_knots,
+                  pair_values)
     return OK, 0.0
 
 
 @njit(cache=True, error_model="numpy")
 def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_knots,
               pair_values):
-    """Overwrite ``geo``'s ``L1 .. L4`` with the calibrated MAE's (after :func:`mae_prepare`).
+    """Overwrite ``geo``'s ``L1 .. L4`` with the calibrated MAE's (:func:`mae_prepare` calls it).
 
     :func:`fastsim_ros.contact.mae_calibrated.calibrated_flexibilities`:
     each zone's half-ellipse ``c11, c22, c23`` scaled by the pair's shared
@@ -729,7 +726,7 @@ def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_
     full adhesion gives those coefficients on these cells; ``c23`` with the
     zone's strip offsets (the reference's ``offset_c23``).  Where ``D3 <= 0``
     the paper's ``L3`` (with the method's ``c23``) is kept.  ``strips``: as
-    :func:`mae_prepare_strips` leaves it.  A strip of one segment is summed
+    :func:`mae_prepare` leaves it.  A strip of one segment is summed
     in closed form (the midpoint sums of a linear integrand are exact: a
     cell ``m`` cells behind the front face has ``d = (m + 1/2) dx`` and
     ``s3 = ((x_lead - x_c)^2 - (x - x_c)^2)/2``); a strip of several, cell by
@@ -1050,13 +1047,10 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     geo = np.empty(GEO_SIZE)
     env = np.empty((2, nx), dtype=np.int64)
     strips = np.empty((3, ny), dtype=np.int64)
-    status, info = mae_prepare_strips(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo,
-                                      env, strips)
+    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
+                               strips, calibrated, pair_knots, pair_values)
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
-    if calibrated:
-        calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_knots,
-                  pair_values)
     # the given bound is mu p, applied in the sweep: no array for it
     bound = np.empty((ny, nx) if parabolic else (0, 0))
     if parabolic:
@@ -1152,13 +1146,11 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
         p = ps[pb]
         same = _same_patch(b, pb, prev_pb, x0, y0, dx, dy)
         if not same:
-            status, info = mae_prepare_strips(p, x0[b], y0[b], dx[b], dy[b], rule,
-                                              shear_modulus, knots, polys, geo, env, strips)
+            status, info = mae_prepare(p, x0[b], y0[b], dx[b], dy[b], rule, shear_modulus,
+                                       knots, polys, geo, env, strips, calibrated,
+                                       pair_knots, pair_values)
             if status != OK:
                 return status, b, info
-            if calibrated:
-                calibrate(p, x0[b], y0[b], dx[b], dy[b], strips, geo, shear_modulus, knots,
-                          polys, pair_knots, pair_values)
             mae_strip_flexibility(geo, flex)
         if parabolic and not (same and mu[b] == mu[b - 1]):
             parabolic_bound(p, dx[b], dy[b], mu[b], geo[G_LOAD], bound)
