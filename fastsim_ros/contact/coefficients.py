@@ -3,14 +3,17 @@
 METHOD.md section 1 (paper eq. 3).  The exact solver, MAE's own
 coefficients, MAE + FastSim and the equivalent ellipse all fill a
 :class:`CreepCoefficients`, directly or from their forces at the unit
-creepages (:func:`coefficients_from_unit_solutions`).  Imports nothing of the
+creepages (:func:`coefficients_from_unit_solutions`, or
+:func:`coefficients_of_solver` which makes those solves).  Imports nothing of the
 package: it sits below every solver.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 
 @dataclass(frozen=True)
@@ -63,3 +66,28 @@ def coefficients_from_unit_solutions(
         C21=-fy1 / (g * c**2), C22=-fy2 / (g * c**2), C23=-fy3 / (g * c**3),
         C31=mz1 / (g * c**3), C32=mz2 / (g * c**3), C33=-mz3 / (g * c**4),
         area=area, reference=reference)
+
+
+class Forces(Protocol):
+    """What :func:`coefficients_of_solver`'s solve returns: ``fx``, ``fy`` (N), ``mz`` (N m)."""
+
+    @property
+    def fx(self) -> float: ...
+
+    @property
+    def fy(self) -> float: ...
+
+    @property
+    def mz(self) -> float: ...
+
+
+def coefficients_of_solver(area: float, solve: Callable[[float, float, float], Forces], *,
+                           reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
+    """Return a method's coefficients from its solves at :data:`UNIT_CREEPAGES` (G = 1 Pa).
+
+    ``solve(xi, eta, phi)``: the method in full adhesion with ``G = 1`` Pa
+    and creepages about ``reference`` (m); ``area``: ``A`` (m^2).
+    """
+    unit = tuple(solve(*cr) for cr in UNIT_CREEPAGES)
+    return coefficients_from_unit_solutions(area, tuple((r.fx, r.fy, r.mz) for r in unit),
+                                            reference=reference)

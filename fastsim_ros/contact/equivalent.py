@@ -18,8 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fastsim_ros.contact.area import GridArea, ellipse
-from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
-                                              coefficients_from_unit_solutions)
+from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
                                          traction_bound)
 from fastsim_ros.contact.friction import FrictionLaw, resolve
@@ -99,8 +98,7 @@ def equivalent_coefficients(area: GridArea, table: CoefficientTable, *,
     """
     unit_load = area.with_load(1.0)
     # a friction coefficient so large that no cell reaches the bound: full adhesion
-    unit = tuple(equivalent_fastsim(unit_load, *cr, mu=1e300, table=table, shear_modulus=1.0,
-                                    reference=reference)
-                 for cr in UNIT_CREEPAGES)
-    return coefficients_from_unit_solutions(area.area, tuple((r.fx, r.fy, r.mz) for r in unit),
-                                            reference=reference)
+    return coefficients_of_solver(
+        area.area, lambda xi, eta, phi: equivalent_fastsim(
+            unit_load, xi, eta, phi, mu=1e300, table=table, shear_modulus=1.0,
+            reference=reference), reference=reference)

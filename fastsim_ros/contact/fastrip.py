@@ -97,8 +97,7 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import (check_bound, check_creepages, check_friction,
                                         check_shear_modulus)
-from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
-                                              coefficients_from_unit_solutions)
+from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
 from fastsim_ros.contact.equivalent import EquivalentEllipse, equivalent_ellipse
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.fastsim import kalker_flexibility
@@ -325,8 +324,7 @@ def fastrip_coefficients(area: GridArea, table: CoefficientTable, *,
     """
     unit_load = area.with_load(1.0)
     # so large a friction coefficient that no strip has a slip zone: full adhesion
-    unit = tuple(fastrip(unit_load, *cr, mu=1e300, table=table, shear_modulus=1.0,
-                         reference=reference)
-                 for cr in UNIT_CREEPAGES)
-    return coefficients_from_unit_solutions(area.area, tuple((r.fx, r.fy, r.mz) for r in unit),
-                                            reference=reference)
+    return coefficients_of_solver(
+        area.area, lambda xi, eta, phi: fastrip(
+            unit_load, xi, eta, phi, mu=1e300, table=table, shear_modulus=1.0,
+            reference=reference), reference=reference)

@@ -25,8 +25,7 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import SplitRule, check_split_rule
-from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
-                                              coefficients_from_unit_solutions)
+from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.rules import MIN_ZONE_SHARE
@@ -309,7 +308,7 @@ def mae_fastsim_coefficients(area: GridArea, table: CoefficientTable, *,
     coefficients (:func:`mae_coefficients`) and the exact theory's.
     """
     unbounded = np.where(area.mask, np.inf, 0.0)
-    unit = tuple(mae_fastsim(area, *cr, bound=unbounded, table=table, shear_modulus=1.0,
-                             reference=reference, rule=rule) for cr in UNIT_CREEPAGES)
-    return coefficients_from_unit_solutions(area.area, tuple((r.fx, r.fy, r.mz) for r in unit),
-                                            reference=reference)
+    return coefficients_of_solver(
+        area.area, lambda xi, eta, phi: mae_fastsim(
+            area, xi, eta, phi, bound=unbounded, table=table, shear_modulus=1.0,
+            reference=reference, rule=rule), reference=reference)
