@@ -27,8 +27,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -61,6 +59,9 @@ from fastsim_ros.contact.pairs import PairFactors, pair_factors  # noqa: E402
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
 
 import validate  # noqa: E402  (scripts/validate.py: the report's own areas)
+
+sys.path.insert(0, str(ROOT / "benchmarks"))
+import bench_fastsim as bench  # noqa: E402  (the cost ratio's patches and timing)
 
 DOCS = ROOT / "docs"
 DATA = DOCS / "data" / "validation_wider.json"
@@ -106,18 +107,6 @@ def area_makers(loaded: bool) -> dict[str, AreaMaker]:
         out[f"profile gap {1e3 * u:+.1f} mm"] = (
             lambda n, u=u: samples.profile_gap_patch(u, cells=n, load=LOAD))
     return out
-
-
-def _machine() -> str:
-    cpu = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
 def _saturation(ar: areas.GridArea) -> tuple[float, float, float]:
@@ -218,21 +207,9 @@ def selection_makers() -> dict[str, AreaMaker]:
             g1, g2, cells=n, scale=SCALE, load=LOAD))
     for ratio, half_width, depth in ((1.5, 0.2, 0.3), (1.2, 0.45, 0.1)):
         out[f"notch {ratio:g}/{half_width:g}/{depth:g}"] = (
-            lambda n, r=ratio, w=half_width, d=depth: _notch(r, w, d, n))
+            lambda n, r=ratio, w=half_width, d=depth: samples.notched_ellipse(
+                cells=n, scale=SCALE, load=LOAD, a_over_b=r, half_width=w, depth=d))
     return out
-
-
-def _notch(ratio: float, half_width: float, depth: float, cells: int) -> areas.GridArea:
-    """Ellipse ``a/b = ratio`` (1e-4 m^2, 5e4 N) without ``|x| < half_width a, y > depth b``."""
-    a, b = areas.semi_ellipse_axes(ratio)
-    x = -a + 2 * a / cells * (np.arange(cells) + 0.5)
-    y = -b + 2 * b / cells * (np.arange(cells) + 0.5)
-    xx, yy = x[None, :], y[:, None]
-    p = np.sqrt(np.clip(1.0 - (xx / a) ** 2 - (yy / b) ** 2, 0.0, None))
-    p = p * ~((np.abs(xx) < half_width * a) & (yy > depth * b))
-    ar = areas.GridArea(float(x[0]) * SCALE, float(y[0]) * SCALE, 2 * a / cells * SCALE,
-                        2 * b / cells * SCALE, p)
-    return ar.with_load(LOAD)
 
 
 #: the pair-factor rules compared on the selection areas (numpy reference)
@@ -285,40 +262,26 @@ def coefficient_grid_check(names: list[str]) -> dict[str, Any]:
 def cost_ratio(calls: int = 3000) -> dict[str, Any]:
     """Time the calibrated and the paper's MAE side by side on 30x30 patches (TARGETS.md).
 
-    The patches of ``benchmarks/bench_fastsim.py`` (a Hertzian 6 x 4 mm ellipse and two
-    semi-ellipses 0.5/2 of 1 cm^2, 50 kN) at its creepages; the calls interleaved in blocks
-    (a drifting machine affects both alike); medians in seconds.
+    ``benchmarks/bench_fastsim.py``'s patches (two semi-ellipses 0.5/2 of 1 cm^2 and a
+    Hertzian 6 x 4 mm ellipse, 50 kN), creepages and interleaved timing (``per_call``);
+    medians in seconds.
     """
-    ell = areas.ellipse(6e-3, 4e-3, nx=30, load=LOAD)
-    base = areas.semi_ellipses(0.5, 2.0, cells=30)
-    a1, b1 = areas.semi_ellipse_axes(0.5)
-    a2, b2 = areas.semi_ellipse_axes(2.0)
-    xx, yy = base.x[None, :], base.y[:, None]
-    rho2 = np.where(yy < 0.0, (xx / a1) ** 2 + (yy / b1) ** 2, (xx / a2) ** 2 + (yy / b2) ** 2)
-    p = np.where(base.mask, np.sqrt(np.clip(1.0 - rho2, 0.0, None) + 1e-3), 0.0)
-    semi = base.with_pressure(p).scaled(0.01).with_load(LOAD)
-    solvers = {"mae_calibrated": CalibratedMaeSolver(NU, G), "mae": MaeSolver(NU, G)}
-    creep = (1.0e-3, 5.0e-4, 1.0)
+    cal, mae = CalibratedMaeSolver(bench.NU, bench.G), MaeSolver(bench.NU, bench.G)
     out: dict[str, Any] = {}
-    for name, ar in (("semi-ellipses 30x30", semi), ("ellipse 30x30", ell)):
-        times: dict[str, list[float]] = {m: [] for m in solvers}
-        for _ in range(200):
-            for sv in solvers.values():
-                sv.solve(ar, *creep, mu=MU)
-        for _ in range(calls // 100):
-            for m, sv in solvers.items():
-                for _ in range(100):
-                    t0 = time.perf_counter()
-                    sv.solve(ar, *creep, mu=MU)
-                    times[m].append(time.perf_counter() - t0)
-        out[name] = {m: float(np.median(v)) for m, v in times.items()}
+    for name, make in (("semi-ellipses 30x30", bench.semi_ellipses),
+                       ("ellipse 30x30", bench.ellipse)):
+        ar = make(30)
+        t = bench.per_call({
+            "mae_calibrated": lambda: cal.solve(ar, *bench.CREEP, mu=bench.MU),
+            "mae": lambda: mae.solve(ar, *bench.CREEP, mu=bench.MU)}, calls)
+        out[name] = {m: 1e-6 * median for m, (median, _) in t.items()}
     return out
 
 
 def compute() -> dict[str, Any]:
     """Run every part; return what the JSON holds."""
     warm_up()
-    res: dict[str, Any] = {"machine": _machine(), "curve_cells": CURVE_CELLS,
+    res: dict[str, Any] = {"machine": validate._machine(), "curve_cells": CURVE_CELLS,
                            "check_cells": CHECK_CELLS, "exact_grids": EXACT_GRIDS,
                            "online_cells": ONLINE_CELLS, "mu": MU, "G": G, "nu": NU,
                            "load": LOAD, "areas": {}, "grid_check": {}}

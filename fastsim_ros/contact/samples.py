@@ -66,16 +66,20 @@ def semi_ellipses_patch(g1: float, g2: float, *, cells: int, scale: float = 1.0,
     return base.with_pressure(p).scaled(scale).with_load(load)
 
 
-def notched_ellipse(*, cells: int, scale: float = 1.0, load: float | None = None) -> GridArea:
+def notched_ellipse(*, cells: int, scale: float = 1.0, load: float | None = None,
+                    a_over_b: float = 0.8, half_width: float = 0.3,
+                    depth: float = 0.35) -> GridArea:
     """Ellipse ``a/b = 0.8`` of area ``scale^2`` with a notch in its ``y > 0`` side.
 
     The notch removes ``|x| < 0.3 a``, ``y > 0.35 b``: strips there have two
-    segments, and the area is asymmetric in ``y``.
+    segments, and the area is asymmetric in ``y``.  ``a_over_b``,
+    ``half_width`` (of ``a``) and ``depth`` (of ``b``) make other notched
+    ellipses (the calibrated MAE's selection areas).
     """
-    a, b = semi_ellipse_axes(0.8)
+    a, b = semi_ellipse_axes(a_over_b)
     x, y, dx, dy = _grid((-a, a), (-b, b), cells)
     xx, yy = x[None, :], y[:, None]
-    p = _hertz_like(xx, yy, a, b) * ~((np.abs(xx) < 0.3 * a) & (yy > 0.35 * b))
+    p = _hertz_like(xx, yy, a, b) * ~((np.abs(xx) < half_width * a) & (yy > depth * b))
     return _finish(x, y, dx, dy, p, scale, load)
 
 
