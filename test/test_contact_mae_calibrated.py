@@ -22,15 +22,11 @@ from fastsim_ros.contact.pairs import PAIR_NAMES, pair_factors
 from fastsim_ros.contact.rules import rigid_slip_return
 from fastsim_ros.contact.tables import coefficient_table
 
-from test_contact_compiled import (AREAS, CREEPAGES, MU, NU, G, assert_forces,
-                                   assert_tractions, size)
+import test_contact_compiled
+from test_contact_compiled import CREEPAGES, MU, NU, G, assert_forces, assert_tractions, size
 
-
-@pytest.fixture(scope="module", params=sorted(AREAS))
-def case(request):
-    """Give the compiled path's test areas (test_contact_compiled.AREAS): name, area, point."""
-    make, reference = AREAS[request.param]
-    return request.param, make(), reference
+#: the compiled path's test areas, one fixture for both files (name, area, reference point)
+case = test_contact_compiled.case
 
 
 @pytest.fixture(scope="module")
