@@ -52,6 +52,8 @@ from fastsim_ros.contact.traction import Tractions, resultants
 FloatArray = NDArray[np.float64]
 SlipRule = Literal["radial", "rigid_slip"]
 SLIP_RULES: tuple[SlipRule, ...] = ("radial", "rigid_slip")
+#: a rigid-slip return in the reference sweep: traction (Pa), applies, rigid slip w h (m)
+_Returned = tuple[float, float, bool, float, float]
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,14 +193,22 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     prev_slip = np.zeros(ny, dtype=bool)
     # each strip's friction ratio in its last cell (read only where that cell slipped)
     ratio = np.ones(ny)
+
+    def returned_to(jj: int | np.integer, level: float) -> _Returned:
+        # strip jj's rigid-slip return onto ``level`` (Pa) in the column being marched, and
+        # its rigid slip over the step (m), taken where the traction lives: the cell's centre
+        h = step[jj]
+        wxh = w_x[jj] * h
+        wyh = (w_y0[jj] + phi * (x[i] - x_c)) * h
+        rx, ry, ok = rigid_slip_return(px[jj], py[jj], wxh, wyh, flex.l1[jj], flex.l2[jj], level)
+        return rx, ry, ok, wxh, wyh
+
     for i in range(nx - 1, -1, -1):
         g = bound[:, i]
         inside = g > 0.0
         # first cell of a segment: half a step from its front face
         step = np.where(prev_in, dx, 0.5 * dx)
         x_mid = x[i] - x_c + 0.5 * step
-        # the rigid-slip return takes the slip where the traction lives: at the cell's centre
-        x_cell = np.full(ny, x[i] - x_c)
         # the traction one step upstream (zero at a segment's front face)
         px = np.where(inside & prev_in, tx, 0.0)
         py = np.where(inside & prev_in, ty, 0.0)
@@ -209,10 +219,7 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
             over = mag > g
             if rigid:
                 for jj in np.flatnonzero(over):
-                    h = step[jj]
-                    rx, ry, ok = rigid_slip_return(
-                        px[jj], py[jj], w_x[jj] * h, (w_y0[jj] + phi * x_cell[jj]) * h,
-                        flex.l1[jj], flex.l2[jj], g[jj])
+                    rx, ry, ok, _, _ = returned_to(jj, g[jj])
                     if ok:
                         # on the bound already: the scale below leaves it there
                         tx[jj], ty[jj], mag[jj] = rx, ry, g[jj]
@@ -231,16 +238,14 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
                 returned = []
                 if rigid:
                     for n_, jj in enumerate(idx):
-                        h = step[jj]
                         lv = level[jj]
-                        wyh = (w_y0[jj] + phi * x_cell[jj]) * h
-                        rx, ry, ok = rigid_slip_return(px[jj], py[jj], w_x[jj] * h, wyh,
-                                                       flex.l1[jj], flex.l2[jj], lv)
+                        rx, ry, ok, wxh, wyh = returned_to(jj, lv)
                         if ok:
                             # the slip at the kinetic level, |V| |w h + L (tau_k - tau_p)| / h
-                            sx = w_x[jj] * h + flex.l1[jj] * (rx - px[jj])
+                            sx = wxh + flex.l1[jj] * (rx - px[jj])
                             sy = wyh + flex.l2[jj] * (ry - py[jj])
-                            k[n_] = law.ratio(np.asarray(v_roll * math.hypot(sx, sy) / h))
+                            k[n_] = law.ratio(np.asarray(v_roll * math.hypot(sx, sy)
+                                                         / step[jj]))
                             returned.append((n_, jj, rx, ry, lv))
                 r = g[idx] * k
                 slides = r < m
