@@ -277,10 +277,13 @@ LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
 #: :data:`fastsim_ros.contact.rules.MIN_OFFSET_C23_SHARE` (frozen into the kernels)
 MIN_OFFSET_C23_SHARE = rules.MIN_OFFSET_C23_SHARE
 
-#: :func:`fastsim_ros.contact.rules.rigid_slip_return` and
-#: :func:`~fastsim_ros.contact.rules.pair_factor`, compiled: the reference's formulas, no copies
+#: :func:`fastsim_ros.contact.rules.rigid_slip_return`,
+#: :func:`~fastsim_ros.contact.rules.pair_factor` and
+#: :func:`~fastsim_ros.contact.rules.chord_bend_offset`, compiled: the reference's formulas,
+#: no copies
 rigid_slip_return = njit(cache=True, error_model="numpy")(rules.rigid_slip_return)
 pair_factor = njit(cache=True, error_model="numpy")(rules.pair_factor)
+chord_bend_offset = njit(cache=True, error_model="numpy")(rules.chord_bend_offset)
 
 
 @njit(cache=True, error_model="numpy")
@@ -724,7 +727,7 @@ def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_
     (``d``: the length a cell's traction has grown over from its segment's
     front face, ``s3``: the sum of ``(x_mid - x_c) h``), so that FastSim in
     full adhesion gives those coefficients on these cells; ``c23`` with the
-    zone's strip offsets (the reference's ``offset_c23``).  Where ``D3 <= 0``
+    bend of the zone's strips (the reference's ``offset_c23``).  Where ``D3 <= 0``
     the paper's ``L3`` (with the method's ``c23``) is kept.  ``strips``: as
     :func:`mae_prepare` leaves it.  A strip of one segment is summed
     in closed form (the midpoint sums of a linear integrand are exact: a
@@ -737,10 +740,9 @@ def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_
     y_s = geo[G_YS]
     f = int(geo[G_FACE])
     half = 0.5 * dx
-    # per zone: D1, D3 and D4 sums (before dA); rule 4: strip centres and strips
-    d1_1 = d3_1 = d4_1 = cen_1 = 0.0
-    d1_2 = d3_2 = d4_2 = cen_2 = 0.0
-    n_1 = n_2 = 0
+    # per zone: D1, D3 and D4 sums (before dA)
+    d1_1 = d3_1 = d4_1 = 0.0
+    d1_2 = d3_2 = d4_2 = 0.0
     for j in range(ny):
         n = strips[0, j]
         if n == 0:
@@ -774,19 +776,14 @@ def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_
                 cs += (x0 + dx * i - x_c + 0.5 * s) * s
                 sum_d += cd
                 sum_s3 += cs
-        centre = x0 + dx * 0.5 * (i_first + i_last)
         if j < f:
             d1_1 += sum_d
             d3_1 += sum_s3
             d4_1 += y_rel * sum_d
-            cen_1 += centre
-            n_1 += 1
         else:
             d1_2 += sum_d
             d3_2 += sum_s3
             d4_2 += y_rel * sum_d
-            cen_2 += centre
-            n_2 += 1
     da = dx * dy
     both = geo[G_ZONE1] > 0.0 and geo[G_ZONE2] > 0.0
     t1 = math.log(geo[G_ZONE1 + 3]) if geo[G_ZONE1] > 0.0 else 0.0
@@ -827,10 +824,11 @@ def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_
         lone23 = spline(knots, polys[I_H23], t)
         c13 = spline(knots, polys[I_H13], t) * (k13_1 if z == 0 else k13_2)
         ab = 2.0 * geo[zone] / math.pi
-        # rule 4 (the reference's offset_c23): the strips' offsets from x_c
+        # rule 4 (the reference's offset_c23): the bend of the zone's strips
         c23 = lone23 * s23
-        x_eta = cen_1 / n_1 if z == 0 else cen_2 / n_2
-        c23 = max(c23 + c22 * (x_eta - x_c) / math.sqrt(ab), MIN_OFFSET_C23_SHARE * c23)
+        offset = (chord_bend_offset(strips[0], strips[1], strips[2], 0, f, dx) if z == 0
+                  else chord_bend_offset(strips[0], strips[1], strips[2], f, ny, dx))
+        c23 = max(c23 + c22 * offset / math.sqrt(ab), MIN_OFFSET_C23_SHARE * c23)
         g = shear_modulus
         d1 = (d1_1 if z == 0 else d1_2) * da
         d3 = (d3_1 if z == 0 else d3_2) * da

@@ -43,9 +43,9 @@ showed the paper's method off and why (docs/validation_wider.md):
 
 4. **A bent zone's strips are offset** (rule 4, :func:`offset_c23`): spin
    about the centroid acts on a strip centred off it as a lateral creepage,
-   carried by the strips as the exact theory carries a lateral creepage on
-   an ellipse (each strip alike), which adds to the zone's ``c23`` (the
-   paper's MAE is 31% low in C~23 on the crescent of a hollow tread).
+   which adds to the zone's ``c23`` where the strips are bent (the paper's
+   MAE is 31% low in C~23 on the crescent of a hollow tread); offsets in
+   proportion to the chord (an egg) do nothing.
 
 Assumptions (besides MAE's): FastSim's local flexibility, one set per zone;
 the zones couple as the equal-area pair of their ``a/b`` would; the
@@ -69,7 +69,7 @@ from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone
                                      ZoneFlexibility, ZonePair, row_extents, mae_geometry,
                                      strip_flexibility, zone_flexibility)
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
-from fastsim_ros.contact.rules import MIN_OFFSET_C23_SHARE
+from fastsim_ros.contact.rules import MIN_OFFSET_C23_SHARE, chord_bend_offset
 from fastsim_ros.contact.tables import CoefficientTable
 
 FloatArray = NDArray[np.float64]
@@ -166,32 +166,30 @@ def _paired_coefficients(
 
 def offset_c23(area: GridArea, geometry: MaeGeometry, zone: Zone, rows: NDArray[np.bool_],
                c: dict[str, float]) -> dict[str, float]:
-    """Return the zone's coefficients with ``c23`` for its strips' offsets along ``x`` (rule 4).
+    """Return the zone's coefficients with ``c23`` for the bend of its strips (rule 4).
 
     MAE likens a zone to a semi-ellipse whose strips are centred on ``x_c``.
     A crescent's are not (a hollow tread bends the patch: its horns lead):
     spin about ``S`` then also acts on strip ``j`` as a lateral creepage
-    ``phi (x_j - x_c)``, ``x_j`` the strip's centre.  In Kalker's exact
-    full-adhesion solution on an ellipse the lateral traction under a
-    lateral creepage is ``const / sqrt(1 - x^2/a^2 - y^2/b^2)``, whose
-    integral along a strip is the same for every strip (FastSim's parabola
-    gives each strip a share growing with its length squared): so the
-    lateral force of that creepage is the zone's, ``G A' c22``, times the
-    mean over its strips, each strip counted once, of ``phi (x_j - x_c)``;
-    ``c23 -> c23 + c22 (x_eta - x_c)/sqrt(A')``, ``x_eta`` that mean of the
-    strip centres (``A' = 2 A_i/pi``).  For a straight zone (``x_j = x_c``,
-    every ellipse and semi-ellipse) nothing changes.  Evidence: the crescent
-    (docs/validation_wider.md) and crescents of half and of 1.7 times its bend
-    (C~23 -8.3% and -22.2% without this rule, -1.2% and -10.2% with it; no
-    parameter is fitted).  ``c23`` is kept at least
-    :data:`MIN_OFFSET_C23_SHARE` of its straight value.
+    ``phi (x_j - x_c)``, ``x_j`` the strip's centre, and the lateral force
+    of that creepage adds to the zone's ``c23``: ``c23 -> c23 + c22
+    offset/sqrt(A')`` (``A' = 2 A_i/pi``), ``offset`` the bend's part of
+    the strips' mean centre less the centroid
+    (:func:`~fastsim_ros.contact.rules.chord_bend_offset`: centres that
+    move in proportion to the chord, as an egg's, do not count, the exact
+    theory shows them doing nothing).  For a straight zone (every ellipse
+    and semi-ellipse) nothing changes.  Evidence (docs/validation_wider.md,
+    section 6): the first form (every offset counted, each strip once) took
+    the crescent's C~23 from -12.4% to -1.7% but put eggs whose longer half
+    trails up to 0.16 above the exact value (C~23 0.91); this form keeps
+    the crescents and brings the eggs within 0.04 (no parameter fitted).
+    ``c23`` is kept at least :data:`MIN_OFFSET_C23_SHARE` of its straight
+    value.
     """
     count, first, last = row_extents(area.mask & rows[:, None])
-    used = count > 0
-    centres = 0.5 * (area.x[first[used]] + area.x[last[used]])
-    x_eta = float(centres.mean())
+    offset = chord_bend_offset(count, first, last, 0, area.ny, area.dx)
     out = dict(c)
-    shifted = c["c23"] + c["c22"] * (x_eta - geometry.x_c) / math.sqrt(2.0 * zone.area / math.pi)
+    shifted = c["c23"] + c["c22"] * offset / math.sqrt(2.0 * zone.area / math.pi)
     out["c23"] = max(shifted, MIN_OFFSET_C23_SHARE * c["c23"])
     return out
 

@@ -129,3 +129,74 @@ def pair_factor(knots: Any, values: Any, t_self: float, t_other: float) -> float
     if u >= v:
         return (1.0 - u) * values[i, j] + (u - v) * values[i + 1, j] + v * values[i + 1, j + 1]
     return (1.0 - v) * values[i, j] + (v - u) * values[i, j + 1] + u * values[i + 1, j + 1]
+
+
+def chord_bend_offset(count: Any, first: Any, last: Any, j_lo: int, j_hi: int,
+                      dx: float) -> float:
+    """Return the strip offset (m) of the calibrated MAE's rule 4 for the strips ``j_lo .. j_hi-1``.
+
+    ``count[j]``, ``first[j]``, ``last[j]``: strip ``j``'s cells in contact
+    and the indices of its first and last such cell (a strip with ``count
+    = 0`` is skipped); ``dx``: the cell length (m).  Each strip ``k`` has
+    its chord's centre ``m_k`` and half-length ``l_k`` (the faces of its
+    outermost cells).  Spin about the centroid acts on a strip centred off
+    it as a lateral creepage; the exact theory tells two kinds of offset
+    apart (docs/validation_wider.md, section 6):
+
+    - offsets proportional to the chord, ``m = m0 + s l`` (an egg: two half
+      ellipses of different lengths; any shape sheared in proportion to its
+      chords): the exact lateral force of a strip is then proportional to
+      its length (measured: within 7% rms on eight eggs, 80 cells), so the
+      offsets average to the centroid and do nothing (the exact C~23 about
+      the centroid of an egg is its straightened shape's within 1.2%);
+    - a bend, ``m = m0 - B l^2`` (a crescent: strips moved by a function of
+      ``y`` whatever their length, the short ones most): the exact theory
+      weighs the offsets nearly alike per strip (with the elastic coupling
+      of the bent strips), as rule 4 first found on the crescent.
+
+    So the centres are fitted by least squares, each strip counted once,
+    with ``m = alpha + beta l + kappa l^2``, and the offset is the bend's
+    part alone, ``kappa (mean(l^2) - sum(l^3)/sum(l))``: the mean centre,
+    each strip once, of ``kappa l^2`` less its centroid (strips weighed by
+    their length).  On a crescent (centres exactly quadratic in the chord)
+    that is the mean strip centre less the centroid, the first form of the
+    rule; on an egg, a straight zone, or too few distinct chords to tell a
+    bend (``< 3``, or a singular fit) it is zero.
+    """
+    n = 0
+    s_l = 0.0
+    s_l2 = 0.0
+    s_l3 = 0.0
+    for j in range(j_lo, j_hi):
+        if count[j] > 0:
+            half = 0.5 * dx * (last[j] - first[j] + 1)
+            n += 1
+            s_l += half
+            s_l2 += half * half
+            s_l3 += half * half * half
+    if n < 3:
+        return 0.0
+    mean_l = s_l / n
+    mean_u2 = 0.0
+    for j in range(j_lo, j_hi):
+        if count[j] > 0:
+            u = 0.5 * dx * (last[j] - first[j] + 1) - mean_l
+            mean_u2 += u * u
+    mean_u2 /= n
+    # centred regressors u = l - mean(l) and q = u^2 - mean(u^2): kappa is q's coefficient
+    s_uu = s_uq = s_qq = s_um = s_qm = 0.0
+    for j in range(j_lo, j_hi):
+        if count[j] > 0:
+            u = 0.5 * dx * (last[j] - first[j] + 1) - mean_l
+            q = u * u - mean_u2
+            m = 0.5 * dx * (first[j] + last[j])
+            s_uu += u * u
+            s_uq += u * q
+            s_qq += q * q
+            s_um += u * m
+            s_qm += q * m
+    det = s_uu * s_qq - s_uq * s_uq
+    if not det > 1e-9 * s_uu * s_qq:
+        return 0.0
+    kappa = (s_uu * s_qm - s_uq * s_um) / det
+    return kappa * (s_l2 / n - s_l3 / s_l)

@@ -93,6 +93,40 @@ def two_lobes(*, cells: int, scale: float = 1.0, load: float | None = None) -> G
     return _finish(x, y, dx, dy, p, scale, load)
 
 
+def asymmetric_lobes(*, cells: int, scale: float = 1.0, load: float | None = None,
+                     size: float = 0.6, lead: float = 0.3, overlap: float = 0.2,
+                     a_over_b: tuple[float, float] = (1.0, 1.0)) -> GridArea:
+    """Make two overlapping elliptical lobes side by side, the second smaller and leading.
+
+    Lobe 1 (``y < 0``) has semi-axes ``a1 = a_over_b[0] b1``, ``b1 = 1``;
+    lobe 2 (``y > 0``) is ``size`` times as large (``b2 = size``, ``a2 =
+    a_over_b[1] b2``), its centre ``lead a1`` ahead of lobe 1's along ``x``
+    and laterally where the lobes overlap by ``overlap b1`` (a two-point
+    contact about to merge: asymmetric in ``x`` and in ``y``); Hertz-like
+    pressure per lobe growing with its size; area ``scale^2``.
+    """
+    for name, v in (("size", size), ("overlap", overlap)):
+        if not (math.isfinite(v) and v > 0.0):
+            raise InvalidInputError(f"{name} must be positive, got {v}")
+    a1, b1 = a_over_b[0], 1.0
+    a2, b2 = a_over_b[1] * size, size
+    lobes = ((0.0, 0.0, a1, b1), (lead * a1, b1 + b2 - overlap * b1, a2, b2))
+    box = ((min(xc - a for xc, _, a, _ in lobes), max(xc + a for xc, _, a, _ in lobes)),
+           (-b1, lobes[1][1] + b2))
+
+    def pressure(cells_: int) -> tuple[np.ndarray, np.ndarray, float, float, np.ndarray]:
+        x, y, dx, dy = _grid(box[0], box[1], cells_)
+        xx, yy = x[None, :], y[:, None]
+        return x, y, dx, dy, np.maximum.reduce(
+            [b * _hertz_like(xx - xc, yy - yc, a, b) for xc, yc, a, b in lobes])
+
+    # area scale^2: the shape's own area, on a fine grid whatever ``cells`` (one shape)
+    *_, dx_f, dy_f, p_f = pressure(400)
+    k = scale / math.sqrt(float(np.count_nonzero(p_f > 0.0)) * dx_f * dy_f)
+    x, y, dx, dy, p = pressure(cells)
+    return _finish(x, y, dx, dy, p, k, load)
+
+
 def truncated_ellipse(*, cells: int, scale: float = 1.0, load: float | None = None,
                       cut: float = 0.1) -> GridArea:
     """Ellipse ``a/b = 1.5`` (``a b = scale^2/pi``) without the part beyond ``y = cut * b``."""
@@ -154,36 +188,64 @@ def long_narrow_patch(*, cells: int, scale: float = 1.0, load: float | None = No
     return _finish(x, y, dx, dy, p, scale, load)
 
 
+def flat_band_patch(*, cells: int, scale: float = 1.0, load: float | None = None,
+                    a_over_b: float = 0.25, exponent: float = 4.0) -> GridArea:
+    """Make a flat band: the superellipse ``|x/a|^n + |y/b|^n < 1`` wide across the rail.
+
+    A conformal contact (a worn wheel on a worn rail) spreads laterally into
+    a band, short along the rolling direction and flat-ended: ``a/b =
+    a_over_b`` (below 1), ``n = exponent`` (2 is an ellipse; larger is
+    squarer), area ``scale^2``, pressure ``p0 sqrt(1 - |x/a|^n - |y/b|^n)``.
+    """
+    if not (math.isfinite(a_over_b) and 0.0 < a_over_b < 1.0):
+        raise InvalidInputError(f"a flat band has 0 < a/b < 1, got {a_over_b}")
+    if not (math.isfinite(exponent) and exponent > 2.0):
+        raise InvalidInputError(f"a flat band's exponent is above 2, got {exponent}")
+    # area of |x|^n + |y|^n < 1: 4 Gamma(1 + 1/n)^2 / Gamma(1 + 2/n)
+    unit = 4.0 * math.gamma(1.0 + 1.0 / exponent) ** 2 / math.gamma(1.0 + 2.0 / exponent)
+    b = math.sqrt(1.0 / (unit * a_over_b))
+    a = a_over_b * b
+    x, y, dx, dy = _grid((-a, a), (-b, b), cells)
+    rn = np.abs(x[None, :] / a) ** exponent + np.abs(y[:, None] / b) ** exponent
+    p = np.sqrt(np.clip(1.0 - rn, 0.0, None))
+    return _finish(x, y, dx, dy, p, scale, load)
+
+
 def crescent_patch(*, cells: int, scale: float = 1.0, load: float | None = None,
-                   bend: float = 1.2) -> GridArea:
+                   bend: float = 1.2, a_over_b: float = 0.3) -> GridArea:
     """Make a crescent: a hollow-worn tread's patch, an ellipse bent along its lateral axis.
 
-    The ellipse ``a/b = 0.3`` (area ``scale^2``) with each strip moved along
-    ``x`` by ``bend a (y/b)^2``: the horns lead the middle by ``bend a`` (a
-    patch on a hollow tread, whose contact runs ahead towards both of the
-    hollow's shoulders); Hertz-like pressure in the bent coordinates.
+    The ellipse ``a/b = a_over_b`` (area ``scale^2``) with each strip moved
+    along ``x`` by ``bend a (y/b)^2``: the horns lead the middle by ``bend
+    a`` (a patch on a hollow tread, whose contact runs ahead towards both of
+    the hollow's shoulders); Hertz-like pressure in the bent coordinates.  A
+    negative ``bend`` makes the horns trail.
     """
-    a, b = semi_ellipse_axes(0.3)
-    x, y, dx, dy = _grid((-a, a + bend * a), (-b, b), cells)
+    if not math.isfinite(bend):
+        raise InvalidInputError(f"bend must be finite, got {bend}")
+    a, b = semi_ellipse_axes(a_over_b)
+    x, y, dx, dy = _grid((-a + min(bend, 0.0) * a, a + max(bend, 0.0) * a), (-b, b), cells)
     xx, yy = x[None, :], y[:, None]
     p = _hertz_like(xx - bend * a * (yy / b) ** 2, yy, a, b)
     return _finish(x, y, dx, dy, p, scale, load).cropped()
 
 
 def egg_patch(*, cells: int, scale: float = 1.0, load: float | None = None,
-              lead_over_trail: float = 1.8) -> GridArea:
+              lead_over_trail: float = 1.8, a_over_b: float = 1.0) -> GridArea:
     """Make an egg: the leading half (``x > 0``) ``lead_over_trail`` times the trailing one.
 
     Two half ellipses joined along ``x = 0``, semi-axes ``a_l`` (leading),
     ``a_t`` (trailing) and ``b``, ``a_l = lead_over_trail a_t``, ``(a_l +
-    a_t)/(2 b) = 1``, area ``scale^2``; Hertz-like pressure per half, equal on
-    the join.  Asymmetric in ``x`` only: symmetric in ``y``.
+    a_t)/(2 b) = a_over_b``, area ``scale^2``; Hertz-like pressure per half,
+    equal on the join.  Asymmetric in ``x`` only: symmetric in ``y``.
+    ``lead_over_trail < 1``: the longer half trails.
     """
-    if not (math.isfinite(lead_over_trail) and lead_over_trail > 0.0):
-        raise InvalidInputError(f"lead_over_trail must be positive, got {lead_over_trail}")
-    # area pi (a_l + a_t) b / 2 = 1 with a_l + a_t = 2 b
-    b = 1.0 / math.sqrt(math.pi)
-    a_t = 2.0 * b / (1.0 + lead_over_trail)
+    for name, v in (("lead_over_trail", lead_over_trail), ("a_over_b", a_over_b)):
+        if not (math.isfinite(v) and v > 0.0):
+            raise InvalidInputError(f"{name} must be positive, got {v}")
+    # area pi (a_l + a_t) b / 2 = 1 with a_l + a_t = 2 b a_over_b
+    b = 1.0 / math.sqrt(math.pi * a_over_b)
+    a_t = 2.0 * b * a_over_b / (1.0 + lead_over_trail)
     a_l = lead_over_trail * a_t
     x, y, dx, dy = _grid((-a_t, a_l), (-b, b), cells)
     xx, yy = x[None, :], y[:, None]
