@@ -11,7 +11,9 @@ the paper's MAE on every area of docs/validation_wider.md), ``mae`` (the paper's
 and ``fastsim_ellipse`` run the compiled solvers of
 :mod:`fastsim_ros.contact.compiled`, the code the node runs; ``exact`` runs
 the exact theory (:mod:`fastsim_ros.contact.exact`); ``fastrip`` the numpy
-FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path).
+FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path);
+``dlm`` and ``asm`` the seed paper's older ways to FastSim's flexibilities
+(:mod:`~fastsim_ros.contact.dlm`, :mod:`~fastsim_ros.contact.asm`, numpy).
 
 What the command line accepts is bounded (:data:`LIMITS`, :data:`MAX_PATCH_CELLS`,
 :data:`MAX_STRIP_CELLS`, :data:`MAX_EXACT_FORCE_CELLS`): every real contact lies
@@ -48,11 +50,13 @@ from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, 
 #: on an ellipse, to rounding): the grid enters through the zones' geometry
 #: only, as for ``mae``, hence the same 100 cells.
 DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
+                 "dlm": 100, "asm": 100,
                  "exact_forces": 60, "mae_forces": 60, "mae_calibrated_forces": 60,
-                 "fastsim_ellipse_forces": 60, "fastrip_forces": 60}
+                 "fastsim_ellipse_forces": 60, "fastrip_forces": 60, "dlm_forces": 60,
+                 "asm_forces": 60}
 #: the methods of ``coefficients`` and of ``forces`` (the first: ``forces``' default)
-COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim")
-FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip")
+COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
+FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -145,7 +149,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_area(co, forces=False)
     co.add_argument("--method", choices=COEFFICIENT_METHODS, default="exact",
                     help="exact solver (default), MAE's coefficients, the calibrated MAE's "
-                    "(its FastSim in full adhesion), or MAE + FastSim in full adhesion")
+                    "(its FastSim in full adhesion), MAE + FastSim in full adhesion, or the "
+                    "seed's DLM or ASM (FastSim with their flexibilities, full adhesion)")
     co.add_argument("--nu", type=_finite, default=0.25, help="Poisson ratio (default 0.25)")
     fo = sub.add_parser("forces", help="creep forces at given creepages")
     _add_area(fo, forces=True)
@@ -168,7 +173,7 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
     fo.add_argument("--method", choices=FORCE_METHODS, default="mae_calibrated",
                     help="mae_calibrated (default: the calibrated MAE), mae (the paper's), "
-                    "fastsim_ellipse, exact or fastrip")
+                    "fastsim_ellipse, exact, fastrip, dlm or asm")
     fo.add_argument("--bound", choices=BOUNDS, default="given",
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch)")
@@ -381,6 +386,11 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
             # full adhesion, about the area's origin (as every method here)
             c = mae_calibrated_coefficients(ar, coefficient_table(args.nu),
                                             pair_factors(args.nu))
+        elif args.method in ("dlm", "asm"):
+            from fastsim_ros.contact.asm import asm_fastsim_coefficients
+            from fastsim_ros.contact.dlm import dlm_coefficients
+            seed = dlm_coefficients if args.method == "dlm" else asm_fastsim_coefficients
+            c = seed(ar, nu=args.nu)
         else:
             c = mae_fastsim_coefficients(ar, coefficient_table(args.nu))
         # MAE gives no C~3j: reported as null
@@ -442,6 +452,14 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
                       # an empty zone (a one-sided split) has no semi-ellipse: null axes
                       zones=[{"area": z.area, "a": _or_none(z.a_eq), "b": _or_none(z.b_eq)}
                              for z in (g.zone1, g.zone2)])
+    elif args.method in ("dlm", "asm"):
+        from fastsim_ros.contact.asm import asm_fastsim
+        from fastsim_ros.contact.dlm import dlm_fastsim
+        seed = dlm_fastsim if args.method == "dlm" else asm_fastsim
+        sol = seed(patch, *creepages, mu=args.mu, nu=args.nu, shear_modulus=args.shear_modulus,
+                   bound=args.bound, friction=law, speed=speed)
+        result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
+            np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
     elif args.method == "fastrip":
         from fastsim_ros.contact.fastrip import fastrip
         from fastsim_ros.contact.tables import coefficient_table

@@ -118,3 +118,37 @@ def point_load_displacement(
         scale * nu * x * y / rho**3,
         scale * (1.0 - nu) / rho,
     )
+
+
+def line_influence(
+    x: FloatArray, y_lo: FloatArray, y_hi: FloatArray, *, shear_modulus: float, nu: float
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Integrals of the point-force kernels over a lateral segment: ``(xx, yy, xy)`` (1/Pa).
+
+    The kernels of :func:`point_load_displacement` at ``(x, y)`` integrated
+    over ``y`` from ``y_lo`` to ``y_hi`` (field minus source, m), in closed
+    form: ``int 1/rho dy = asinh(y/|x|)``, ``int x^2/rho^3 dy = y/rho``,
+    ``int y^2/rho^3 dy = asinh(y/|x|) - y/rho``, ``int x y/rho^3 dy =
+    -x/rho``.  The displacement difference of a line load of 1 N/m along
+    ``x`` on that segment, per unit length: a strip's traction integrated
+    across its width.  ``x = 0`` with ``y_lo < 0 < y_hi`` (the field point
+    on the segment) is the kernels' logarithmic singularity: do not ask for
+    it; ``x = 0`` elsewhere is taken as its limit.
+    """
+    ax = np.abs(x)
+    safe = np.where(ax > 0.0, ax, 1.0)
+
+    def primitives(y: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        rho = np.hypot(x, y)
+        r = np.where(rho > 0.0, rho, 1.0)
+        # asinh(y/|x|) at x -> 0 (y != 0): sign(y) log(2|y|/|x|); the |x| cancels between the
+        # two ends of a segment that does not hold y = 0
+        a = np.where(ax > 0.0, np.arcsinh(y / safe),
+                     np.sign(y) * np.log(2.0 * np.maximum(np.abs(y), 1e-300)))
+        return a, np.where(rho > 0.0, y / r, 0.0), np.where(rho > 0.0, -x / r, 0.0)
+
+    a_hi, b_hi, c_hi = primitives(np.asarray(y_hi, dtype=float))
+    a_lo, b_lo, c_lo = primitives(np.asarray(y_lo, dtype=float))
+    a, b, c = a_hi - a_lo, b_hi - b_lo, c_hi - c_lo
+    scale = 1.0 / (np.pi * shear_modulus)
+    return scale * ((1.0 - nu) * a + nu * b), scale * (a - nu * b), scale * nu * c
