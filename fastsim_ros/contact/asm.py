@@ -61,8 +61,9 @@ FloatArray = NDArray[np.float64]
 
 #: the two collocation points of a strip, as fractions of its length from the leading edge,
 #: fitted by ``scripts/validate_seed.py --fit-asm`` (least squares of the relative errors of
-#: C11, C22, C23 against Kalker's table at nu = 0.25, a/b = 0.2, 0.5, 1, 2, 5; 60 strips)
-ASM_COLLOCATION = (0.0888, 0.6938)
+#: C11, C22, C23 against Kalker's published table at nu = 0.25, a/b = 0.2, 0.5, 1, 2, 5;
+#: 60 strips; rms 1.3%)
+ASM_COLLOCATION = (0.0883, 0.6923)
 #: Gauss-Legendre points on each side of a collocation point's own position along a strip
 QUADRATURE_POINTS = 16
 #: the most strips (segments of rows) ASM solves: its dense system has 4 unknowns per strip
@@ -287,7 +288,7 @@ def asm_flexibility(area: GridArea, *, nu: float, shear_modulus: float,
 def fastsim_with(area: GridArea, flex: CalibratedFlexibility, xi: float, eta: float,
                  phi: float, *, bound: FloatArray, reference: tuple[float, float] = (0.0, 0.0),
                  friction: FrictionLaw | None = None, speed: float | None = None) -> Tractions:
-    """Kalker's FastSim on ``area`` with ``flex`` (radial slip rule), creepages about ``reference``."""
+    """FastSim on ``area`` with ``flex`` (radial return), creepages about ``reference``."""
     return fastsim(area, xi, eta, phi, bound=bound, flexibility=flex.strips(area),
                    sweep_point=(flex.x_c, flex.y_c), reference=reference, friction=friction,
                    speed=speed)

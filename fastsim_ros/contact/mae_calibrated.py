@@ -105,12 +105,21 @@ def sweep_integrals(area: GridArea, x_c: float) -> tuple[FloatArray, FloatArray]
 
 
 PairShare = Literal["shared", "zone"]
+#: the calibrated MAE's four rules by name (``without=`` leaves some out: the validation's
+#: leave-one-out check of each rule; the compiled path has every rule)
+RULES = ("pairs", "calibration", "rigid_slip", "bend")
+
+
+def _check_without(without: tuple[str, ...]) -> None:
+    for name in without:
+        if name not in RULES:
+            raise ValueError(f"unknown rule {name!r}: the rules are {RULES}")
 
 
 def zone_coefficients(area: GridArea, geometry: MaeGeometry, table: CoefficientTable,
-                      pairs: PairFactors, *,
-                      share: PairShare = "shared") -> tuple[dict[str, float] | None,
-                                                            dict[str, float] | None]:
+                      pairs: PairFactors, *, share: PairShare = "shared",
+                      without: tuple[str, ...] = ()) -> tuple[dict[str, float] | None,
+                                                              dict[str, float] | None]:
     """Return each zone's ``c11, c22, c23, c13``: pair interaction (rule 1), strip offsets (4).
 
     The pair factors give each half's share of the joined pair's force; their
@@ -128,11 +137,18 @@ def zone_coefficients(area: GridArea, geometry: MaeGeometry, table: CoefficientT
     ``share="zone"``: each half its own factor (the alternative, kept for
     the validation's comparison; the compiled path has the shared rule
     only).  Then :func:`offset_c23` (rule 4).  ``None`` for an empty zone;
-    with the other zone empty the lone (pair) values stand.
+    with the other zone empty the lone (pair) values stand.  ``without``:
+    rules left out (``"pairs"``: every factor 1; ``"bend"``: no rule 4).
     """
     if share not in ("shared", "zone"):
         raise ValueError(f"share must be 'shared' or 'zone', got {share!r}")
+    _check_without(without)
+    if "pairs" in without:
+        pairs = PairFactors(pairs.nu, np.log(np.array([0.05, 20.0])),
+                            np.ones((len(PAIR_NAMES), 2, 2)))
     paired = _paired_coefficients(geometry, table, pairs, share)
+    if "bend" in without:
+        return paired
     lower = area.y < geometry.y_s
     c1, c2 = (None if c is None else offset_c23(area, geometry, zone, rows, c)
               for c, zone, rows in zip(paired, (geometry.zone1, geometry.zone2),
@@ -216,12 +232,35 @@ def calibrated_zone_flexibility(area: GridArea, geometry: MaeGeometry, zone: Zon
     return ZoneFlexibility(d1 / (g * ab * c["c11"]), d1 / (g * ab * c["c22"]), l3, l4)
 
 
+def paper_zone_flexibility(zone: Zone, c: dict[str, float],
+                           shear_modulus: float) -> ZoneFlexibility:
+    """Return the paper's ``L1 .. L4`` of the zone's semi-ellipse for coefficients ``c``.
+
+    :func:`~fastsim_ros.contact.mae.zone_flexibility`'s formulas with the
+    method's (pair-factored, bent) ``c`` in place of the table's: rule 2 left
+    out (the leave-one-out check).
+    """
+    a, b, g = zone.a_eq, zone.b_eq, shear_modulus
+    l4 = math.sqrt(a * b) / (2.0 * g * c["c13"]) if c["c13"] > 0.0 else math.inf
+    return ZoneFlexibility(4.0 * a / (3.0 * g * c["c11"]), 4.0 * a / (3.0 * g * c["c22"]),
+                           math.pi * a**1.5 / (8.0 * g * math.sqrt(b) * c["c23"]), l4)
+
+
 def calibrated_flexibilities(area: GridArea, geometry: MaeGeometry, table: CoefficientTable,
                              pairs: PairFactors, shear_modulus: float, *,
-                             share: PairShare = "shared") -> ZonePair:
-    """Return both zones' calibrated flexibilities (``None`` for an empty zone)."""
+                             share: PairShare = "shared",
+                             without: tuple[str, ...] = ()) -> ZonePair:
+    """Return both zones' calibrated flexibilities (``None`` for an empty zone).
+
+    ``without``: rules left out (:func:`zone_coefficients`'; ``"calibration"``:
+    the paper's flexibilities of the zones' semi-ellipses, :func:`paper_zone_flexibility`).
+    """
+    c1, c2 = zone_coefficients(area, geometry, table, pairs, share=share, without=without)
+    if "calibration" in without:
+        return tuple(None if c is None else paper_zone_flexibility(z, c, shear_modulus)
+                     for c, z in zip((c1, c2), (geometry.zone1, geometry.zone2))
+                     )  # type: ignore[return-value]
     d, s3 = sweep_integrals(area, geometry.x_c)
-    c1, c2 = zone_coefficients(area, geometry, table, pairs, share=share)
     z1 = None if c1 is None else calibrated_zone_flexibility(
         area, geometry, geometry.zone1, True, c1, table, shear_modulus, d, s3)
     z2 = None if c2 is None else calibrated_zone_flexibility(
@@ -233,28 +272,33 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
                            bound: FloatArray, table: CoefficientTable, pairs: PairFactors,
                            shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                            rule: SplitRule = DEFAULT_SPLIT, friction: FrictionLaw | None = None,
-                           speed: float | None = None, share: PairShare = "shared") -> MaeResult:
+                           speed: float | None = None, share: PairShare = "shared",
+                           without: tuple[str, ...] = ()) -> MaeResult:
     """Solve the calibrated MAE + FastSim; arguments as :func:`.mae.mae_fastsim`.
 
     ``pairs``: the pair factors at the table's ``nu``
     (:func:`~fastsim_ros.contact.pairs.pair_factors`); ``share``:
-    :func:`zone_coefficients`'.
+    :func:`zone_coefficients`'; ``without``: rules left out (:data:`RULES`;
+    ``"rigid_slip"``: FastSim's radial return).
     """
     geometry = mae_geometry(area, rule)
-    zones = calibrated_flexibilities(area, geometry, table, pairs, shear_modulus, share=share)
+    zones = calibrated_flexibilities(area, geometry, table, pairs, shear_modulus, share=share,
+                                     without=without)
     flex: StripFlexibility = strip_flexibility(area, geometry, zones)
     res = fastsim(area, xi, eta, phi, bound=bound, flexibility=flex,
                   sweep_point=(geometry.x_c, geometry.y_s), reference=reference,
-                  friction=friction, speed=speed, slip_rule="rigid_slip")
+                  friction=friction, speed=speed,
+                  slip_rule="radial" if "rigid_slip" in without else "rigid_slip")
     return MaeResult(res.fx, res.fy, res.mz, res, geometry, zones)
 
 
 def mae_calibrated_coefficients(area: GridArea, table: CoefficientTable, pairs: PairFactors, *,
                                 reference: tuple[float, float] = (0.0, 0.0),
-                                rule: SplitRule = DEFAULT_SPLIT) -> CreepCoefficients:
+                                rule: SplitRule = DEFAULT_SPLIT,
+                                without: tuple[str, ...] = ()) -> CreepCoefficients:
     """Return the calibrated method's generalised coefficients in full adhesion (no bound)."""
     unbounded = np.where(area.mask, np.inf, 0.0)
     return coefficients_of_solver(
         area.area, lambda xi, eta, phi: mae_calibrated_fastsim(
             area, xi, eta, phi, bound=unbounded, table=table, pairs=pairs, shear_modulus=1.0,
-            reference=reference, rule=rule), reference=reference)
+            reference=reference, rule=rule, without=without), reference=reference)

@@ -133,7 +133,7 @@ def pair_factor(knots: Any, values: Any, t_self: float, t_other: float) -> float
 
 def chord_bend_offset(count: Any, first: Any, last: Any, j_lo: int, j_hi: int,
                       dx: float) -> float:
-    """Return the strip offset (m) of the calibrated MAE's rule 4 for the strips ``j_lo .. j_hi-1``.
+    """Return the strip offset (m) of the calibrated MAE's rule 4 for strips ``j_lo .. j_hi-1``.
 
     ``count[j]``, ``first[j]``, ``last[j]``: strip ``j``'s cells in contact
     and the indices of its first and last such cell (a strip with ``count
