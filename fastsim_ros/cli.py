@@ -456,10 +456,10 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         from fastsim_ros.contact.asm import asm_fastsim
         from fastsim_ros.contact.dlm import dlm_fastsim
         seed = dlm_fastsim if args.method == "dlm" else asm_fastsim
-        sol = seed(patch, *creepages, mu=args.mu, nu=args.nu, shear_modulus=args.shear_modulus,
-                   bound=args.bound, friction=law, speed=speed)
-        result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
-            np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
+        fs = seed(patch, *creepages, mu=args.mu, nu=args.nu, shear_modulus=args.shear_modulus,
+                  bound=args.bound, friction=law, speed=speed)
+        result.update(Fx=fs.fx, Fy=fs.fy, Mz=fs.mz, slip_fraction=float(
+            np.count_nonzero(fs.slip)) / np.count_nonzero(patch.mask))
     elif args.method == "fastrip":
         from fastsim_ros.contact.fastrip import fastrip
         from fastsim_ros.contact.tables import coefficient_table

@@ -38,7 +38,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import asm, dlm  # noqa: E402
-from fastsim_ros.contact.mae_calibrated import sweep_integrals  # noqa: E402
+from fastsim_ros.contact.fastsim import sweep_integrals  # noqa: E402
 
 import validate  # noqa: E402  (the machine line)
 
@@ -93,7 +93,7 @@ def _ellipse(g: float, n: int) -> areas.GridArea:
 
 
 def _coefficients_from_l(ar: areas.GridArea, l1: float, l2: float, l3: float) -> dict[str, float]:
-    """FastSim's full-adhesion coefficients on ``ar`` with ``L1 .. L3`` (G = 1 Pa)."""
+    """Return FastSim's full-adhesion coefficients on ``ar`` with ``L1 .. L3`` (G = 1 Pa)."""
     x_c, _ = asm.centroid(ar)
     d, s3 = sweep_integrals(ar, x_c)
     da = ar.cell_area

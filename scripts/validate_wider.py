@@ -652,7 +652,7 @@ def report(res: dict[str, Any]) -> None:
 
 
 def _c_tolerance(exact_value: float) -> float:
-    """The coefficient target: 5% of the exact value, or 0.05 where that is near zero."""
+    """Return the coefficient target: 5% of the exact value, or 0.05 where that is near zero."""
     return max(0.05 * abs(exact_value), 0.05)
 
 
@@ -663,7 +663,7 @@ def _c_error(e: dict[str, Any], m: str, key: str) -> float:
 
 
 def _c_text(e: dict[str, Any], m: str, key: str) -> str:
-    """A coefficient's error as the target reads it: % of exact, or absolute near zero."""
+    """Return a coefficient's error as the target reads it: % of exact, or absolute near zero."""
     co = e["coefficients"]
     ex = co["exact"][key]
     if abs(ex) >= 1.0:

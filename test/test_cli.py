@@ -274,3 +274,32 @@ def test_calibrated_mae_coefficients_follow_the_exact_theory_on_unequal_halves(c
     # C11 and C22 (unequal halves too) follow as well
     for key in ("C11", "C22"):
         assert c["mae_calibrated"][key] == pytest.approx(c["exact"][key], rel=0.05), key
+
+
+@pytest.mark.parametrize("method, g, want, rel", [
+    # the seed's Table 1 (DLM's numbers) and Kalker's coefficients (Table 2, ASM)
+    ("dlm", "1", (4.49, 4.08), 0.03),
+    ("asm", "1", (4.12, 3.67), 0.02),
+    ("asm", "0.5", (3.62, 3.01), 0.02),
+])
+def test_seed_methods_coefficients_of_ellipses(capsys, method, g, want, rel):
+    rc, out, _ = run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", g,
+                     "--method", method, "--nu", "0.25", "--cells", "60", "--json")
+    assert rc == 0
+    res = json.loads(out)
+    assert res["method"] == method
+    assert res["C11"] == pytest.approx(want[0], rel=rel)
+    assert res["C22"] == pytest.approx(want[1], rel=rel)
+
+
+@pytest.mark.parametrize("method", ["dlm", "asm"])
+def test_seed_methods_forces_saturate_and_refuse_bad_input(capsys, method):
+    base = ["forces", "--shape", "ellipse", "--a", "6e-3", "--b", "4e-3", "--load", "1e4",
+            "--eta", "0", "--phi", "0", "--mu", "0.3", "--cells", "30", "--method", method]
+    rc, out, _ = run(capsys, *base, "--xi", "0.5", "--json")
+    assert rc == 0
+    res = json.loads(out)
+    assert res["Fx"] == pytest.approx(-0.3 * res["N"], rel=1e-9)
+    assert res["slip_fraction"] == 1.0
+    rc, out, err = run(capsys, *base, "--xi", "nan")
+    assert rc == 2 and out == "" and len(err.strip().splitlines()) == 1

@@ -130,3 +130,62 @@ def test_profile_gap_patches_run_from_the_tread_to_the_flange_root():
     assert -y0 > 1.5 * y1
     for p in patches:
         assert p.load == pytest.approx(5e4, rel=1e-6)
+
+
+@pytest.mark.parametrize("ratio", [0.6, 1.7])
+def test_eggs_of_other_proportions_keep_their_area_and_halves(ratio):
+    ar = samples.egg_patch(cells=60, scale=0.01, load=5e4, lead_over_trail=ratio,
+                           a_over_b=1.25)
+    x0, x1, y0, y1 = extents(ar)
+    assert x1 / -x0 == pytest.approx(ratio, rel=0.05)
+    assert (x1 - x0) / (y1 - y0) == pytest.approx(1.25, rel=0.05)
+    assert ar.area == pytest.approx(1e-4, rel=0.03)
+    # the default proportions are the report's egg, bit for bit
+    np.testing.assert_array_equal(samples.egg_patch(cells=30).pressure,
+                                  samples.egg_patch(cells=30, a_over_b=1.0).pressure)
+
+
+def test_crescents_bend_either_way():
+    lead = samples.crescent_patch(cells=40, bend=1.5, a_over_b=0.4)
+    trail = samples.crescent_patch(cells=40, bend=-1.5, a_over_b=0.4)
+    # the horns trailing: the mirror image in x of the horns leading
+    np.testing.assert_array_equal(trail.mask, lead.mask[:, ::-1])
+    assert lead.area == pytest.approx(1.0, rel=0.03)
+    np.testing.assert_array_equal(samples.crescent_patch(cells=30).pressure,
+                                  samples.crescent_patch(cells=30, a_over_b=0.3).pressure)
+
+
+def test_flat_band_is_wide_and_squarer_than_an_ellipse():
+    ar = samples.flat_band_patch(cells=60, scale=0.01, load=5e4, a_over_b=0.25, exponent=4.0)
+    x0, x1, y0, y1 = extents(ar)
+    assert (x1 - x0) / (y1 - y0) == pytest.approx(0.25, rel=0.05)
+    assert ar.area == pytest.approx(1e-4, rel=0.03)
+    assert ar.area / (np.pi * (x1 - x0) * (y1 - y0) / 4) == pytest.approx(1.18, rel=0.03)
+    with pytest.raises(samples.InvalidInputError):
+        samples.flat_band_patch(cells=20, a_over_b=1.5)
+    with pytest.raises(samples.InvalidInputError):
+        samples.flat_band_patch(cells=20, exponent=2.0)
+
+
+def test_asymmetric_lobes_are_one_waisted_area_asymmetric_both_ways():
+    ar = samples.asymmetric_lobes(cells=60, scale=0.01, load=5e4, size=0.6, lead=0.4)
+    assert ar.area == pytest.approx(1e-4, rel=0.03)
+    # one connected area: a flood fill from one cell reaches every cell in contact
+    seen = np.zeros_like(ar.mask)
+    stack = [tuple(int(v) for v in np.argwhere(ar.mask)[0])]
+    while stack:
+        j, i = stack.pop()
+        if 0 <= j < ar.ny and 0 <= i < ar.nx and ar.mask[j, i] and not seen[j, i]:
+            seen[j, i] = True
+            stack += [(j + 1, i), (j - 1, i), (j, i + 1), (j, i - 1)]
+    np.testing.assert_array_equal(seen, ar.mask)
+    counts = ar.mask.sum(axis=1)
+    rows = np.flatnonzero(counts)
+    # a waist: the chords shrink and grow again between the lobes
+    inner = counts[rows[0]:rows[-1] + 1]
+    k = int(np.argmin(inner[len(inner) // 4: 3 * len(inner) // 4])) + len(inner) // 4
+    assert inner[k] < inner[:k].max() and inner[k] < inner[k:].max()
+    jj, ii = np.nonzero(ar.mask)
+    assert ar.x[ii][ar.y[jj] > ar.y[jj].mean()].mean() > ar.x[ii].mean()  # the small one leads
+    with pytest.raises(samples.InvalidInputError):
+        samples.asymmetric_lobes(cells=20, size=-1.0)

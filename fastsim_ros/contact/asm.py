@@ -52,7 +52,8 @@ from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions,
                                               coefficients_of_solver)
 from fastsim_ros.contact.errors import InvalidInputError
-from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, traction_bound
+from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, sweep_integrals,
+                                         traction_bound)
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.influence import line_influence
 from fastsim_ros.contact.traction import Tractions
@@ -92,14 +93,15 @@ def area_strips(area: GridArea) -> Strips:
     rows, starts = np.nonzero(edges == 1)
     _, ends = np.nonzero(edges == -1)
     x0 = area.x0 - 0.5 * area.dx
-    return Strips(area.y[rows], np.full(rows.size, area.dy), x0 + area.dx * starts,
-                  x0 + area.dx * ends)
+    return Strips(area.y[rows], np.full(rows.size, area.dy),
+                  (x0 + area.dx * starts).astype(np.float64),
+                  (x0 + area.dx * ends).astype(np.float64))
 
 
 def ellipse_strips(a: float, b: float, strips: int) -> Strips:
     """Return ``strips`` strips of equal width across an ellipse, chords exact (m)."""
     dy = 2.0 * b / strips
-    y = -b + dy * (np.arange(strips) + 0.5)
+    y = -b + dy * (np.arange(strips, dtype=np.float64) + 0.5)
     half = a * np.sqrt(np.clip(1.0 - (y / b) ** 2, 0.0, None))
     return Strips(y, np.full(strips, dy), -half, half)
 
@@ -220,17 +222,6 @@ def ellipse_coefficients(a_over_b: float, *, nu: float, strips: int = 60,
                          collocation=collocation))
 
 
-def sweep_integrals(area: GridArea, x_c: float) -> tuple[FloatArray, FloatArray]:
-    """FastSim's adhesion integrals per cell, ``d`` (m) and ``s3`` (m^2) about ``x_c``.
-
-    As :func:`fastsim_ros.contact.mae_calibrated.sweep_integrals` (one
-    formula, re-exported here so that ASM and DLM do not reach into the
-    calibrated MAE).
-    """
-    from fastsim_ros.contact.mae_calibrated import sweep_integrals as integrals
-    return integrals(area, x_c)
-
-
 @dataclass(frozen=True)
 class CalibratedFlexibility:
     """One ``L1, L2, L3`` (m/Pa) for the whole area and the sweep point ``(x_c, y_c)`` (m)."""
@@ -288,7 +279,7 @@ def asm_flexibility(area: GridArea, *, nu: float, shear_modulus: float,
 def fastsim_with(area: GridArea, flex: CalibratedFlexibility, xi: float, eta: float,
                  phi: float, *, bound: FloatArray, reference: tuple[float, float] = (0.0, 0.0),
                  friction: FrictionLaw | None = None, speed: float | None = None) -> Tractions:
-    """FastSim on ``area`` with ``flex`` (radial return), creepages about ``reference``."""
+    """Solve FastSim on ``area`` with ``flex`` (radial return), creepages about ``reference``."""
     return fastsim(area, xi, eta, phi, bound=bound, flexibility=flex.strips(area),
                    sweep_point=(flex.x_c, flex.y_c), reference=reference, friction=friction,
                    speed=speed)

@@ -45,10 +45,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.asm import CalibratedFlexibility, centroid, fastsim_with, sweep_integrals
+from fastsim_ros.contact.asm import CalibratedFlexibility, centroid, fastsim_with
 from fastsim_ros.contact.checks import check_material
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
-from fastsim_ros.contact.fastsim import traction_bound
+from fastsim_ros.contact.fastsim import sweep_integrals, traction_bound
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.influence import influence_kernel
 from fastsim_ros.contact.traction import Tractions

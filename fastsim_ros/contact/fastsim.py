@@ -268,6 +268,36 @@ def sweep(bound: FloatArray, x: FloatArray, dx: float, xi: FloatArray | float,
     return out_x, out_y, slip
 
 
+def sweep_integrals(area: GridArea, x_c: float) -> tuple[FloatArray, FloatArray]:
+    """Return per cell ``d`` (m) and ``s3`` (m^2) of FastSim's adhesion march.
+
+    ``d``: the length over which the cell's traction has grown since its
+    segment's front face (half a cell, then a cell per step); ``s3``: the
+    sum of ``(x_mid - x_c) h`` over the same steps, ``x_mid`` each step's
+    middle.  FastSim's full-adhesion traction is ``tau_x = -(xi/L1) d``,
+    ``tau_y = -(eta/L2) d - (phi/L3) s3`` (plus MAE's spin term ``phi (y -
+    y_s) d / L4`` in ``tau_x``).  Zero outside the contact.  The calibrated
+    MAE's rule 2 and the seed's DLM and ASM build their flexibilities on them.
+    """
+    mask = area.mask
+    ny, nx = mask.shape
+    d = np.zeros((ny, nx))
+    s3 = np.zeros((ny, nx))
+    cd = np.zeros(ny)
+    cs = np.zeros(ny)
+    prev = np.zeros(ny, dtype=bool)
+    for i in range(nx - 1, -1, -1):
+        inside = mask[:, i]
+        step = np.where(prev, area.dx, 0.5 * area.dx)
+        x_mid = area.x[i] - x_c + 0.5 * step
+        cd = np.where(inside, np.where(prev, cd, 0.0) + step, 0.0)
+        cs = np.where(inside, np.where(prev, cs, 0.0) + x_mid * step, 0.0)
+        d[:, i] = cd
+        s3[:, i] = cs
+        prev = inside
+    return d, s3
+
+
 def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatArray,
             flexibility: StripFlexibility, sweep_point: tuple[float, float] = (0.0, 0.0),
             reference: tuple[float, float] = (0.0, 0.0), friction: FrictionLaw | None = None,

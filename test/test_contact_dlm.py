@@ -1,0 +1,82 @@
+"""DLM, Kalker's deformation levelling method (the seed's Table 1): pieces and physics."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import samples
+from fastsim_ros.contact.dlm import (Displacements, dlm_coefficients, dlm_fastsim,
+                                     dlm_flexibility, dlm_iteration, level)
+from fastsim_ros.contact.influence import influence_kernel
+
+NU = 0.25
+
+
+def ellipse(g: float, n: int, load: float = 1.0) -> areas.GridArea:
+    a, b = areas.semi_ellipse_axes(g)
+    return areas.ellipse(a, b, nx=n, ny=n, load=load)
+
+
+def test_displacements_equal_the_direct_sum_of_the_influence_coefficients():
+    ar = samples.notched_ellipse(cells=12)
+    rng = np.random.default_rng(3)
+    tx = rng.normal(size=ar.mask.shape) * ar.mask
+    ty = rng.normal(size=ar.mask.shape) * ar.mask
+    ux, uy = Displacements(ar, nu=NU, shear_modulus=2.0)(tx, ty)
+    k = influence_kernel(ar.dx, ar.dy, ar.nx - 1, ar.ny - 1, shear_modulus=2.0, nu=NU)
+    for j, i in [(0, 0), (5, 7), (11, 3)]:
+        # field (j, i), source (l, m): offsets field minus source
+        dj = j - np.arange(ar.ny)[:, None] + ar.ny - 1
+        di = i - np.arange(ar.nx)[None, :] + ar.nx - 1
+        assert ux[j, i] == pytest.approx(float((k.xx[dj, di] * tx + k.xy[dj, di] * ty).sum()),
+                                         rel=1e-10, abs=1e-14)
+        assert uy[j, i] == pytest.approx(float((k.xy[dj, di] * tx + k.yy[dj, di] * ty).sum()),
+                                         rel=1e-10, abs=1e-14)
+
+
+def test_levelling_recovers_the_flexibility_of_a_displacement_proportional_to_traction():
+    rng = np.random.default_rng(0)
+    mask = rng.random((8, 9)) > 0.3
+    tx, ty = rng.normal(size=mask.shape), rng.normal(size=mask.shape)
+    # u = L tau plus a rigid translation per component: levelled exactly
+    assert level([2.5e-11 * tx + 3.0, 2.5e-11 * ty - 1.0], [tx, ty], mask) == pytest.approx(
+        2.5e-11, rel=1e-9)
+    # a uniform traction is a translation itself: nothing to level
+    assert math.isnan(level([tx], [np.ones(mask.shape)], mask))
+
+
+def test_the_iteration_from_the_full_slip_traction_converges_after_one_step():
+    it = dlm_iteration(ellipse(1.0, 40), nu=NU, shear_modulus=1.0, steps=3)
+    for hist in (it.l1, it.l2, it.l3):
+        assert hist[1] == hist[2]  # the adhesion traction's shape does not depend on L
+        assert abs(hist[0] / hist[1] - 1.0) > 0.05  # the full-slip traction's is another L
+
+
+@pytest.mark.parametrize("g, c11, c22", [(1.0, 4.49, 4.08), (10.0, 13.23, 14.53)])
+def test_circle_and_long_ellipse_reproduce_table_1(g, c11, c22):
+    # the seed's Table 1, DLM's numbers (the second of each printed pair): within 3%
+    c = dlm_coefficients(ellipse(g, 60), nu=NU)
+    assert c.C11 == pytest.approx(c11, rel=0.03)
+    assert c.C22 == pytest.approx(c22, rel=0.03)
+    assert c.C13 == pytest.approx(0.0, abs=1e-9)
+
+
+def test_flexibilities_scale_with_length_over_shear_modulus():
+    small = dlm_flexibility(ellipse(0.5, 30), nu=NU, shear_modulus=1.0)
+    big = dlm_flexibility(ellipse(0.5, 30).scaled(3.0), nu=NU, shear_modulus=8.0)
+    for a, b in ((small.l1, big.l1), (small.l2, big.l2), (small.l3, big.l3)):
+        assert b == pytest.approx(a * 3.0 / 8.0, rel=1e-9)
+
+
+def test_dlm_fastsim_saturates_at_mu_n_and_mirrors():
+    ar = samples.two_lobes(cells=30, scale=0.01, load=3e4)
+    sol = dlm_fastsim(ar, 0.5, 0.0, 0.0, mu=0.3, nu=0.28, shear_modulus=8e10)
+    assert sol.fx == pytest.approx(-0.3 * ar.load, rel=1e-9)
+    spin = dlm_fastsim(ar, 0.0, 0.0, 2.0, mu=0.3, nu=0.28, shear_modulus=8e10)
+    mirrored = dlm_fastsim(ar.mirrored_y(), 0.0, 0.0, 2.0, mu=0.3, nu=0.28, shear_modulus=8e10)
+    assert mirrored.fx == pytest.approx(-spin.fx, rel=1e-9, abs=1e-9 * ar.load)
+    assert mirrored.fy == pytest.approx(spin.fy, rel=1e-9)
