@@ -31,7 +31,9 @@ from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.publisher import Publisher
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.subscription import Subscription
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import PoseStamped, TwistStamped, Vector3Stamped, WrenchStamped
@@ -105,7 +107,10 @@ class FastsimNode(Node):
         depth = int(config["qos_depth"])
         qos_in = _qos(config["patch_reliability"], depth)
         qos_out = _qos(config["output_reliability"], depth)
-        self._pubs: dict[str, Any] = {}
+        # every topic by its name as configured: the diagnostics report how many
+        # peers each has matched (publishers of an input, subscribers of an output)
+        self._pubs: dict[str, Publisher] = {}
+        self._subs: dict[str, Subscription] = {}
         for c in config.contacts:
             for kind, msgtype in _MESSAGE_TYPES.items():
                 topic = f"contact/{c}/{kind}"
@@ -114,19 +119,44 @@ class FastsimNode(Node):
             WrenchStamped, WHEELSET_WRENCH_TOPIC, qos_out)
         self._pubs[MARKERS_TOPIC] = self.create_publisher(MarkerArray, MARKERS_TOPIC, qos_out)
         self._diagnostics = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
-        self.create_subscription(TwistStamped, WHEEL_TWIST_TOPIC, self._on_wheel_twist, qos_in,
-                                 raw=True)
-        self.create_subscription(TwistStamped, RAIL_TWIST_TOPIC, self._on_rail_twist, qos_in,
-                                 raw=True)
+        self._subscribe(TwistStamped, WHEEL_TWIST_TOPIC, self._on_wheel_twist, qos_in)
+        self._subscribe(TwistStamped, RAIL_TWIST_TOPIC, self._on_rail_twist, qos_in)
         for c in config.contacts:
-            self.create_subscription(PointCloud2, patch_topic(c), self._patch_callback(c),
-                                     qos_in, raw=True)
-        self.create_timer(1.0, self._publish_diagnostics)
+            self._subscribe(PointCloud2, patch_topic(c), self._patch_callback(c), qos_in)
+        self.create_timer(float(config["diagnostics_period"]), self._publish_diagnostics)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self.get_logger().info(
             f"solving {', '.join(config.contacts)} with {config['method']} "
             f"(mu {config['friction_coefficient']:g}, bound {config['traction_bound']}); "
             f"kernels ready in {warm:.2f} s")
+
+    def _subscribe(self, msgtype: Any, topic: str, callback: Callable[[bytes], None],
+                   qos: QoSProfile) -> None:
+        """Subscribe to ``topic`` raw (CDR bytes to ``callback``)."""
+        self._subs[topic] = self.create_subscription(msgtype, topic, callback, qos, raw=True)
+
+    def connections(self) -> dict[str, list[tuple[str, str]]]:
+        """Return each contact's matched peers as diagnostic key-values.
+
+        ``publishers/<topic>`` for the contact's patch and the twists,
+        ``subscribers/<topic>`` for its outputs and the shared ones: the
+        counts DDS matched on the node's side, which a client cannot see
+        from its own (a message sent before both sides matched is lost).
+        """
+        shared = [(f"publishers/{t}", str(s.get_publisher_count()))
+                  for t, s in self._subs.items() if not t.startswith("contact/")]
+        shared += [(f"subscribers/{t}", str(p.get_subscription_count()))
+                   for t, p in self._pubs.items() if not t.startswith("contact/")
+                   or t == MARKERS_TOPIC]
+        out: dict[str, list[tuple[str, str]]] = {}
+        for c in self.pipeline.config.contacts:
+            own = f"contact/{c}/"
+            out[c] = [(f"publishers/{t}", str(s.get_publisher_count()))
+                      for t, s in self._subs.items() if t.startswith(own)]
+            out[c] += [(f"subscribers/{t}", str(p.get_subscription_count()))
+                       for t, p in self._pubs.items() if t.startswith(own)]
+            out[c] += shared
+        return out
 
     def _on_wheel_twist(self, raw: bytes) -> None:
         verdict = self.pipeline.on_wheel_twist(raw)
@@ -156,7 +186,8 @@ class FastsimNode(Node):
             pubs[topic].publish(msg)
 
     def _publish_diagnostics(self) -> None:
-        self._diagnostics.publish(self.pipeline.diagnostics(self.get_clock().now().nanoseconds))
+        self._diagnostics.publish(self.pipeline.diagnostics(
+            self.get_clock().now().nanoseconds, self.connections()))
 
     def _on_set_parameters(self, changes: list[Parameter]) -> SetParametersResult:
         values = {}

@@ -468,17 +468,20 @@ class Pipeline:
                                                                w.torque)))
         return msgs
 
-    def diagnostics(self, stamp_ns: int) -> Any:
+    def diagnostics(self, stamp_ns: int,
+                    extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> Any:
         """Return the ``DiagnosticArray`` at ``stamp_ns``: one status per contact.
 
         Each carries the twist counts too (``twists/<what>``: taken for the
-        wheel and the rail, dropped by reason), the kinematics being shared.
+        wheel and the rail, dropped by reason), the kinematics being shared,
+        then the key-values ``extra[contact]`` if given (the node's connections).
         """
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
         statuses: list[tuple[str, int, str, Sequence[tuple[str, str]]]] = []
         for c in self.config.contacts:
             r = self.report(c)
-            statuses.append((r.name, r.level, r.message, r.values + twists))
+            more = tuple(extra.get(c, ())) if extra is not None else ()
+            statuses.append((r.name, r.level, r.message, r.values + twists + more))
         return out.diagnostic_array(stamp_ns, statuses)
 
     # ---------------------------------------------------------------- diagnostics
