@@ -433,10 +433,10 @@ class Pipeline:
     def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
         """Return the ``(topic, message)`` pairs to publish for an outcome, in order.
 
-        Per-patch messages come as CDR bytes, the rest as message objects
-        (INTERFACE.md "Outputs"): the contact's wrench and creepage, its
-        frame when it moved, its traction cloud when asked for, its marker
-        when due, and the wheelset wrench when the rig cycle is complete.
+        Each as CDR bytes (INTERFACE.md "Outputs"): the contact's wrench and
+        creepage, its frame when it moved, its traction cloud when asked
+        for, its marker when due, and the wheelset wrench when the rig cycle
+        is complete.
         """
         if not outcome.has_wrench:
             return []
@@ -454,14 +454,14 @@ class Pipeline:
                 msgs.append((base + "frame", out.pose_cdr(stamp, frame_id, outcome.frame)))
             if (f.tau_x is not None and f.tau_y is not None and f.slip is not None
                     and f.grid is not None):
-                msgs.append((base + "traction", out.traction_cloud(
+                msgs.append((base + "traction", out.traction_cloud_cdr(
                     stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid)))
         if outcome.markers:
             index = self.config.contacts.index(c)
             fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)
-            marker = out.force_marker(stamp, frame_id, index, c, outcome.frame, fx, fy,
-                                      float(self.config["marker_scale"]))
-            msgs.append((MARKERS_TOPIC, out.marker_array([marker])))
+            msgs.append((MARKERS_TOPIC, out.force_marker_cdr(
+                stamp, frame_id, index, c, outcome.frame, fx, fy,
+                float(self.config["marker_scale"]))))
         w = outcome.wheelset
         if w is not None:
             msgs.append((WHEELSET_WRENCH_TOPIC, out.wrench_cdr(w.stamp_ns, frame_id, w.force,
