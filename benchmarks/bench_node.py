@@ -324,9 +324,8 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
         for target in order:
             runs[target].append(run(contacts, rate, seconds, 0.0, executor, node_args,
                                     target))
-    med = {t: {k: statistics.median(f[k] for f in runs[t]) for k in ("received", "p50",
-                                                                          "p99", "cpu")}
-           for t in runs}
+    keys = ("received", "p50", "p99", "cpu")
+    med = {t: {k: statistics.median(f[k] for f in runs[t]) for k in keys} for t in runs}
     n, f = med["node"], med["floor"]
     print(f"medians of {rounds} alternating runs, {contacts} contacts x {rate:g} Hz, "
           f"{seconds:g} s each:")

@@ -25,11 +25,11 @@ def stamp_of(msg):
 @pytest.mark.parametrize("frame_id", FRAMES)
 @pytest.mark.parametrize("stamp", STAMPS)
 def test_stamped_doubles_decode_to_the_messages(frame_id, stamp):
-    w = deserialize_message(cdr.stamped_doubles(stamp, frame_id, (1.5, -2.0, 3e5, 0.0, -0.0,
-                                                                 math.pi)), WrenchStamped)
+    values = (1.5, -2.0, 3e5, 0.0, -0.0, math.pi)
+    w = deserialize_message(cdr.stamped_doubles(stamp, frame_id, values), WrenchStamped)
     assert stamp_of(w) == stamp and w.header.frame_id == frame_id
     assert (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z, w.wrench.torque.x,
-            w.wrench.torque.y, w.wrench.torque.z) == (1.5, -2.0, 3e5, 0.0, -0.0, math.pi)
+            w.wrench.torque.y, w.wrench.torque.z) == values
     v = deserialize_message(cdr.stamped_doubles(stamp, frame_id, (1e-3, 2e-3, -0.5)),
                             Vector3Stamped)
     assert (v.vector.x, v.vector.y, v.vector.z) == (1e-3, 2e-3, -0.5)
@@ -50,7 +50,7 @@ def test_a_template_returns_copies():
 
 
 def reference_marker(stamp, wheelset_frame, index, contact, frame, fx, fy, scale):
-    """The marker as rclpy builds it (what the encoder must stand for)."""
+    """Return the marker as rclpy builds it (what the encoder must stand for)."""
     m = Marker()
     m.header.stamp.sec, m.header.stamp.nanosec = divmod(stamp, 1_000_000_000)
     m.header.frame_id = wheelset_frame
