@@ -2,7 +2,8 @@
 
 Usage (INTERFACE.md, "The offline replay fastsim_replay")::
 
-    fastsim_replay IN [IN ...] -o OUT [--params FILE] [--plot] [--csv] [--jobs N]
+    fastsim_replay IN [IN ...] -o OUT [--params FILE] [--namespace NS] [--plot] [--csv]
+                   [--jobs N]
 
 Each ``IN`` (a rosbag2 directory, or a single ``.mcap``) named ``NAME`` (the
 directory's name, or the file's without ``.mcap``) gives:
@@ -30,8 +31,13 @@ directory's name, or the file's without ``.mcap``) gives:
   0 and ``xi, eta, phi, V, slip_fraction`` blank (undefined: no contact).
 
 Messages are fed to :class:`~fastsim_ros.pipeline.Pipeline` in the bag's
-log-time order, raw CDR as read.  Without ``--params`` every parameter has
-its default.  Everything is written under a temporary name inside ``OUT``
+log-time order, raw CDR as read.  Topic names resolve as ROS resolves them:
+a bag's relative names are in the root namespace, the node's in
+``--namespace`` (default ``/``: patches on ``NS/contact/<name>/patch``,
+outputs under ``NS``, ``/diagnostics`` absolute).  Without ``--params``
+every parameter has its default and the contacts are those with a
+``NS/contact/<name>/patch`` topic in the bag, in the bag's order (the
+summary names them).  Everything is written under a temporary name inside ``OUT``
 and renamed at the end; on failure, Ctrl-C or SIGTERM nothing is left of
 an unfinished input (inputs already done, whose summaries were printed, stay).
 A progress bar (tqdm, on stderr) appears when stderr is a terminal, ``--jobs``
@@ -61,8 +67,9 @@ from fastsim_ros.replay.cli import main, parser
 from fastsim_ros.replay.errors import BadInput, OutputError
 from fastsim_ros.replay.records import CSV_HEADER
 from fastsim_ros.replay.results import Profile, Result
-from fastsim_ros.replay.run import PARAMETERS_KEY, PROG, Task, replay_bag, run_task, targets
+from fastsim_ros.replay.run import (PARAMETERS_KEY, PROG, Task, bag_contacts, replay_bag,
+                                    resolve, run_task, targets)
 
 __all__ = ["BadInput", "CSV_HEADER", "OutputError", "PARAMETERS_KEY", "PROG", "Pipeline",
-           "Profile", "Result", "Task", "input_name", "main", "output_topics", "parser",
-           "replay_bag", "run_task", "targets"]
+           "Profile", "Result", "Task", "bag_contacts", "input_name", "main", "output_topics",
+           "parser", "replay_bag", "resolve", "run_task", "targets"]

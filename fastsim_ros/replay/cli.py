@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shutil
 import signal
 import sys
@@ -32,7 +33,11 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
                    help="output directory (made if missing)")
     p.add_argument("--params", type=Path, metavar="FILE",
-                   help="the node's ROS 2 parameter file (default: every default)")
+                   help="the node's ROS 2 parameter file (default: every default, and the "
+                        "contacts those with a patch topic in the bag)")
+    p.add_argument("--namespace", type=namespace, default="/", metavar="NS",
+                   help="the node's namespace: patches on NS/contact/<name>/patch, outputs "
+                        "under NS (default /; a bag's relative topic names are in /)")
     p.add_argument("--plot", action="store_true", help="write OUT/NAME.png")
     p.add_argument("--csv", action="store_true", help="write OUT/NAME.csv, one row per wrench")
     p.add_argument("--jobs", type=_jobs, default=1, metavar="N",
@@ -40,6 +45,26 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--no-progress", action="store_true",
                    help="no progress bar (it shows only on a terminal anyway)")
     return p
+
+
+_TOKEN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def namespace(text: str) -> str:
+    """Return a ROS namespace made absolute (``rig1`` -> ``/rig1``); refuse a malformed one.
+
+    Tokens of letters, digits and underscores, not starting with a digit,
+    separated by single slashes (ROS 2 name rules); ``/`` is the root.
+    """
+    name = text if text.startswith("/") else "/" + text
+    if name == "/":
+        return name
+    tokens = name[1:].split("/")
+    if not all(_TOKEN.match(t) for t in tokens):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a ROS namespace (tokens of letters, digits and underscores, "
+            "not starting with a digit, separated by single slashes)")
+    return name
 
 
 def _jobs(text: str) -> int:
@@ -93,7 +118,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     tag = f"{os.getpid()}"
     jobs = min(args.jobs, len(names))
-    tasks = [Task(src, name, out, values, plot=args.plot, write_csv=args.csv, tag=tag,
+    tasks = [Task(src, name, out, values, plot=args.plot, write_csv=args.csv,
+                  contacts_from_bag=args.params is None, namespace=args.namespace, tag=tag,
                   progress=not args.no_progress and jobs == 1)
              for name, src in names.items()]
     previous = signal.signal(signal.SIGTERM, _terminate)

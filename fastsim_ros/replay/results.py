@@ -47,6 +47,8 @@ class Result:
     wall_s: float = 0.0
     plot_s: float = 0.0
     contacts: tuple[str, ...] = ()
+    contacts_found: tuple[str, ...] = ()
+    namespace: str = "/"
     counts: dict[str, dict[str, int]] = field(default_factory=dict)
     solve_us: dict[str, tuple[float, float]] = field(default_factory=dict)
     kinematics: dict[str, int] = field(default_factory=dict)
@@ -68,6 +70,12 @@ class Result:
         where = self.written[0] if self.written else "-"
         lines = [f"{self.name}: {self.messages_in} messages in ({self.duration_s:.3f} s of "
                  f"log), {self.messages_out} written -> {where}"]
+        if self.contacts_found:
+            lines.append(f"  contacts found in the bag (no --params): "
+                         f"{', '.join(self.contacts_found)}"
+                         + (f"; namespace {self.namespace}" if self.namespace != "/" else ""))
+        elif self.namespace != "/":
+            lines.append(f"  namespace {self.namespace}")
         for c in self.contacts:
             k = self.counts[c]
             patches = sum(k.values())

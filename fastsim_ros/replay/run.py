@@ -28,6 +28,7 @@ from typing import Any
 
 from rclpy.serialization import serialize_message
 
+from fastsim_ros.params import SPECS, ParameterError
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, Pipeline, PipelineConfig,
                                   output_topics)
 from fastsim_ros.replay import bagio
@@ -49,9 +50,11 @@ class Task:
     """One input to replay (picklable: executors send it to their workers).
 
     ``source``: the bag; ``name``: its NAME; ``out``: the output directory;
-    ``values``: the parameters (checked again by the pipeline); ``tag``:
-    this run's mark on temporary names (so the main process can clean up
-    after an interrupt).
+    ``values``: the parameters (checked again by the pipeline);
+    ``contacts_from_bag``: take the contacts from the bag's patch topics
+    instead of ``values`` (no ``--params``); ``namespace``: the node's
+    (absolute); ``tag``: this run's mark on temporary names (so the main
+    process can clean up after an interrupt).
     """
 
     source: Path
@@ -60,6 +63,8 @@ class Task:
     values: dict[str, Any]
     plot: bool = False
     write_csv: bool = False
+    contacts_from_bag: bool = False
+    namespace: str = "/"
     tag: str = ""
     progress: bool = False
 
@@ -74,30 +79,34 @@ def targets(out: Path, name: str, plot: bool, write_csv: bool) -> list[Path]:
     return paths
 
 
-def run_task(task: Task) -> Result:
-    """Replay one task (what executors run); see :func:`replay_bag`."""
-    return replay_bag(task.source, task.name, task.out, task.values, plot=task.plot,
-                      write_csv=task.write_csv, tag=task.tag, progress=task.progress)
-
-
 def replay_bag(source: Path, name: str, out: Path, values: dict[str, Any], *,
-               plot: bool = False, write_csv: bool = False, tag: str = "",
-               progress: bool = True, profile: bool = False) -> Result:
-    """Replay one input into ``out`` (atomically); return its :class:`Result`.
+               plot: bool = False, write_csv: bool = False, contacts_from_bag: bool = False,
+               namespace: str = "/", tag: str = "", progress: bool = True,
+               profile: bool = False) -> Result:
+    """Replay one input into ``out``: :func:`run_task` of the :class:`Task` of these options."""
+    return run_task(Task(source, name, out, values, plot, write_csv, contacts_from_bag,
+                         namespace, tag, progress), profile=profile)
 
-    Never raises for a bad input or an unwritable output: ``Result.ok`` is
-    False, ``status`` 2 (bad input) or 1 (output or internal error) and
-    ``error`` one line naming the file.  KeyboardInterrupt and SystemExit
-    propagate, after the temporary files are removed.
+
+def run_task(task: Task, *, profile: bool = False) -> Result:
+    """Replay one input into its ``out`` (atomically); return its :class:`Result`.
+
+    What every executor runs.  Never raises for a bad input or an
+    unwritable output: ``Result.ok`` is False, ``status`` 2 (bad input) or
+    1 (output or internal error) and ``error`` one line naming the file.
+    KeyboardInterrupt and SystemExit propagate, after the temporary files
+    are removed.  ``profile``: time each phase
+    (:class:`~fastsim_ros.replay.results.Profile`, for the benchmark).
     """
+    source, name, out = task.source, task.name, task.out
     result = Result(str(source), name)
-    staging = out / f".{name}.{tag or os.getpid()}.replay-tmp"
+    staging = out / f".{name}.{task.tag or os.getpid()}.replay-tmp"
     done = False
     try:
         staging.mkdir()
         with bagio.fast_yaml():
-            _replay(source, name, staging, values, plot, write_csv, progress, profile, result)
-        for tmp in targets(staging, name, plot, write_csv):
+            _replay(task, staging, profile, result)
+        for tmp in targets(staging, name, task.plot, task.write_csv):
             final = out / tmp.name
             if os.path.lexists(final):
                 raise OutputError(f"{final}: appeared while replaying; not overwritten")
@@ -131,17 +140,45 @@ def _progress(name: str, total: int, enabled: bool) -> Any:
                 dynamic_ncols=True)
 
 
-def _absolute(topic: str) -> str:
-    return topic if topic.startswith("/") else "/" + topic
+def resolve(topic: str, namespace: str = "/") -> str:
+    """Return the absolute name of ``topic`` in ``namespace``, as ROS resolves it.
+
+    An absolute name stays; a relative one is put under the namespace (a
+    bag's topic names resolve in the root namespace).
+    """
+    if topic.startswith("/"):
+        return topic
+    return f"{namespace.rstrip('/')}/{topic}"
 
 
-def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot: bool,
-            write_csv: bool, progress: bool, profile: bool, result: Result) -> None:
+def _contact_name(name: str) -> bool:
+    try:
+        SPECS["contacts"].check((name,))
+    except ParameterError:
+        return False
+    return True
+
+
+def bag_contacts(topics: list[str], namespace: str) -> tuple[str, ...]:
+    """Return the contacts with a ``contact/<name>/patch`` topic under ``namespace``.
+
+    In the order of ``topics`` (the bag's connections), each once; only
+    names the ``contacts`` parameter accepts.
+    """
+    prefix = resolve("contact/", namespace)
+    found: list[str] = []
+    for topic in topics:
+        topic = resolve(topic)
+        if topic.startswith(prefix) and topic.endswith("/patch"):
+            name = topic[len(prefix):-len("/patch")]
+            if name not in found and _contact_name(name):
+                found.append(name)
+    return tuple(found)
+
+
+def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
     start_wall = time.perf_counter()
-    config = PipelineConfig.from_values(values)
-    pipeline = Pipeline(config)
-    contacts = config.contacts
-    result.contacts = contacts
+    source, name, namespace = task.source, task.name, task.namespace
     prof = Profile() if profile else None
     result.profile = prof
     clock = time.perf_counter_ns
@@ -150,26 +187,44 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
     try:
         if reader.message_count == 0:
             raise BadInput(f"{source}: empty bag (no messages)")
-        absolute = {_absolute(t): msgtype for t, msgtype in output_topics(contacts).items()}
-        inputs = {_absolute(i.topic): i for i in pipeline.inputs()}
-        if not any(conn.topic in inputs and inputs[conn.topic].kind not in _KINEMATICS
+        values = task.values
+        found: tuple[str, ...] = ()
+        if task.contacts_from_bag:
+            found = bag_contacts([conn.topic for conn in reader.connections], namespace)
+            if found:
+                values = dict(values, contacts=list(found))
+        config = PipelineConfig.from_values(values)
+        pipeline = Pipeline(config)
+        contacts = config.contacts
+        result.contacts = contacts
+        result.contacts_found = found
+        result.namespace = namespace
+        absolute = {resolve(t, namespace): msgtype
+                    for t, msgtype in output_topics(contacts).items()}
+        inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
+        if not any(resolve(conn.topic) in inputs
+                   and inputs[resolve(conn.topic)].kind not in _KINEMATICS
                    for conn in reader.connections):
             result.warnings.append(
-                f"{source}: no patch topic of the configured contacts "
-                f"({', '.join(contacts)}); nothing solved (is --params right?)")
+                f"{source}: no patch topic "
+                + (f"under {namespace} (no --params: the contacts are those with a "
+                   f"{resolve('contact/<name>/patch', namespace)} topic)"
+                   if task.contacts_from_bag else
+                   f"of the configured contacts ({', '.join(contacts)})")
+                + "; nothing solved (are --params and --namespace right?)")
         writer = bagio.open_writer(staging / name, {
             PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
             "fastsim.input": str(source), "fastsim.replay": PROG})
         qos_out = bagio.qos(config["output_reliability"], int(config["qos_depth"]))
         csv_file = None
         rows = None
-        if write_csv:
+        if task.write_csv:
             csv_file = open(staging / f"{name}.csv", "w", newline="", encoding="utf-8")
             rows = csv.writer(csv_file, lineterminator="\n")
             rows.writerow(CSV_HEADER)
         series = {c: Series() for c in contacts}
         method, law = str(config["method"]), str(config["friction_law"])
-        bar = _progress(name, reader.message_count, progress)
+        bar = _progress(name, reader.message_count, task.progress)
         with writer:
             copies = bagio.copy_connections(reader, writer, set(absolute))
             conns: dict[str, Any] = {}
@@ -183,6 +238,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
                 writer.write(conn, log_ns, data)
                 result.messages_out += 1
 
+            diagnostics = resolve(DIAGNOSTICS_TOPIC, namespace)
             first: int | None = None
             last: int | None = None
             next_diag = 0
@@ -199,7 +255,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
                 if bar is not None and result.messages_in % _PROGRESS_EVERY == 0:
                     bar.update(_PROGRESS_EVERY)
                 if log_ns >= next_diag:
-                    put(DIAGNOSTICS_TOPIC, log_ns, serialize_message(
+                    put(diagnostics, log_ns, serialize_message(
                         pipeline.diagnostics(log_ns)))
                     next_diag += ((log_ns - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
                 copy = copies.get(conn.id)
@@ -209,7 +265,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
                     result.messages_out += 1
                     if prof is not None:
                         prof.copy.append(clock() - t0)
-                source_topic = inputs.get(conn.topic)
+                source_topic = inputs.get(resolve(conn.topic))
                 if source_topic is not None:
                     t0 = clock()
                     outcomes = source_topic.take(raw)
@@ -223,7 +279,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
                                  else serialize_message(m)) for t, m in msgs]
                         t2 = clock()
                         for rel, payload in data:
-                            put(_absolute(rel), log_ns, payload)
+                            put(resolve(rel, namespace), log_ns, payload)
                         if prof is not None:
                             prof.emit.append(t2 - t1)
                             prof.write.append(clock() - t2)
@@ -236,7 +292,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
                 t_read = clock()
             if first is None or last is None:
                 raise BadInput(f"{source}: empty bag (no messages)")
-            put(DIAGNOSTICS_TOPIC, last, serialize_message(pipeline.diagnostics(last)))
+            put(diagnostics, last, serialize_message(pipeline.diagnostics(last)))
             result.duration_s = (last - first) * 1e-9
         if bar is not None:
             bar.close()
@@ -246,7 +302,7 @@ def _replay(source: Path, name: str, staging: Path, values: dict[str, Any], plot
         result.kinematics = dict(pipeline.kinematics_counts)
         if csv_file is not None:
             csv_file.close()
-        if plot:
+        if task.plot:
             plot_start = time.perf_counter()
             write_plot(staging / f"{name}.png", name, contacts, series,
                        float(config["friction_coefficient"]))
