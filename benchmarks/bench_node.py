@@ -211,12 +211,15 @@ def target_command(target: str, names: list[str], executor: str,
 
 
 def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
-        node_args: list[str], target: str = "node") -> dict[str, float]:
+        node_args: list[str], target: str = "node",
+        py_spy: str | None = None) -> dict[str, float]:
     """Drive the node (or the floor) with ``contacts`` contacts at ``rate`` Hz each.
 
     Prints the figures and returns them: ``received`` (share of the patches
     answered, %), ``p50``, ``p99`` (latency, ms), ``cpu`` (the target's share
-    of one core, %), ``late`` (times the driver re-anchored).
+    of one core, %), ``late`` (times the driver re-anchored).  ``py_spy``: a
+    file to which py-spy (``pip install py-spy``) writes the target's
+    sampled stacks over the run (collapsed, the flame graph format).
     """
     names = [f"c{k}" for k in range(contacts)]
     proc = subprocess.Popen(target_command(target, names, executor, node_args),
@@ -256,6 +259,14 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
     duration = soak * 60.0 if soak else seconds
     period = 1.0 / rate
     rss = [(0.0, rss_mib(proc.pid))]
+    spy = None
+    if py_spy:
+        duration_s = soak * 60.0 if soak else seconds
+        spy = subprocess.Popen([str(Path(sys.executable).parent / "py-spy"), "record",
+                                "--pid", str(proc.pid), "--rate", "250", "--nonblocking",
+                                "--format", "raw", "--duration", str(int(duration_s)),
+                                "--output", py_spy],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     cpu0, wall0 = cpu_seconds(proc.pid), time.perf_counter()
     t_next = wall0
     stamp = 1_700_000_000 * 1_000_000_000
@@ -287,6 +298,8 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
     while time.perf_counter() - drain < 1.0:
         ex.spin_once(timeout_sec=0.01)
     rss.append((time.perf_counter() - wall0, rss_mib(proc.pid)))
+    if spy is not None:
+        spy.wait(30)
     proc.send_signal(signal.SIGTERM)
     status = proc.wait(10)
     node.destroy_node()
@@ -356,6 +369,8 @@ def main() -> None:
                         help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
                         help="first time the per-message path in-process")
+    parser.add_argument("--py-spy", default=None, metavar="FILE",
+                        help="record the node with py-spy (collapsed stacks to FILE)")
     parser.add_argument("--floor", type=int, default=0, metavar="ROUNDS",
                         help="drive the node and the DDS floor (dds_floor.py) alternately, "
                         "ROUNDS times each, and print node/floor ratios of the medians")
@@ -374,7 +389,7 @@ def main() -> None:
                               shlex.split(args.node_args))
             else:
                 run(n, args.rate, args.seconds, args.soak, executor,
-                    shlex.split(args.node_args))
+                    shlex.split(args.node_args), py_spy=args.py_spy)
 
 
 if __name__ == "__main__":
