@@ -378,3 +378,24 @@ def test_egg_with_the_longer_half_trailing_c23_near_exact(table, pairs):
     c = mae_calibrated_coefficients(samples.egg_patch(cells=60, lead_over_trail=0.5), table,
                                     pairs)
     assert c.C23 == pytest.approx(c23_exact, abs=0.05)
+
+
+def test_a_bend_whose_horns_trail_leaves_c23_alone(table, pairs, solver):
+    # the mirror image in x of a horns-leading crescent: its bend offset is negative, and
+    # rule 4 only raises c23 (a lower c23 would halve the lateral force under spin)
+    ar = samples.crescent_patch(cells=40, bend=-1.5, a_over_b=0.35)
+    geo = mae_geometry(ar)
+    lower = ar.y < geo.y_s
+    for rows in (lower, ~lower):
+        count, first, last = row_extents(ar.mask & rows[:, None])
+        assert chord_bend_offset(count, first, last, 0, ar.ny, ar.dx) < -0.03 * math.sqrt(
+            ar.area)
+    assert zone_coefficients(ar, geo, table, pairs) == _paired_coefficients(
+        geo, table, pairs, "shared")
+    loaded = samples.crescent_patch(cells=40, scale=0.01, load=3e4, bend=-1.5, a_over_b=0.35)
+    bound = traction_bound(loaded, MU)
+    for creep in ((0.0, 0.0, 2.0), (1e-4, 2e-4, 0.5)):
+        ref = mae_calibrated_fastsim(loaded, *creep, bound=bound, table=table, pairs=pairs,
+                                     shear_modulus=G)
+        res = solver.solve(loaded, *creep, mu=MU)
+        assert_forces(res, ref.fx, ref.fy, ref.mz, size(loaded))

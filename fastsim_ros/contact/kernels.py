@@ -274,8 +274,6 @@ def kalker_flexibility(a, b, c11, c22, c23, shear_modulus):
 LAW_CONSTANT = rules.LAW_CONSTANT
 LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
 
-#: :data:`fastsim_ros.contact.rules.MIN_OFFSET_C23_SHARE` (frozen into the kernels)
-MIN_OFFSET_C23_SHARE = rules.MIN_OFFSET_C23_SHARE
 
 #: :func:`fastsim_ros.contact.rules.rigid_slip_return`,
 #: :func:`~fastsim_ros.contact.rules.pair_factor` and
@@ -828,7 +826,8 @@ def calibrate(p, x0, y0, dx, dy, strips, geo, shear_modulus, knots, polys, pair_
         c23 = lone23 * s23
         offset = (chord_bend_offset(strips[0], strips[1], strips[2], 0, f, dx) if z == 0
                   else chord_bend_offset(strips[0], strips[1], strips[2], f, ny, dx))
-        c23 = max(c23 + c22 * offset / math.sqrt(ab), MIN_OFFSET_C23_SHARE * c23)
+        # (a bend whose horns trail is left out: rule 4 only raises c23)
+        c23 = c23 + c22 * max(offset, 0.0) / math.sqrt(ab)
         g = shear_modulus
         d1 = (d1_1 if z == 0 else d1_2) * da
         d3 = (d3_1 if z == 0 else d3_2) * da

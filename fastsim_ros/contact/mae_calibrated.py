@@ -69,7 +69,7 @@ from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone
                                      ZoneFlexibility, ZonePair, row_extents, mae_geometry,
                                      strip_flexibility, zone_flexibility)
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
-from fastsim_ros.contact.rules import MIN_OFFSET_C23_SHARE, chord_bend_offset
+from fastsim_ros.contact.rules import chord_bend_offset
 from fastsim_ros.contact.tables import CoefficientTable
 
 FloatArray = NDArray[np.float64]
@@ -164,20 +164,31 @@ def offset_c23(area: GridArea, geometry: MaeGeometry, zone: Zone, rows: NDArray[
     the strips' mean centre less the centroid
     (:func:`~fastsim_ros.contact.rules.chord_bend_offset`: centres that
     move in proportion to the chord, as an egg's, do not count, the exact
-    theory shows them doing nothing).  For a straight zone (every ellipse
-    and semi-ellipse) nothing changes.  Evidence (docs/validation_wider.md,
-    section 6): the first form (every offset counted, each strip once) took
-    the crescent's C~23 from -12.4% to -1.7% but put eggs whose longer half
-    trails up to 0.16 above the exact value (C~23 0.91); this form keeps
-    the crescents and brings the eggs within 0.04 (no parameter fitted).
-    ``c23`` is kept at least :data:`MIN_OFFSET_C23_SHARE` of its straight
-    value.
+    theory shows them doing nothing), where it is positive (the horns
+    lead).  For a straight zone (every ellipse and semi-ellipse) nothing
+    changes.
+
+    Evidence (docs/validation_wider.md, section 6): the first form (every
+    offset counted, each strip once) took the crescent's C~23 from -12.4%
+    to -1.7% but put eggs whose longer half trails up to 0.16 above the
+    exact value (C~23 0.91); counting the bend alone brings the eggs within
+    0.04 and keeps the crescents (no parameter fitted).  Why a bend whose
+    horns trail is left out: the rule acts through the zone's spin
+    flexibility (rule 2 calibrates ``L3`` to ``c23``), and lowering ``c23``
+    by a third or more makes ``L3`` so large that the spin's lateral traction
+    builds too slowly along every strip: on a crescent whose horns trail
+    (bend -1.5, a/b 0.35) its C~23 came right (within 0.03 of exact) but the
+    lateral force under spin halved at moderate spin (10.8% of mu N off,
+    5.7% without the rule; the paper's MAE 8.3%), while raising ``c23`` (the
+    horns leading) left every curve as it was (within 0.3 point of mu N on
+    the six crescents) and the linear range right.  The lateral force of a
+    trailing bend is a redistribution over the strips, which one flexibility
+    per zone cannot carry: this rule does not try.
     """
     count, first, last = row_extents(area.mask & rows[:, None])
     offset = chord_bend_offset(count, first, last, 0, area.ny, area.dx)
     out = dict(c)
-    shifted = c["c23"] + c["c22"] * offset / math.sqrt(2.0 * zone.area / math.pi)
-    out["c23"] = max(shifted, MIN_OFFSET_C23_SHARE * c["c23"])
+    out["c23"] = c["c23"] + c["c22"] * max(offset, 0.0) / math.sqrt(2.0 * zone.area / math.pi)
     return out
 
 

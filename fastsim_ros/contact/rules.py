@@ -23,10 +23,6 @@ LAW_EXPONENTIAL = 1
 #: ``auto`` split rule (:func:`fastsim_ros.contact.mae.split_face`)
 MIN_ZONE_SHARE = 0.15
 
-#: the calibrated MAE's rule 4 keeps at least this share of a zone's ``c23``
-#: (a zone bent far backwards; :func:`fastsim_ros.contact.mae_calibrated.offset_c23`)
-MIN_OFFSET_C23_SHARE = 0.25
-
 
 def ellipse_cells(cells_in_contact: float) -> int:
     """Return the cells across the ellipse's box giving as many cells in contact as the patch.
@@ -161,7 +157,8 @@ def chord_bend_offset(count: Any, first: Any, last: Any, j_lo: int, j_hi: int,
     their length).  On a crescent (centres exactly quadratic in the chord)
     that is the mean strip centre less the centroid, the first form of the
     rule; on an egg, a straight zone, or too few distinct chords to tell a
-    bend (``< 3``, or a singular fit) it is zero.
+    bend (``< 3``, or a singular fit) it is zero.  Signed (negative: the
+    horns trail); rule 4 counts it where it is positive.
     """
     n = 0
     s_l = 0.0
