@@ -360,10 +360,11 @@ def report(res: dict[str, Any]) -> None:
             _pct(entry["rows"][str(g)][n] / TABLE1[(g, n)][1] - 1) for g in TABLE1_RATIOS
             for n in NAMES) + " |")
     add("")
-    add("Without the translation `L` is the mean displacement's and every coefficient comes"
-        " out about half of Table 1's; a translation per strip (the slip is `du/dx`, blind to"
+    add("Without the translation `L` is the mean displacement's and every C11 and C22 comes"
+        " out 35 to 67% below Table 1's; a translation per strip (the slip is `du/dx`, blind to"
         " a displacement constant along a strip) overshoots at a/b = 0.1 and 1; the full-slip"
-        " traction alone (the iteration's first step) gives 50-70% at a/b = 0.1 and 1;"
+        " traction alone (the iteration's first step) falls 20 to 50% short at a/b = 0.1 and"
+        " 1;"
         " weighting the least squares by the traction fits a/b = 0.1's C11 but is 25-40% high"
         " at a/b = 1 and 10. The package's reading is the only one within 2% of C11 and C22 at"
         " a/b = 1 and 10. The"
@@ -378,7 +379,7 @@ def report(res: dict[str, Any]) -> None:
                     for n in ("C11", "C22"))
         + "). The grid is not the cause (the package's values move by "
         + f"{_grid_spread(d, 0.1):.1f}% between 40 and 160 cells; an exploration with square"
-        " cells, 4 to 20 along x, moved them by less than 6%, downwards); neither is nu (an"
+        " cells, 4 to 20 along x, moved them by up to 6%, downwards); neither is nu (an"
         " exploration over nu = 0..0.5: no single nu fits the three ratios). What is left is"
         " what the issue's description of the method does not fix: the paper's mesh and the"
         " weights of its least squares. Table 1's a/b = 0.1 values lie between the unweighted"
@@ -477,8 +478,8 @@ def report(res: dict[str, Any]) -> None:
         " varies along a strip on a length scale that shrinks with the strip's width as the"
         " ellipse grows long (Figure 6, bottom); two fixed collocation points weigh that"
         " misfit alike at every a/b, so one placement cannot be right at both ends. The best"
-        " single placement over the whole table (minimax, not the method's fit) leaves"
-        " 3.3% at its worst (an exploration, not in the report's data): within 2% over the"
+        " single placement over the whole table (minimax, not the method's fit) leaves about"
+        " 3% at its worst (an exploration, not in the report's data): within 2% over the"
         " whole range is not reachable with two fixed points per strip. The paper's Table 2"
         " agrees with Kalker's to three digits; if its ASM numbers were computed, its"
         " placement or strips must differ from this reading's.\n")
