@@ -264,9 +264,11 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
     spy = None
     if py_spy:
         duration_s = soak * 60.0 if soak else seconds
+        # native frames need the process paused at each sample (no --nonblocking)
+        sampling = NATIVE or ["--nonblocking"]
         spy = subprocess.Popen([str(Path(sys.executable).parent / "py-spy"), "record",
-                                "--pid", str(proc.pid), "--rate", "250", *(NATIVE or ["--nonblocking"]),
-                                "--format", "raw", *NATIVE, "--duration", str(int(duration_s)),
+                                "--pid", str(proc.pid), "--rate", "250", *sampling,
+                                "--format", "raw", "--duration", str(int(duration_s)),
                                 "--output", py_spy],
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     cpu0, wall0 = cpu_seconds(proc.pid), time.perf_counter()
