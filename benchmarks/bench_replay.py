@@ -52,8 +52,8 @@ sys.path.insert(0, str(ROOT))
 from bench_fastsim import machine  # noqa: E402  (one machine line for every benchmark)
 from fastsim_ros import replay  # noqa: E402
 from fastsim_ros.contact import compiled  # noqa: E402
-from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipseSolver,  # noqa: E402
-                                          MaeSolver)
+from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
+from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from fastsim_ros.contact.friction import friction_law  # noqa: E402
 from fastsim_ros.params import load_params_file  # noqa: E402
 from fastsim_ros.replay import kernels  # noqa: E402
@@ -71,8 +71,11 @@ SOLVERS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
 
 def batch_rate(solves: list[tuple[Any, ...]], values: dict[str, Any],
                repeats: int = 3) -> float:
-    """Return patch solves per second of the bag's method's ``solve_batch`` on the same
-    patches and creepages (as solved), one call per patch shape, best of ``repeats``."""
+    """Return patch solves per second of the bag's method's ``solve_batch``.
+
+    On the same patches and creepages as the replay solved them, one call
+    per patch shape, best of ``repeats``.
+    """
     solver = SOLVERS[values["method"]](values["poisson_ratio"], values["shear_modulus"])
     mu = float(values["friction_coefficient"])
     law = friction_law(values["friction_law"], mu,
@@ -201,8 +204,8 @@ def main(argv: list[str] | None = None) -> int:
             rest = r.wall_s - sum(known) - phases.get("csv", 0.0)
             shares = known + [rest]
             print(f"{name:20s}" + "".join(f" {100 * v / r.wall_s:6.0f}%" for v in shares))
-            print(f"{'  us/msg':20s}" + "".join(f" {v / r.messages_in * 1e6:7.2f}"
-                                                 for v in shares))
+            per = [v / r.messages_in * 1e6 for v in shares]
+            print(f"{'  us/msg':20s}" + "".join(f" {v:7.2f}" for v in per))
         print("  (read: chunk reads, decompression, record scan; copy: the input's chunks as "
               "they are;\n   decode: twists, patch layouts, compiled scan and fit; write: "
               "records, compression, summary, metadata)\n")

@@ -53,7 +53,7 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseS
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import friction_law
 from fastsim_ros.pipeline import (FRAME_TOLERANCE, NO_CONTACT, SOLVE_TIME_WINDOW, SOLVED,
-                                  TWIST_HISTORY, Pipeline)
+                                  TWIST_HISTORY, Pipeline, PipelineConfig)
 from fastsim_ros.replay import kernels
 from fastsim_ros.replay.mcap import Window
 from msg_adapters.cdr import read_cloud, read_twist
@@ -180,8 +180,10 @@ def cloud_layout(raw: bytes, frame_id: str, max_cells: int) -> Layout | None:
 
 
 def twist_layout(frame_id: str) -> tuple[Layout, int]:
-    """Return the layout of a little-endian TwistStamped in ``frame_id`` and where its
-    six doubles start."""
+    """Return the layout of a little-endian TwistStamped in ``frame_id``, and its doubles' place.
+
+    The six doubles (linear, angular) start at the returned byte.
+    """
     name = frame_id.encode("utf-8") + b"\x00"
     head = b"\x00\x01\x00\x00" + bytes(8) + len(name).to_bytes(4, "little") + name
     at = _align(len(head), 8)
@@ -612,8 +614,12 @@ class Batch:
 
     def _newest_before(self, hist: _Twists, stamp: Ints,
                        arrival: Ints) -> tuple[Ints, Bools, Bools]:
-        """Per patch: the index of the newest twist in the history at its arrival whose
-        stamp is not after it, whether there is one, and whether any twist came before."""
+        """Return per patch the newest twist's index, whether there is one, whether any came.
+
+        The newest twist in the history as it was when the patch arrived
+        whose stamp is not after the patch's; whether there is one; whether
+        any twist was taken before the patch.
+        """
         m = np.searchsorted(hist.arrival, arrival, "left")   # taken before the patch
         idx = np.minimum(np.searchsorted(hist.stamp, stamp, "right") - 1, m - 1)
         found = (m > 0) & (idx >= np.maximum(m - TWIST_HISTORY, 0)) & (idx >= 0)
@@ -771,7 +777,7 @@ class Batch:
             stats.solve_times[:len(times)] = times
 
     def reported(self) -> None:
-        """The pipeline reported (and restarted its rate windows): restart ours."""
+        """Restart the rate windows: the pipeline reported, and restarted its own."""
         st = self.state
         st.window_inputs[:] = 0
         st.window_rejected[:] = 0
@@ -810,3 +816,22 @@ def _creepages(frame: Floats, v: Floats, r: Floats) -> Floats:
     out[speed == 0.0, :3] = np.nan
     out[speed == 0.0, 3] = 0.0
     return out
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's disk cache) the batched path's loops, every solver."""
+    kernels.warm_up()
+    p = np.zeros((1, 4, 4))
+    p[0, 1:3, 1:3] = 1e9
+    grid = np.array([[-1.5e-3, -1.5e-3, 1e-3, 1e-3]])
+    creep = np.array([[1e-3, 0.0, 0.0]])
+    for method in ("mae", "fastsim_ellipse"):
+        b = Batch(Pipeline(PipelineConfig.from_values({"method": method, "contacts": ["a"]})),
+                  {})
+        b._solve(p, grid, creep, np.ones(1))
+    one = np.zeros(1, dtype=np.int64)
+    flags = np.zeros(1, dtype=np.bool_)
+    kernels.advance(one, one, one, np.zeros((1, 12)), np.zeros((1, 4)), FRAME_TOLERANCE, True,
+                    0, np.zeros((1, 12)), flags.copy(), one.copy(), flags.copy(), one.copy(),
+                    np.zeros((1, 6)), flags.copy(), flags.copy(), flags.copy(), flags.copy(),
+                    one.copy(), np.zeros((1, 6)))

@@ -47,8 +47,11 @@ def resolve(topic: str, namespace: str = "/") -> str:
 
 
 def open_indexed(source: Path, reader: Any) -> mcap.IndexedMcap | None:
-    """Return the input's one MCAP file opened by its index, or ``None`` (read it with
-    rosbags): several files, per-message or file compression, no index."""
+    """Return the input's one MCAP file opened by its index, or ``None``.
+
+    ``None`` (rosbags reads it) for several files, per-message or file
+    compression, no summary or no message indexes.
+    """
     storage = reader.storage
     files: list[Any] = getattr(storage, "storages", [storage])
     if len(files) != 1 or not isinstance(files[0], mcap_reader_type()):

@@ -33,8 +33,11 @@ def _fill_stamps(rows: Rows, stamps: Ints, at: int) -> None:
 
 
 class Stamped:
-    """A header (stamp, ``frame_id``) and ``count`` doubles: ``WrenchStamped`` (6),
-    ``Vector3Stamped`` (3), ``PoseStamped`` (7: position, quaternion ``x y z w``)."""
+    """A header (stamp, ``frame_id``) and ``count`` doubles.
+
+    ``WrenchStamped`` (6), ``Vector3Stamped`` (3), ``PoseStamped`` (7:
+    position, quaternion ``x y z w``).
+    """
 
     def __init__(self, frame_id: str, count: int) -> None:
         template = stamped_doubles(0, frame_id, (0.0,) * count)
@@ -87,8 +90,10 @@ class Markers:
         return np.frombuffer(data, dtype=np.uint8), found
 
     def arrows(self, stamps: Ints, frame: Floats, fx: Floats, fy: Floats) -> Rows:
-        """Return the arrows of forces ``fx, fy`` (N) at frames (origin, ``e_x``, ``e_y``,
-        ``e_z``): from the origin to ``origin + scale (Fx e_x + Fy e_y)``."""
+        """Return the arrows of forces ``fx, fy`` (N) at frames (origin, ``e_x .. e_z``).
+
+        Each from the origin to ``origin + scale (Fx e_x + Fy e_y)``.
+        """
         rows = np.repeat(self.arrow[None], stamps.size, axis=0)
         _fill_stamps(rows, stamps, self.arrow_at[0])
         a, b = fx * self.scale, fy * self.scale
@@ -110,8 +115,11 @@ class Markers:
 
 
 def quaternions(frame: Floats) -> Floats:
-    """:meth:`msg_adapters.patch.ContactFrame.quaternion` on arrays (rows: origin, ``e_x``,
-    ``e_y``, ``e_z``), branch for branch: ``(k, 4)`` ``x, y, z, w``."""
+    """Return the frames' orientations as quaternions ``(k, 4)``: ``x, y, z, w``.
+
+    :meth:`msg_adapters.patch.ContactFrame.quaternion` on arrays (rows:
+    origin, ``e_x``, ``e_y``, ``e_z``), branch for branch.
+    """
     xx, xy, xz = frame[:, 3], frame[:, 4], frame[:, 5]
     yx, yy, yz = frame[:, 6], frame[:, 7], frame[:, 8]
     zx, zy, zz = frame[:, 9], frame[:, 10], frame[:, 11]

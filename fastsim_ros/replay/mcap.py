@@ -155,8 +155,11 @@ class IndexedMcap:
         self.file.close()
 
     def read_chunk(self, chunk: ChunkIndex) -> tuple[bytes, bytes]:
-        """Return ``(record, records)``: the chunk's whole file bytes (chunk record and its
-        message indexes, to copy as they are) and its decompressed records."""
+        """Return ``(raw, records)``: the chunk's bytes in the file and its records.
+
+        ``raw``: the chunk record and its message indexes (to copy as they
+        are); ``records``: the decompressed records.
+        """
         f = self.file
         f.seek(chunk.offset)
         raw = f.read(chunk.length + chunk.index_length)
@@ -278,7 +281,7 @@ class Window:
         return cached
 
     def data(self, i: int) -> memoryview:
-        """Return message ``i``'s serialized data (a view of its chunk's records)."""
+        """Return the serialized bytes of message ``i`` (a view of its chunk's records)."""
         s = int(self.start[i])
         return memoryview(self.buffers[int(self.buffer[i])])[s:s + int(self.size[i])]
 
@@ -492,8 +495,11 @@ class McapWriter:
 
     def write_records(self, records: bytes, channel: NDArray[np.int64],
                       log_time: NDArray[np.int64], offset: NDArray[np.int64]) -> None:
-        """Add message records built in bulk: their bytes, and per record its channel,
-        log time (ns) and offset in ``records``."""
+        """Add message records built in bulk.
+
+        ``records``: their bytes; per record its ``channel``, ``log_time``
+        (ns) and ``offset`` in ``records``.
+        """
         if not channel.size:
             return
         p = self._pending
