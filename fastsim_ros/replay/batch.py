@@ -59,8 +59,9 @@ from fastsim_ros.replay.mcap import Window
 from msg_adapters.cdr import read_cloud, read_twist
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import twist_is_finite
-from msg_adapters.patch import (FLOAT32, FLOAT64, GRID_TOLERANCE, MIN_CELL_SIZE, PATCH_FIELDS,
-                                ContactPatch, patch_from_cloud)
+from msg_adapters import patch_kernels as adapter
+from msg_adapters.patch import (FLOAT32, FLOAT64, GRID_TOLERANCE, MIN_CELL_SIZE,
+                                MIN_CONTACT_CELLS, PATCH_FIELDS, ContactPatch, patch_from_cloud)
 
 Ints = NDArray[np.int64]
 Floats = NDArray[np.float64]
@@ -74,6 +75,12 @@ _MISSING, _WRONG_FRAME, _OLD = CODE["missing_field"], CODE["wrong_frame"], CODE[
 #: kinds of input the batch takes (anything else: the per-message path)
 KINDS = ("wheel_twist", "rail_twist", "patch")
 _FIRST = np.iinfo(np.int64).min
+#: where the adapter loop leaves the contact frame (origin, e_x, e_y, e_z) and the grid fit
+#: (x0, dx, worst_x, y0, dy, worst_y)
+_FRAME_SLOTS = np.array([b + k for b in (adapter.ORIGIN, adapter.E_X, adapter.E_Y, adapter.E_Z)
+                         for k in range(3)])
+_FIT_SLOTS = np.array([adapter.X0, adapter.DX, adapter.WORST_X, adapter.Y0, adapter.DY,
+                       adapter.WORST_Y])
 
 
 def supported(pipeline: Pipeline) -> bool:
@@ -527,19 +534,24 @@ class Batch:
         """Scan patches of one layout; return them and the rows left to the one-by-one path."""
         n = rows.size
         pressure = np.empty((n, layout.height, layout.cells))
-        xyz = np.empty((layout.height, layout.cells, 3))
-        code = np.zeros(n, dtype=np.int64)
-        total = np.zeros(n)
-        fit = np.zeros((n, 6))
-        frame = np.zeros((n, 12))
+        out = np.zeros((n, adapter.OUT_SIZE))
         m = at[rows]
         kernels.scan_patches(w.arrays, w.buffer[m], w.start[m], layout.data_at, layout.width,
                              layout.height, layout.cells, layout.row, layout.step, layout.cols,
-                             pressure, xyz, code, np.zeros(n, dtype=np.int64), total, frame, fit)
-        p.stamp[rows] = self._stamps(w, at[rows])
-        p.status[rows[code == kernels.EMPTY]] = _EMPTY
-        rest = rows[code == kernels.OTHER].tolist()
-        fitted = np.flatnonzero(code == kernels.FITTED)
+                             pressure, out)
+        p.stamp[rows] = self._stamps(w, m)
+        status, cells = out[:, adapter.STATUS], out[:, adapter.CELLS]
+        clean = status == adapter.OK
+        p.status[rows[clean & (cells == 0)]] = _EMPTY
+        # patch_from_cloud's decisions; any other outcome goes one by one for its words
+        fitted = np.flatnonzero(clean & (cells >= MIN_CONTACT_CELLS))
+        rest = rows[~clean | ((cells > 0) & (cells < MIN_CONTACT_CELLS))].tolist()
+        if layout.height < 2 or layout.cells < 2:
+            rest += rows[fitted].tolist()
+            fitted = fitted[:0]
+        total = out[:, adapter.P_SUM]
+        frame = out[:, _FRAME_SLOTS]
+        fit = out[:, _FIT_SLOTS]
         # patch_from_cloud's checks after the fit; what fails goes one by one for its words
         g = fit[fitted]
         x0, dx, x_order, x_bad = _grid_axis(g[:, 0], g[:, 1], g[:, 2], layout.cells)

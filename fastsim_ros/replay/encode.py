@@ -55,32 +55,35 @@ class Stamped:
 
 
 _SEC, _NANOSEC = 0x2B3C4D5E, 987_654_321
-_POINTS = tuple(1.2345678901234567e-150 * (k + 1) for k in range(6))
+#: a frame and forces whose arrow has six distinct, unmistakable coordinates
+_ORIGIN = (1.2345678901234567e-150, 2.3456789012345678e-150, 3.4567890123456789e-150)
+_AXES = ((0.6, 0.0, 0.8), (0.0, 1.0, 0.0), (-0.8, 0.0, 0.6))
+_FORCE = (1.0e-140, 3.0e-140)
 
 
 class Markers:
-    """The ``MarkerArray`` of one contact's creep-force arrow (or its deletion)."""
+    """The ``MarkerArray`` of one contact's creep-force arrow (or its deletion).
+
+    Templates from the node's own encoder
+    (:func:`msg_adapters.outputs.force_marker_cdr`): where the stamp and the
+    arrow's two points lie is found by encoding unmistakable values.
+    """
 
     def __init__(self, frame_id: str, index: int, contact: str, scale: float) -> None:
-        from geometry_msgs.msg import Point
-        from rclpy.serialization import serialize_message
         self.scale = scale
         stamp = _SEC * 1_000_000_000 + _NANOSEC
-        axes = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
-        arrow = outputs.force_marker(stamp, frame_id, index, contact,
-                                     ContactFrame((0.0, 0.0, 0.0), axes), 1.0, 0.0, scale)
-        arrow.points = [Point(x=_POINTS[0], y=_POINTS[1], z=_POINTS[2]),
-                        Point(x=_POINTS[3], y=_POINTS[4], z=_POINTS[5])]
-        gone = outputs.force_marker(stamp, frame_id, index, contact, None, 0.0, 0.0, scale)
-        self.arrow, self.arrow_at = self._template(serialize_message(
-            outputs.marker_array([arrow])), True)
-        self.delete, self.delete_at = self._template(serialize_message(
-            outputs.marker_array([gone])), False)
+        frame = ContactFrame(_ORIGIN, _AXES)
+        fx, fy = _FORCE[0] / scale, _FORCE[1] / scale
+        tip = frame.to_wheelset((fx * scale, fy * scale, 0.0))
+        points = _ORIGIN + tuple(o + t for o, t in zip(_ORIGIN, tip))
+        self.arrow, self.arrow_at = self._template(outputs.force_marker_cdr(
+            stamp, frame_id, index, contact, frame, fx, fy, scale), points)
+        self.delete, self.delete_at = self._template(outputs.force_marker_cdr(
+            stamp, frame_id, index, contact, None, 0.0, 0.0, scale), ())
 
     @staticmethod
-    def _template(data: bytes, points: bool) -> tuple[Rows, list[int]]:
-        marks = [struct.pack("<i", _SEC)] + ([struct.pack("<d", v) for v in _POINTS]
-                                             if points else [])
+    def _template(data: bytes, points: tuple[float, ...]) -> tuple[Rows, list[int]]:
+        marks = [struct.pack("<iI", _SEC, _NANOSEC)] + [struct.pack("<d", v) for v in points]
         found = []
         for m in marks:
             at = data.find(m)

@@ -107,10 +107,6 @@ def stamps(bufs, which, start, out):
         out[i] = sec * 1_000_000_000 + nsec
 
 
-#: codes of :func:`scan_patches`: fitted, empty (no cell in contact), anything else
-FITTED, EMPTY, OTHER = 0, 1, 2
-
-
 @njit(cache=True)
 def doubles(bufs, which, start, at, out):
     """Read ``out.shape[1]`` little-endian doubles ``at`` bytes into each message."""
@@ -121,78 +117,27 @@ def doubles(bufs, which, start, at, out):
 
 
 @njit(cache=True)
-def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pressure, xyz,
-                 code, cells, total, frame, fit):
-    """Run the node's patch scan and grid fit on every patch of one layout in a chunk.
+def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pressure, out):
+    """Run the node's patch adapter loop on every patch of one layout.
 
     Patch ``i``'s points start ``data_at`` bytes into its message
-    (``bufs[which[i]][start[i]:]``) as native floats of ``width`` bytes (4: float32,
-    8: float64), point ``(j, k)`` at word ``j * row + k * step``, the patch
-    fields at word offsets ``cols``.  Fills ``pressure[i]`` (Pa),
-    ``cells[i]`` (cells in contact) and ``total[i]`` (their pressure sum)
-    as :func:`msg_adapters.patch_kernels.scan_points`, and ``code[i]``:
-    :data:`FITTED` (then ``frame[i]``: origin, ``e_x``, ``e_y``, ``e_z`` of
-    the contact frame with the arithmetic of
-    :func:`msg_adapters.patch.contact_axes`, and ``fit[i]`` = ``(x0, dx,
-    worst_x, y0, dy, worst_y)`` of
-    :func:`~msg_adapters.patch_kernels.fit_grid`), :data:`EMPTY` (no
-    positive pressure, no contact) or :data:`OTHER` (a rejection: the
-    per-message path says which, with its words).
+    (``bufs[which[i]][start[i]:]``) as native floats of ``width`` bytes (4:
+    float32, 8: float64), point ``(j, k)`` at word ``j * row + k * step``,
+    the patch fields at word offsets ``cols``.  Fills ``pressure[i]`` (Pa)
+    and ``out[i]`` as :func:`msg_adapters.patch_kernels.adapt` does (its
+    status, cells, sums, contact frame and grid fit, by its indices): the
+    node's own loop, so a patch gives the node's numbers.
     """
     nbytes = ((ny - 1) * row + nx * step) * width
     for i in range(start.size):
         buf = bufs[which[i]]
         s = start[i] + data_at
         if width == 4:
-            st, c, p_sum, p_min, sm = patch_kernels.scan_points(
-                buf[s:s + nbytes].view(np.float32), ny, nx, row, step, cols, pressure[i], xyz)
+            patch_kernels.adapt(buf[s:s + nbytes].view(np.float32), ny, nx, row, step, cols,
+                                pressure[i], out[i])
         else:
-            st, c, p_sum, p_min, sm = patch_kernels.scan_points(
-                buf[s:s + nbytes].view(np.float64), ny, nx, row, step, cols, pressure[i], xyz)
-        cells[i] = c
-        total[i] = p_sum
-        code[i] = OTHER
-        if st != patch_kernels.OK:
-            continue
-        if c == 0:
-            code[i] = EMPTY
-            continue
-        if c < 4 or ny < 2 or nx < 2:
-            continue
-        o0 = sm[0] / p_sum
-        o1 = sm[1] / p_sum
-        o2 = sm[2] / p_sum
-        n0 = sm[3]
-        n1 = sm[4]
-        n2 = sm[5]
-        norm = np.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-        if not norm > 0.0:
-            continue
-        ez0 = n0 / norm
-        ez1 = n1 / norm
-        ez2 = n2 / norm
-        exx = 1.0 - ez0 * ez0
-        exy = -ez0 * ez1
-        exz = -ez0 * ez2
-        ex_norm = np.sqrt(exx * exx + exy * exy + exz * exz)
-        if not ex_norm > 1e-6:
-            continue
-        ex0 = exx / ex_norm
-        ex1 = exy / ex_norm
-        ex2 = exz / ex_norm
-        ey0 = ez1 * ex2 - ez2 * ex1
-        ey1 = ez2 * ex0 - ez0 * ex2
-        ey2 = ez0 * ex1 - ez1 * ex0
-        x0, dx, wx, y0, dy, wy = patch_kernels.fit_grid(
-            xyz, (o0, o1, o2), (ex0, ex1, ex2), (ey0, ey1, ey2))
-        f = frame[i]
-        f[0], f[1], f[2] = o0, o1, o2
-        f[3], f[4], f[5] = ex0, ex1, ex2
-        f[6], f[7], f[8] = ey0, ey1, ey2
-        f[9], f[10], f[11] = ez0, ez1, ez2
-        g = fit[i]
-        g[0], g[1], g[2], g[3], g[4], g[5] = x0, dx, wx, y0, dy, wy
-        code[i] = FITTED
+            patch_kernels.adapt(buf[s:s + nbytes].view(np.float64), ny, nx, row, step, cols,
+                                pressure[i], out[i])
 
 
 @njit(cache=True)
@@ -368,6 +313,5 @@ def warm_up() -> None:
     cols = np.arange(7, dtype=np.int64)
     for width in (4, 8):
         scan_patches(bufs, one, one, 0, width, 2, 2, 14, 7, cols, np.empty((1, 2, 2)),
-                     np.empty((2, 2, 3)), one.copy(), one.copy(), np.zeros(1),
-                     np.zeros((1, 12)), np.zeros((1, 6)))
+                     np.zeros((1, patch_kernels.OUT_SIZE)))
     scatter_rows(np.zeros(64, dtype=np.uint8), np.zeros((1, 8), dtype=np.uint8), one)
