@@ -360,3 +360,21 @@ def test_contact_published_spin_case(solver):
     assert sol.mz + x_p * sol.fy == pytest.approx(-48.21, rel=0.004)
     assert abs(sol.fx) < 1e-9 * abs(sol.fy)
     assert abs(np.count_nonzero(sol.slip) - 920) <= 3
+
+
+def test_the_fft_solver_crops_the_empty_margin_and_answers_on_the_callers_grid():
+    ar = _hertz_area()
+    wide = areas.GridArea(ar.x0 - 7 * ar.dx, ar.y0 - 3 * ar.dy, ar.dx, ar.dy,
+                          np.pad(ar.pressure, ((3, 5), (7, 2))))
+    cr = (2e-4, 1e-4, 0.05)
+    tight = exact.coulomb(ar, *cr, mu=0.3, nu=0.28, shear_modulus=8e10)
+    padded = exact.coulomb(wide, *cr, mu=0.3, nu=0.28, shear_modulus=8e10)
+    assert padded.tau_x.shape == wide.pressure.shape and padded.area is wide
+    # the same problem (the grids' origins differ by round-off)
+    scale = 0.3 * ar.pressure.max()
+    np.testing.assert_allclose(padded.tau_x[3:-5, 7:-2], tight.tau_x, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(padded.tau_y[3:-5, 7:-2], tight.tau_y, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_array_equal(padded.slip[3:-5, 7:-2], tight.slip)
+    assert not padded.tau_x[:3].any() and not padded.slip[-5:].any()
+    assert (padded.fx, padded.fy, padded.mz) == pytest.approx((tight.fx, tight.fy, tight.mz),
+                                                              rel=1e-12)

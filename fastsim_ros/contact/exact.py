@@ -291,7 +291,10 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
     combined ``G`` (Pa).  ``operator``: the area's
     :class:`SteadyRollingOperator` for this material, if already built: a
     sweep of creepages on one area should pass it (the FFT solver keeps its
-    spectra, strip blocks and coarse grids on it).
+    spectra, strip blocks and coarse grids on it); without it the FFT solver
+    builds one for the smallest grid holding the cells in contact
+    (:meth:`GridArea.cropped`: a potential-contact grid's empty margin costs
+    nothing), the results on ``area``'s grid all the same.
 
     ``solver="fft"`` (default): semismooth Newton on the whole area, GMRES
     with FFT products and strip-block preconditioning, started from the
@@ -318,7 +321,10 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
     n = int(np.count_nonzero(mask))
     if solver == "fft":
         _check_cells(n, MAX_COULOMB_CELLS, "the FFT Coulomb solver")
-        op = _operator(operator, area, nu, shear_modulus)
+        # the FFTs span the grid: without an operator, solve on the smallest grid that holds
+        # the cells in contact (their order, row by row, is the same on both grids)
+        op = _operator(operator, area if operator is not None else area.cropped(), nu,
+                       shear_modulus)
         with one_blas_thread():
             res = solve_area(op, (xi, eta, phi), reference, mu_s=mu, tol=tol, law=slip_law,
                              speed=v_roll)

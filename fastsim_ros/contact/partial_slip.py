@@ -77,7 +77,7 @@ MAX_HALVINGS = 5
 #: iterations whose largest residual a step must not exceed (non-monotone search)
 NONMONOTONE_MEMORY = 5
 #: GMRES: restart length and most iterations per Newton step
-KRYLOV_RESTART = 80
+KRYLOV_RESTART = 60
 KRYLOV_MAX = 400
 #: GMRES iterations of a Newton step beyond which the next step refactors every strip
 #: segment (otherwise only those whose cells changed between slip and stick)
@@ -242,8 +242,9 @@ def _gmres(matvec: Callable[[FloatArray], FloatArray],
     beta = bnorm
     total = 0
     size = KRYLOV_RESTART
+    # only the Krylov basis is kept: x = M (V y) at the end of a cycle costs one more
+    # preconditioner product and saves as much memory again
     v = np.empty((size + 1, bv.size))
-    z = np.empty((size, bv.size))
     while True:
         h = np.zeros((size + 1, size))
         cs = np.zeros(size)
@@ -253,8 +254,7 @@ def _gmres(matvec: Callable[[FloatArray], FloatArray],
         v[0] = r / beta
         k = 0
         while k < size and total < KRYLOV_MAX and abs(g[k]) > target:
-            z[k] = precondition(v[k].reshape(shape)).ravel()
-            w = matvec(z[k].reshape(shape)).ravel()
+            w = matvec(precondition(v[k].reshape(shape))).ravel()
             # classical Gram-Schmidt twice: as stable as modified, in matrix products
             hk = v[: k + 1] @ w
             w -= hk @ v[: k + 1]
@@ -278,7 +278,8 @@ def _gmres(matvec: Callable[[FloatArray], FloatArray],
             total += 1
         if k == 0:
             return x.reshape(shape), total
-        x += np.linalg.solve(np.triu(h[:k, :k]), g[:k]) @ z[:k]
+        y = np.linalg.solve(np.triu(h[:k, :k]), g[:k])
+        x += precondition((y @ v[:k]).reshape(shape)).ravel()
         r = bv - matvec(x.reshape(shape)).ravel()
         beta = float(np.linalg.norm(r))
         # done, out of iterations, or the estimate met but round-off keeps the true
