@@ -54,7 +54,7 @@ from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
 from fastsim_ros.contact.errors import (ConvergenceError, GridTooLargeError,
                                         InvalidInputError)
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, resolve
-from fastsim_ros.contact.partial_slip import one_blas_thread, solve_area
+from fastsim_ros.contact.partial_slip import on_one_blas_thread, solve_area
 from fastsim_ros.contact.rolling import SteadyRollingOperator, StripBlock
 from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
 
@@ -127,6 +127,7 @@ def _operator(operator: SteadyRollingOperator | None, area: GridArea, nu: float,
     return operator
 
 
+@on_one_blas_thread
 def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: float,
                   shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                   solver: SolverKind = "fft", rtol: float = 1e-10,
@@ -275,6 +276,7 @@ def _strip_coulomb(q: FloatArray, bp: FloatArray, bound: FloatArray, c: float,
     return _project(z, radius)[0] if fnorm <= tol else tau, out
 
 
+@on_one_blas_thread
 def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | None = None,
             nu: float, shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
             tol: float = 1e-9, max_sweeps: int = 500,
@@ -310,7 +312,9 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
     problem and stop when the largest traction error (the Newton residual
     ``|tau - P(tau - c s)|``; the Gauss-Seidel sweep's largest change) is
     below ``tol * mu * max(p)``.  The cell count is checked before anything
-    of the solver is allocated (:class:`GridTooLargeError`).
+    of the solver is allocated (:class:`GridTooLargeError`).  Both run with
+    one BLAS thread (:func:`~fastsim_ros.contact.partial_slip.one_blas_thread`),
+    as does :func:`full_adhesion`.
     """
     law = resolve(mu, friction)
     mu = check_friction(law.mu_s)
@@ -325,9 +329,8 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
         # the cells in contact (their order, row by row, is the same on both grids)
         op = _operator(operator, area if operator is not None else area.cropped(), nu,
                        shear_modulus)
-        with one_blas_thread():
-            res = solve_area(op, (xi, eta, phi), reference, mu_s=mu, tol=tol, law=slip_law,
-                             speed=v_roll)
+        res = solve_area(op, (xi, eta, phi), reference, mu_s=mu, tol=tol, law=slip_law,
+                         speed=v_roll)
         return _solution(area, res.tau, res.slip, reference, res.newton, res.krylov,
                          res.products)
     if solver != "dense":

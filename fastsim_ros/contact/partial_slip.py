@@ -48,10 +48,12 @@ Imports numpy, :mod:`~fastsim_ros.contact.errors`, ``friction`` and ``rolling``.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
+from typing import ParamSpec, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -66,6 +68,8 @@ from fastsim_ros.contact.traction import rigid_slip
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
 IntArray = NDArray[np.intp]
+P = ParamSpec("P")
+R = TypeVar("R")
 
 #: the longest strip segment of the preconditioner (cells): its blocks hold
 #: ``4 SEGMENT_CELLS`` numbers a cell at most
@@ -91,16 +95,25 @@ _BLAS: list[ThreadpoolController] = []
 def one_blas_thread() -> Iterator[None]:
     """Run the block with one BLAS thread, the former number restored after.
 
-    The strip blocks are small (tens to hundreds of rows): a second BLAS
-    thread gains little on them, and on a busy machine its spinning makes
-    the solve many times slower (measured: 25x at 60 x 60 cells with the
-    other core loaded).  The BLAS libraries are those loaded when this is
-    first used (numpy's: the ones the solver calls).
+    The exact solvers' dense blocks are small (tens to hundreds of rows): a
+    second BLAS thread gains little on them, and on a busy machine its
+    spinning makes a solve many times slower (measured: 25x, 60 x 60 cells,
+    the other core loaded).  The BLAS libraries are those loaded when this
+    is first used (numpy's and, once :mod:`scipy.linalg` is imported, SciPy's).
     """
     if not _BLAS:
         _BLAS.append(ThreadpoolController())
     with _BLAS[0].limit(limits=1, user_api="blas"):
         yield
+
+
+def on_one_blas_thread(solve: Callable[P, R]) -> Callable[P, R]:
+    """Run every call of ``solve`` with one BLAS thread (:func:`one_blas_thread`)."""
+    @functools.wraps(solve)
+    def run(*args: P.args, **kwargs: P.kwargs) -> R:
+        with one_blas_thread():
+            return solve(*args, **kwargs)
+    return run
 
 
 @dataclass(frozen=True)
