@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -33,7 +33,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from msg_adapters import outputs as out
-from msg_adapters.cdr import Cloud, StampedTwist, read_cloud, read_twist
+from msg_adapters.cdr import Cloud, CloudReader, StampedTwist, read_twist
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
 from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud
@@ -162,6 +162,27 @@ class ContactStats:
         return float(p50) * 1e6, float(p99) * 1e6
 
 
+#: a handler of one input message (CDR bytes): the outcomes it gave (none for kinematics)
+InputHandler = Callable[[bytes | memoryview], tuple[Outcome, ...]]
+
+
+@dataclass(frozen=True)
+class InputTopic:
+    """One input topic of the pipeline and its handler (front ends dispatch on these).
+
+    ``topic``: relative name; ``msgtype``: its ROS type; ``kind``:
+    ``"patch"`` (of ``contact``), ``"wheel_twist"`` or ``"rail_twist"``;
+    ``take``: the pipeline's handler of one message (CDR bytes), returning
+    the outcomes it gave (none for kinematics).
+    """
+
+    topic: str
+    msgtype: str
+    kind: str
+    contact: str | None
+    take: InputHandler
+
+
 @dataclass(frozen=True)
 class ContactReport:
     """One contact's diagnostics: level (0 OK, 1 WARN, 2 ERROR), message, key-values."""
@@ -174,9 +195,10 @@ class ContactReport:
 
 class _ContactState:
     __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
-                 "wrench_fresh", "stats")
+                 "wrench_fresh", "stats", "reader")
 
     def __init__(self) -> None:
+        self.reader = CloudReader()  # the topic's header parsed once
         self.last_stamp_ns: int | None = None
         self.last_frame: ContactFrame | None = None
         self.last_marker_ns: int | None = None
@@ -190,6 +212,8 @@ class _ContactState:
 def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
     if a is None:
         return True
+    if a.origin == b.origin and a.axes == b.axes:  # the usual case on a steady rig
+        return False
     moved = max(abs(u - v) for u, v in zip(a.origin, b.origin))
     turned = max(abs(u - v) for ea, eb in zip(a.axes, b.axes) for u, v in zip(ea, eb))
     return moved > FRAME_TOLERANCE or turned > FRAME_TOLERANCE
@@ -254,6 +278,31 @@ class Pipeline:
                 raise parameters.ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config)
 
+    def inputs(self) -> tuple[InputTopic, ...]:
+        """Return every input topic the pipeline takes, with its handler, in this order.
+
+        The one table of inputs: a new input (a topic and its ``on_*``
+        method) is added here, and the replay dispatches on it.
+        """
+        def kinematics(on: Callable[[bytes | memoryview], str]) -> InputHandler:
+            def take(raw: bytes | memoryview) -> tuple[Outcome, ...]:
+                on(raw)  # counted in kinematics_counts; no outcome
+                return ()
+            return take
+
+        def patch(contact: str) -> InputHandler:
+            def take(raw: bytes | memoryview) -> tuple[Outcome, ...]:
+                return (self.on_patch(contact, raw),)
+            return take
+
+        twist = "geometry_msgs/msg/TwistStamped"
+        return ((InputTopic(WHEEL_TWIST_TOPIC, twist, "wheel_twist", None,
+                            kinematics(self.on_wheel_twist)),
+                 InputTopic(RAIL_TWIST_TOPIC, twist, "rail_twist", None,
+                            kinematics(self.on_rail_twist)))
+                + tuple(InputTopic(patch_topic(c), "sensor_msgs/msg/PointCloud2", "patch", c,
+                                   patch(c)) for c in self.config.contacts))
+
     # ---------------------------------------------------------------- kinematics
 
     def _twist(self, history: deque[StampedTwist], twist: StampedTwist | bytes | memoryview,
@@ -313,7 +362,7 @@ class Pipeline:
         stats = state.stats
         if not isinstance(cloud, Cloud):
             try:
-                cloud = read_cloud(cloud)
+                cloud = state.reader.read(cloud)
             except MalformedMessageError as e:  # not a PointCloud2: its fields are missing
                 stats.counts["missing_field"] += 1
                 stats.last_detail = f"missing_field: {e}"
@@ -433,10 +482,10 @@ class Pipeline:
     def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
         """Return the ``(topic, message)`` pairs to publish for an outcome, in order.
 
-        Per-patch messages come as CDR bytes, the rest as message objects
-        (INTERFACE.md "Outputs"): the contact's wrench and creepage, its
-        frame when it moved, its traction cloud when asked for, its marker
-        when due, and the wheelset wrench when the rig cycle is complete.
+        Each as CDR bytes (INTERFACE.md "Outputs"): the contact's wrench and
+        creepage, its frame when it moved, its traction cloud when asked
+        for, its marker when due, and the wheelset wrench when the rig cycle
+        is complete.
         """
         if not outcome.has_wrench:
             return []
@@ -454,31 +503,34 @@ class Pipeline:
                 msgs.append((base + "frame", out.pose_cdr(stamp, frame_id, outcome.frame)))
             if (f.tau_x is not None and f.tau_y is not None and f.slip is not None
                     and f.grid is not None):
-                msgs.append((base + "traction", out.traction_cloud(
+                msgs.append((base + "traction", out.traction_cloud_cdr(
                     stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid)))
         if outcome.markers:
             index = self.config.contacts.index(c)
             fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)
-            marker = out.force_marker(stamp, frame_id, index, c, outcome.frame, fx, fy,
-                                      float(self.config["marker_scale"]))
-            msgs.append((MARKERS_TOPIC, out.marker_array([marker])))
+            msgs.append((MARKERS_TOPIC, out.force_marker_cdr(
+                stamp, frame_id, index, c, outcome.frame, fx, fy,
+                float(self.config["marker_scale"]))))
         w = outcome.wheelset
         if w is not None:
             msgs.append((WHEELSET_WRENCH_TOPIC, out.wrench_cdr(w.stamp_ns, frame_id, w.force,
                                                                w.torque)))
         return msgs
 
-    def diagnostics(self, stamp_ns: int) -> Any:
+    def diagnostics(self, stamp_ns: int,
+                    extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> Any:
         """Return the ``DiagnosticArray`` at ``stamp_ns``: one status per contact.
 
         Each carries the twist counts too (``twists/<what>``: taken for the
-        wheel and the rail, dropped by reason), the kinematics being shared.
+        wheel and the rail, dropped by reason), the kinematics being shared,
+        then the key-values ``extra[contact]`` if given (the node's connections).
         """
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
         statuses: list[tuple[str, int, str, Sequence[tuple[str, str]]]] = []
         for c in self.config.contacts:
             r = self.report(c)
-            statuses.append((r.name, r.level, r.message, r.values + twists))
+            more = tuple(extra.get(c, ())) if extra is not None else ()
+            statuses.append((r.name, r.level, r.message, r.values + twists + more))
         return out.diagnostic_array(stamp_ns, statuses)
 
     # ---------------------------------------------------------------- diagnostics
