@@ -71,7 +71,7 @@ CONTACT_MS = {15: (4.0, 3.6), 25: (28.0, 28.0), 35: (134.0, 133.0)}
 
 
 def hertz_rho(a: float, b: float) -> float:
-    """CONTACT's effective radius ``rho`` of the Hertz ellipse ``a``, ``b`` under ``LOAD`` (m).
+    """Return CONTACT's effective radius ``rho`` (m) of the Hertz ellipse ``a``, ``b``.
 
     m_hertz.f90 (hzcalc3d, semi-axes given): ``rho = 4 pi c^3 E* sqrt(g)/(3 N E(k))``,
     ``c = sqrt(a b)``, ``g`` the smaller over the larger axis, ``E`` the complete
@@ -86,7 +86,7 @@ def hertz_rho(a: float, b: float) -> float:
 
 def table_case(cells: int, a_over_b: float, magnitude: float, angle: float,
                spin: float) -> tuple[areas.GridArea, tuple[float, float, float]]:
-    """The area (the ellipse ``cells`` across) and creepages of one case of CONTACT's table."""
+    """Return the area (the ellipse ``cells`` across) and creepages of a table case."""
     a = SEMI_AXES[a_over_b]
     b = a / a_over_b
     rho = hertz_rho(a, b)
@@ -97,7 +97,7 @@ def table_case(cells: int, a_over_b: float, magnitude: float, angle: float,
 
 
 def peak_rss() -> float:
-    """The process's peak resident set (MB): VmHWM, the high-water mark of its own memory.
+    """Return the peak resident set (MB): VmHWM, the high-water mark of this process's memory.
 
     (``getrusage``'s ``ru_maxrss`` would not do: a child starts with its parent's.)
     """
@@ -175,7 +175,7 @@ def coulomb_table(label: str, grids: list[tuple[int, int]], runs: int) -> None:
 
 
 def table_sample(grids: list[int], stride: int, solvers: list[str]) -> None:
-    """CONTACT's table, every ``stride``-th case: mean time per case against CONTACT's."""
+    """Time every ``stride``-th case of CONTACT's table: mean time per case against CONTACT's."""
     cases = [(g, m, a, s) for g in SEMI_AXES for s in SPINS for a in ANGLES for m in MAGNITUDES]
     picked = cases[::stride]
     print(f"\nCONTACT's table (3,220 cases), every {stride}th: {len(picked)} cases per grid; "
@@ -203,6 +203,7 @@ def table_sample(grids: list[int], stride: int, solvers: list[str]) -> None:
 
 
 def adhesion(grids: list[int], runs: int) -> None:
+    """Time the three unit creepages, sticking everywhere, on ellipses ``grids`` cells across."""
     print("\nfull adhesion, unit xi, eta, phi (one operator), nu = 0.25; seconds")
     print(f"{'grid':>8} {'cells':>6} {'median':>8} {'max':>8}")
     a, b = areas.semi_ellipse_axes(1.0)
@@ -219,6 +220,7 @@ def adhesion(grids: list[int], runs: int) -> None:
 
 
 def main() -> int:
+    """Run the tables (or, with ``--child``, trace one call)."""
     if len(sys.argv) > 1 and sys.argv[1] == "--child":
         child(int(sys.argv[2]), sys.argv[3])
         return 0

@@ -304,7 +304,7 @@ def _curvature_ratio(b_over_a):
 
 
 def _contact_grid(mx, my, dx, dy, a1, b1, load):
-    """CONTACT's centred ``mx`` x ``my`` grid, its pressure from the gap ``A x^2 + B y^2``."""
+    """Return CONTACT's centred ``mx`` x ``my`` grid, pressure from the gap ``A x^2 + B y^2``."""
     x0, y0 = -(mx - 1) / 2 * dx, -(my - 1) / 2 * dy
     x = x0 + dx * np.arange(mx)
     y = y0 + dy * np.arange(my)
@@ -337,7 +337,7 @@ def test_contact_published_creep_curve(solver, tractcurv_area):
 
 @pytest.mark.parametrize("solver", SOLVERS)
 def test_contact_published_spin_case(solver):
-    """CONTACT's examples/fastsim.inp, case 1: the exact theory under lateral creepage and spin.
+    """Compare with CONTACT's examples/fastsim.inp, case 1: lateral creepage and spin.
 
     Hertz ellipse a = 8 mm, b = 4 mm, 82 kN, mu 0.3, 44 x 44 cells over 1.1 times the
     ellipse (dx = 0.4 mm, dy = 0.2 mm), eta = -6.25e-4, phi = 0.625 1/m; published

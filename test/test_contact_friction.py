@@ -320,7 +320,7 @@ def test_solvers_refuse_bad_friction_arguments(flange):
 
 @pytest.fixture(scope="module", params=["fft", "dense"])
 def exact_setup(request):
-    """The area, its operator and the Coulomb solver (both pass every test)."""
+    """Return the area, its operator and the Coulomb solver (both pass every test)."""
     from fastsim_ros.contact.exact import SteadyRollingOperator
     area = ellipse(A_AX, B_AX, nx=20, ny=20, load=LOAD)
     return area, SteadyRollingOperator.of(area, nu=NU, shear_modulus=G), request.param

@@ -392,7 +392,7 @@ def _check_cells(n: int, limit: int, what: str) -> None:
 def _solution(area: GridArea, tau: FloatArray, slip: NDArray[np.bool_],
               reference: tuple[float, float], iterations: int, krylov: int = 0,
               products: int = 0) -> TractionSolution:
-    """The solution's fields on the grid from the cells' tractions ``tau`` (m, 2)."""
+    """Return the solution on the grid from the cells' tractions ``tau`` (m, 2)."""
     mask = area.mask
     tau_x = np.zeros(mask.shape)
     tau_y = np.zeros(mask.shape)
