@@ -56,7 +56,7 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
 from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from fastsim_ros.contact.friction import friction_law  # noqa: E402
 from fastsim_ros.params import load_params_file  # noqa: E402
-from fastsim_ros.replay import kernels  # noqa: E402
+from fastsim_ros.replay import batch  # noqa: E402
 from msg_adapters import patch as patch_adapter  # noqa: E402
 
 BAGS = ROOT / "bags"
@@ -162,7 +162,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"machine: {machine()}")
     warm = compiled.warm_up()
     patch_adapter.warm_up()
-    kernels.warm_up()
+    batch.warm_up()
     source = "from the disk cache" if warm < 5.0 else "compiled: the cache was cold"
     print(f"kernels ready in {warm:.2f} s ({source})\n")
 
