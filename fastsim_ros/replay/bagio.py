@@ -76,8 +76,12 @@ def fast_yaml() -> Iterator[None]:
 
 # ------------------------------------------------------------------------ inputs
 
-def input_name(path: Path) -> str:
+def input_name(path: Path | str) -> str:
     """Return the NAME of an input: the directory's name, or the file's without ``.mcap``."""
+    if isinstance(path, str) and "://" in path:  # an fsspec URL
+        base = path.rstrip("/").rsplit("/", 1)[-1]
+        return base[:-len(".mcap")] if base.endswith(".mcap") and not path.endswith("/") \
+            else base
     p = Path(os.path.abspath(path))
     return p.stem if p.suffix == ".mcap" and not p.is_dir() else p.name
 
