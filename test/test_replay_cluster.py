@@ -34,7 +34,7 @@ ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(
 
 @pytest.fixture
 def cluster(tmp_path):
-    """A scheduler and two workers without nannies (a killed worker stays dead)."""
+    """Start a scheduler and two workers without nannies (a killed worker stays dead)."""
     c = LocalProcesses(tmp_path, 2, env=ENV, cwd=ROOT)
     yield c
     c.close()

@@ -105,8 +105,11 @@ class Cluster:
                     dynamic_ncols=True)
 
     def stop(self) -> None:
-        """Cancel the tasks not done (a task already running finishes or is dropped by its
-        worker; its staging is removed by the command line)."""
+        """Cancel the tasks not done, then disconnect.
+
+        A task already running finishes or is dropped by its worker; the
+        command line removes its staging directory.
+        """
         try:
             self.client.cancel(self.futures, force=True)
         finally:

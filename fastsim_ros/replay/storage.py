@@ -45,7 +45,7 @@ def basename(url: str) -> str:
 
 
 def exists(path: str | Path) -> bool:
-    """Tell whether a local path or a URL exists (a broken symlink exists)."""
+    """Tell whether there is anything at a local path or a URL (a broken symlink counts)."""
     if is_url(path):
         fs, p = filesystem(str(path))
         return bool(fs.exists(p))
