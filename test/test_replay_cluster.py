@@ -116,6 +116,35 @@ def test_a_killed_worker_leaves_every_output_once_and_whole(tmp_path, cluster):
         assert (out / f"f{k}.csv").read_text() == (out / "f0.csv").read_text()
 
 
+def test_a_lost_scheduler_is_one_line_and_the_written_outputs_stay(tmp_path, cluster):
+    src = tmp_path / "in"
+    src.mkdir()
+    for k in range(10):
+        (src / f"f{k}").symlink_to(BAGS / "flange_shift", target_is_directory=True)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "fastsim_ros.replay", *sorted(map(str, src.iterdir())), "-o",
+         str(out), "--csv", "--scheduler", cluster.address], cwd=ROOT, env=ENV,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not (out.is_dir() and any(p.name.endswith(".csv") for p in out.iterdir())):
+        assert time.monotonic() < deadline and proc.poll() is None
+        time.sleep(0.005)
+    cluster.procs[0].send_signal(signal.SIGKILL)   # the scheduler
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 1
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr
+    assert f"lost the Dask scheduler at {cluster.address}" in stderr
+    assert "the outputs already written stay" in stderr
+    # what was committed is whole (a worker still running may commit a bag after)
+    done = [p for p in out.iterdir() if not p.name.startswith(".") and p.is_dir()]
+    assert done
+    for bag in done:
+        if (out / f"{bag.name}.csv").exists():
+            with Reader(bag) as reader:
+                assert sum(1 for _ in reader.messages()) == reader.message_count > 4000
+
+
 def test_an_unreachable_scheduler_is_one_line(tmp_path):
     proc = replay(BAGS / "hertz_ramp", "-o", tmp_path / "out", "--scheduler",
                   "tcp://127.0.0.1:9", timeout=120)

@@ -162,8 +162,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{PROG}: interrupted; nothing left of the unfinished inputs", file=sys.stderr)
         return 130
     except ClusterError as e:
-        executor = None
-        print(f"{PROG}: {e}; the outputs already written stay", file=sys.stderr)
+        executor = None  # nothing to close: the scheduler is gone
+        print(f"{PROG}: {e}; the outputs already written stay", file=sys.stderr, flush=True)
         return 1
     finally:
         if executor is not None:

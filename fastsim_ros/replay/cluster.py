@@ -21,10 +21,12 @@ its own outputs, so what the cluster adds is only where it runs:
 from __future__ import annotations
 
 import json
+import logging
 import subprocess
 import sys
 import time
 from collections.abc import Iterator, Sequence
+from concurrent.futures import CancelledError
 from pathlib import Path
 from typing import Any
 
@@ -56,6 +58,9 @@ class Cluster:
 
     def __init__(self, address: str, *, progress: bool = False) -> None:
         from distributed import Client
+        # the client's own reconnection attempts log tracebacks: a lost or unreachable
+        # scheduler is one line of ours instead
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
         self.address = address
         self.progress = progress
         self.futures: list[Any] = []
@@ -68,6 +73,7 @@ class Cluster:
     def results(self, tasks: Sequence[Task]) -> Iterator[Result]:
         """Submit every task; yield the results in the tasks' order."""
         from distributed import KilledWorker
+        from distributed.comm import CommClosedError
         client = self.client
         try:
             client.run(warm_worker)
@@ -85,9 +91,10 @@ class Cluster:
                                 error=f"{task.source}: the workers replaying it died "
                                       f"({problem(e)})")
             except Exception as e:
-                if client.status not in ("running", "connecting"):
-                    raise ClusterError(f"lost the Dask scheduler at {self.address}: "
-                                       f"{problem(e)}") from None
+                lost = (CancelledError, OSError, CommClosedError)
+                if client.status != "running" or isinstance(e, lost):
+                    raise ClusterError(f"lost the Dask scheduler at {self.address} "
+                                       f"({type(e).__name__})") from None
                 result = Result(str(task.source), task.name, status=1,
                                 error=f"{task.source}: internal error on a worker: "
                                       f"{problem(e)}")
