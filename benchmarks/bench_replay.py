@@ -265,7 +265,7 @@ def timed(executor: Any, tasks: list[Any]) -> tuple[float, float]:
 
 
 def cluster_main(count: int) -> int:
-    """The ``--scheduler`` benchmark: a local cluster of two workers against ``--jobs 2``."""
+    """Run the ``--scheduler`` benchmark: a local cluster of two workers against ``--jobs 2``."""
     import os
 
     from fastsim_ros.replay.cluster import Cluster, LocalProcesses, warm_worker
