@@ -210,8 +210,11 @@ class Pipeline:
     :meth:`update` changes the parameters that may change while running.
     """
 
-    def __init__(self, config: PipelineConfig) -> None:
+    def __init__(self, config: PipelineConfig, *, solver: Any = None) -> None:
         self.config = config
+        # a solver with MaeSolver's solve_arrays, used instead of the method's (the
+        # command line's exact solver on patches from profiles)
+        self._override = solver
         nu, g = config["poisson_ratio"], config["shear_modulus"]
         # one solver per method of parameters.METHODS (CalibratedMaeSolver is a MaeSolver)
         self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver] = {
@@ -226,7 +229,7 @@ class Pipeline:
 
     def _apply(self, config: PipelineConfig) -> None:
         self.config = config
-        self._solver = self._solvers[config["method"]]
+        self._solver = self._override or self._solvers[config["method"]]
         self._mu = float(config["friction_coefficient"])
         # None: constant friction, the call of old (speed unused); else the law, run at |V|
         law = friction_law(str(config["friction_law"]), self._mu,
@@ -284,6 +287,13 @@ class Pipeline:
     def on_rail_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
         """Take a rail twist (roller, moving rail); return ``"ok"`` or why it was dropped."""
         return self._twist(self._rail, twist, "rail")
+
+    def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
+        """Return the wheel and rail twists a patch stamped ``stamp_ns`` is solved with.
+
+        Raises :class:`RejectedInput` (``no_kinematics``, ``stale_kinematics``).
+        """
+        return self._kinematics(stamp_ns)
 
     def _kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
         wheel = _newest_before(self._wheel, stamp_ns)
@@ -357,6 +367,31 @@ class Pipeline:
         wheelset = self._add_wrench(state, stamp, f_ws, torque)
         return Outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces, patch,
                        wheelset, self._markers_due(state, stamp))
+
+    def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
+                    rail: StampedTwist = REST) -> tuple[Creepage, ContactForces]:
+        """Return the creepages and creep forces of one converted patch under given twists.
+
+        The rules of :meth:`on_patch` (standstill, the solver's refusals as
+        :class:`RejectedInput`), without its stamps, counts or outputs: the
+        profiles patch source balances a wheel's vertical load with it.
+        """
+        creep = creepages(patch.frame, wheel, rail)
+        if not abs(creep.speed) >= self._min_speed:
+            raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
+        return creep, self._solve(patch, creep, ContactStats())
+
+    def reject(self, contact: str, stamp_ns: int, reason: str, detail: str) -> Outcome:
+        """Count an input of ``contact`` dropped upstream of its patch (profiles mode)."""
+        stats = self._contacts[contact].stats
+        stats.window_inputs += 1
+        if stats.window_first_ns is None:
+            stats.window_first_ns = stamp_ns
+        stats.window_last_ns = stamp_ns
+        stats.counts[reason] += 1
+        stats.window_rejected += 1
+        stats.last_detail = f"{reason}: {detail}"
+        return Outcome(contact, stamp_ns, reason, detail)
 
     def _no_contact(self, contact: str, state: _ContactState, stamp: int) -> Outcome:
         state.stats.counts[NO_CONTACT] += 1

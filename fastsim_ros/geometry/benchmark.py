@@ -100,8 +100,26 @@ def _merge(blocks: list[dict[str, float]]) -> dict[str, float]:
     return merged
 
 
+def read_inputs(name: str) -> list[tuple[float, ...]]:
+    """Every case's ``S, Y, FZ, ROLL, YAW, PITCH, VS, VY, VZ, VROLL, VYAW, VPITCH`` of an ``.inp``.
+
+    The ``.ref_out`` prints the pose with 3-4 digits (a roll of -1.126E-02
+    rad is 7 um at the wheel); the inputs carry them all.
+    """
+    rows: list[tuple[float, ...]] = []
+    pending: list[float] = []
+    for line in (DATA / f"{name}.inp").read_text().splitlines():
+        if "S, Y, FZ, ROLL, YAW, PITCH" in line.replace("  ", " "):
+            pending = [float(v) for v in line.split()[:6]]
+        elif "VS,VY,VZ, VROLL,VYAW,VPITCH" in line.replace(" ", "").replace(
+                "VS,VY,VZ,VROLL,VYAW,VPITCH", "VS,VY,VZ, VROLL,VYAW,VPITCH"):
+            rows.append(tuple(pending + [float(v) for v in line.split()[:6]]))
+    return rows
+
+
 def read_ref_out(name: str) -> list[CaseResult]:
-    """Read one of the shipped ``.ref_out`` files (``mbench_a22_left`` etc.)."""
+    """Read one of the shipped ``.ref_out`` files (``mbench_a22_left`` etc.), poses from its ``.inp``."""
+    inputs = read_inputs(name)
     text = (DATA / f"{name}.ref_out").read_text()
     chunks = re.split(r"^\s*Case\s+(\d+)\s*$", text, flags=re.MULTILINE)
     cases: list[CaseResult] = []
@@ -129,10 +147,11 @@ def read_ref_out(name: str) -> list[CaseResult]:
                 n=v["FN"], fx=-v["FX"], fy=v["FS"], mz=v["MN"] * 1e-3,
                 approach=v["APPROACH"] * 1e-3, p_max=v["PMAX"] * 1e6,
                 cells=int(v["NCON"]), potential_cells=int(v["NPOT"])))
+        given = inputs[int(number) - 1]
         cases.append(CaseResult(
-            number=int(number), side=side, dy=-state["Y_WS"] * 1e-3, dz=-state["Z_WS"] * 1e-3,
-            roll=state["ROLL_WS"], yaw=-state["YAW_WS"], forward_speed=state["VX_WS"] * 1e-3,
-            axle_spin=-state["VPITCH_WS"],
+            number=int(number), side=side, dy=-given[1] * 1e-3, dz=-state["Z_WS"] * 1e-3,
+            roll=given[3], yaw=-given[4], forward_speed=given[6] * 1e-3,
+            axle_spin=-given[11],
             force_track=(-state["FX(TR)"], state["FY(TR)"], state["FZ(TR)"]),
             patches=tuple(patches),
             normal_method={"0": "exact", "5": "kpec", "6": "analyn"}.get(bound, bound)))

@@ -195,7 +195,8 @@ def _box_distance(a: Region, b: Region) -> float:
     return math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
-def _merged(a: Region, b: Region) -> Region:
+def merged(a: Region, b: Region) -> Region:
+    """Return two regions combined into one (weighted reference, union of extents)."""
     wa, wb = a.weight, b.weight
     total = wa + wb
 
@@ -230,7 +231,7 @@ def combine(regions: list[Region], *, a_sep: float = A_SEP, d_sep: float = D_SEP
             while j < len(out):
                 if (abs(out[i].angle - out[j].angle) <= a_sep
                         and _box_distance(out[i], out[j]) <= limit):
-                    out[i] = _merged(out[i], out.pop(j))
+                    out[i] = merged(out[i], out.pop(j))
                 else:
                     j += 1
             i += 1

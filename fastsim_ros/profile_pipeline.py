@@ -1,0 +1,277 @@
+"""The pipeline in profiles mode: wheelset poses (and loads) in, patches and creep forces out.
+
+INTERFACE.md ("Patches from wheel and rail profiles"): a rig knows its
+profiles and measures the wheelset's pose and loads.  :class:`ProfilePipeline`
+wraps the :class:`~fastsim_ros.pipeline.Pipeline` of the patch topics: for
+each ``wheelset/pose`` it places the wheelset
+(:class:`~fastsim_ros.geometry.wheelset.Wheelset`), finds both wheels'
+patches and solves their normal problem, balancing each wheel's vertical
+load with the creep forces the wrapped pipeline computes (its rigid-body
+creepages, its solver: there is no second formula), then hands every patch
+to the wrapped pipeline exactly as if it had arrived on
+``contact/<name>/patch``.  The patches are returned for publishing on those
+topics, so a recording replays in either mode.
+
+Contacts are fixed per wheel: ``left``/``right`` for the patch nearer the
+tread, ``left_flange``/``right_flange`` for a second one; a name with no
+patch this cycle gets an empty patch, i.e. a zero wrench (``no_contact``).
+A pose the geometry cannot serve (past the flange, off the rail head,
+profiles that do not meet) is dropped for every contact as ``derailment``;
+missing or stale kinematics as in topics mode.  Like the wrapped pipeline it
+reads no clock: stamps come from the messages.
+
+Loads: the newest ``wheelset/load`` not after the pose and at most
+``max_kinematics_age`` older (``force.z`` the total, ``torque.x`` the roll
+moment: the left wheel carries ``(F + M/b)/2`` with ``b`` the wheel
+profile's lateral offset); else ``wheel_load`` per wheel; else (``0``) the
+pose's vertical position as given.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fastsim_ros.contact.errors import ContactError
+from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
+from fastsim_ros.geometry.placement import Placement, Pose
+from fastsim_ros.geometry.profiles import read_profile
+from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Wheelset,
+                                           WheelsetContact)
+from fastsim_ros.params import PROFILE_CONTACTS, ParameterError
+from fastsim_ros.pipeline import Outcome, Pipeline, PipelineConfig
+from msg_adapters.cdr import Cloud, StampedTwist
+from msg_adapters.errors import MalformedMessageError, RejectedInput
+from msg_adapters.patch import MIN_CONTACT_CELLS, patch_from_cloud
+from msg_adapters.profile_msgs import StampedPose, patch_cloud, read_load, read_pose
+
+POSE_TOPIC, LOAD_TOPIC = "wheelset/pose", "wheelset/load"
+#: loads kept for matching pose stamps
+LOAD_HISTORY = 1024
+
+
+def contact_name(side: Side, index: int) -> str:
+    """Return the contact name of a wheel's patch: 0 the tread's, 1 a second one."""
+    return side if index == 0 else f"{side}_flange"
+
+
+def placement_of(values: Any) -> Placement:
+    """Return the placement from checked parameters (or any mapping of its names)."""
+    return Placement(gauge_width=float(values["gauge_width"]),
+                     gauge_height=float(values["gauge_height"]),
+                     cant=float(values["cant"]),
+                     flange_back_distance=float(values["flange_back_distance"]),
+                     flange_back_position=float(values["flange_back_position"]),
+                     nominal_radius=float(values["nominal_radius"]))
+
+
+def wheelset_of(config: PipelineConfig) -> Wheelset:
+    """Read the profiles and place them; a bad file or value raises ParameterError (one line)."""
+    smooth = float(config["profile_smoothing"])
+    try:
+        wheel = read_profile(config["wheel_profile"], kind="wheel", smooth=smooth)
+        rail = read_profile(config["rail_profile"], kind="rail", smooth=smooth)
+        right_wheel = (read_profile(config["right_wheel_profile"], kind="wheel", smooth=smooth)
+                       if config["right_wheel_profile"] else None)
+        right_rail = (read_profile(config["right_rail_profile"], kind="rail", smooth=smooth)
+                      if config["right_rail_profile"] else None)
+        return Wheelset(wheel, rail, placement_of(config.values), right_wheel=right_wheel,
+                        right_rail=right_rail, cell=float(config["cell_size"]),
+                        shear_modulus=float(config["shear_modulus"]),
+                        poisson_ratio=float(config["poisson_ratio"]))
+    except ContactError as e:
+        raise ParameterError(str(e)) from None
+
+
+@dataclass(frozen=True, eq=False)
+class ProfileCycle:
+    """What one pose gave: the patches (``(name, cloud)``, all four names, in order),
+    the wrapped pipeline's outcomes (one per contact), and the geometry (``None`` when
+    the pose was dropped)."""
+
+    stamp_ns: int
+    patches: tuple[tuple[str, Cloud], ...]
+    outcomes: tuple[Outcome, ...]
+    contact: WheelsetContact | None
+    loads: tuple[float, float] | None
+
+
+class ProfilePipeline:
+    """Poses + loads + twists -> patches -> the pipeline's outputs (INTERFACE.md)."""
+
+    def __init__(self, config: PipelineConfig, *, solve_roll: bool = False,
+                 solver: Any = None) -> None:
+        if config["patch_source"] != "profiles":
+            raise ParameterError("a ProfilePipeline needs patch_source: profiles")
+        self.pipeline = Pipeline(config, solver=solver)
+        self.wheelset = wheelset_of(config)
+        self.solve_roll = solve_roll
+        self._loads: deque[StampedTwist] = deque(maxlen=LOAD_HISTORY)
+        self._last_pose_ns: int | None = None
+        self.pose_counts = {"pose": 0, "load": 0, "malformed": 0, "wrong_frame": 0,
+                            "nonfinite": 0, "old_stamp": 0}
+
+    @property
+    def config(self) -> PipelineConfig:
+        """Return the wrapped pipeline's configuration."""
+        return self.pipeline.config
+
+    def update(self, changes: dict[str, Any]) -> None:
+        """Apply changes of parameters that may change while running."""
+        for name in ("patch_source", "wheel_profile", "rail_profile", "right_wheel_profile",
+                     "right_rail_profile", "profile_smoothing", "gauge_width", "gauge_height",
+                     "cant", "flange_back_distance", "flange_back_position", "nominal_radius",
+                     "cell_size", "track_frame"):
+            if name in changes and changes[name] != self.config[name]:
+                raise ParameterError(f"parameter {name!r} is set at start only")
+        self.pipeline.update(changes)
+
+    # ------------------------------------------------------------------ inputs
+
+    def on_wheel_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
+        """Take a wheelset twist (see :meth:`Pipeline.on_wheel_twist`)."""
+        return self.pipeline.on_wheel_twist(twist)
+
+    def on_rail_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
+        """Take a rail twist (see :meth:`Pipeline.on_rail_twist`)."""
+        return self.pipeline.on_rail_twist(twist)
+
+    def on_load(self, load: StampedTwist | bytes | memoryview) -> str:
+        """Take a ``wheelset/load`` (force in ``linear``, torque in ``angular``); ``"ok"`` or why not."""
+        if not isinstance(load, StampedTwist):
+            try:
+                load = read_load(load)
+            except MalformedMessageError:
+                self.pose_counts["malformed"] += 1
+                return "malformed"
+        if load.frame_id != self.config["wheelset_frame"]:
+            reason = "wrong_frame"
+        elif not all(math.isfinite(v) for v in load.linear + load.angular) \
+                or not load.linear[2] > 0.0:
+            reason = "nonfinite"
+        elif self._loads and load.stamp_ns < self._loads[-1].stamp_ns:
+            reason = "old_stamp"
+        else:
+            self._loads.append(load)
+            self.pose_counts["load"] += 1
+            return "ok"
+        self.pose_counts[reason] += 1
+        return reason
+
+    def wheel_loads(self, stamp_ns: int) -> tuple[float, float] | None:
+        """Return the per-wheel loads (N) for a pose stamped ``stamp_ns``, or ``None``."""
+        max_age = round(float(self.config["max_kinematics_age"]) * 1e9)
+        for load in reversed(self._loads):
+            if load.stamp_ns <= stamp_ns:
+                if stamp_ns - load.stamp_ns <= max_age:
+                    return self.split_load(load.linear[2], load.angular[0])
+                break
+        per_wheel = float(self.config["wheel_load"])
+        return (per_wheel, per_wheel) if per_wheel > 0.0 else None
+
+    def split_load(self, total: float, roll_moment: float) -> tuple[float, float]:
+        """Return the left and right wheels' shares of a load ``total`` (N), moment ``M`` (N m)."""
+        b = self.wheelset.placement.wheel_offset
+        return (0.5 * (total + roll_moment / b), 0.5 * (total - roll_moment / b))
+
+    # ------------------------------------------------------------------ a cycle
+
+    def on_pose(self, pose: StampedPose | bytes | memoryview) -> ProfileCycle:
+        """Compute both wheels' patches for one pose and solve them (one rig cycle)."""
+        if not isinstance(pose, StampedPose):
+            try:
+                pose = read_pose(pose)
+            except MalformedMessageError as e:
+                self.pose_counts["malformed"] += 1
+                return self._dropped(-1, "missing_field", f"not a PoseStamped: {e}")
+        stamp = pose.stamp_ns
+        if pose.frame_id != self.config["track_frame"]:
+            self.pose_counts["wrong_frame"] += 1
+            return self._dropped(stamp, "wrong_frame", f"pose frame {pose.frame_id!r}, "
+                                 f"expected {self.config['track_frame']!r}")
+        if not pose.is_finite():
+            self.pose_counts["nonfinite"] += 1
+            return self._dropped(stamp, "nonfinite", "NaN or infinite values in the pose")
+        if self._last_pose_ns is not None and stamp < self._last_pose_ns:
+            self.pose_counts["old_stamp"] += 1
+            return self._dropped(stamp, "old_stamp", f"pose stamp {stamp} ns is older than "
+                                 f"the last, {self._last_pose_ns} ns")
+        self._last_pose_ns = stamp
+        self.pose_counts["pose"] += 1
+        try:
+            roll, yaw = pose.roll_yaw()
+            wheelset_pose = Pose(dy=pose.position[1], dz=pose.position[2], yaw=yaw, roll=roll)
+        except (MalformedMessageError, GeometryError) as e:
+            return self._dropped(stamp, "nonfinite", str(e))
+        try:
+            wheel, rail = self.pipeline.kinematics(stamp)
+        except RejectedInput as e:
+            return self._dropped(stamp, e.reason, e.detail)
+        loads = self.wheel_loads(stamp)
+        try:
+            contact = self.solve(wheelset_pose, wheel, rail, stamp, loads=loads)
+        except RejectedInput as e:
+            return self._dropped(stamp, e.reason, e.detail)
+        except (DerailmentError, NoContactError) as e:
+            return self._dropped(stamp, "derailment", str(e))
+        except ContactError as e:
+            return self._dropped(stamp, "degenerate", str(e))
+        patches = self.clouds(contact, stamp)
+        outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
+        return ProfileCycle(stamp, patches, outcomes, contact, loads)
+
+    def solve(self, pose: Pose, wheel: StampedTwist, rail: StampedTwist, stamp_ns: int, *,
+              loads: tuple[float, float] | None) -> WheelsetContact:
+        """Return both wheels' contacts at a pose under the twists (creep forces balanced)."""
+        frame = self.config["wheelset_frame"]
+        max_cells = int(self.config["max_patch_cells"])
+
+        def creep_forces(side: Side, patches: Sequence[WheelPatch]) -> list[Vector]:
+            rot = pose.rotation()
+            out: list[Vector] = []
+            for wp in patches:
+                cloud = patch_cloud(stamp_ns, frame, wp.points, wp.normal, wp.pressure)
+                patch = patch_from_cloud(cloud, max_cells=max_cells)
+                if patch is None:
+                    out.append((0.0, 0.0, 0.0))
+                    continue
+                _, f = self.pipeline.solve_patch(patch, wheel, rail)
+                f_w = patch.frame.to_wheelset((f.fx, f.fy, 0.0))
+                f_t = rot @ np.asarray(f_w)
+                out.append((float(f_t[0]), float(f_t[1]), float(f_t[2])))
+            return out
+
+        return self.wheelset.solve(pose, loads=loads, solve_roll=self.solve_roll,
+                                   tangential=creep_forces)
+
+    def clouds(self, contact: WheelsetContact, stamp_ns: int) -> tuple[tuple[str, Cloud], ...]:
+        """Return the four contacts' patch clouds (empty where a wheel has no such patch)."""
+        frame = self.config["wheelset_frame"]
+        by_name: dict[str, Cloud] = {}
+        for wheel in contact.wheels:
+            for index, wp in enumerate(_tread_first(wheel.patches)):
+                by_name[contact_name(wheel.side, index)] = patch_cloud(
+                    stamp_ns, frame, wp.points, wp.normal, wp.pressure)
+        empty = np.zeros((0, 0))
+        return tuple((name, by_name.get(name) or patch_cloud(stamp_ns, frame, np.zeros((0, 0, 3)),
+                                                             np.zeros(3), empty))
+                     for name in PROFILE_CONTACTS)
+
+    def _dropped(self, stamp: int, reason: str, detail: str) -> ProfileCycle:
+        outcomes = tuple(self.pipeline.reject(name, stamp, reason, detail)
+                         for name in PROFILE_CONTACTS)
+        return ProfileCycle(stamp, (), outcomes, None, None)
+
+
+def _tread_first(patches: Sequence[WheelPatch]) -> list[WheelPatch]:
+    """Order a wheel's patches: nearest the tread (the field side, larger side-frame y) first."""
+    return sorted(patches, key=lambda p: -p.region.reference[1])
+
+
+__all__ = ["LOAD_TOPIC", "POSE_TOPIC", "ProfileCycle", "ProfilePipeline", "SIDES",
+           "contact_name", "placement_of", "wheelset_of", "MIN_CONTACT_CELLS"]
