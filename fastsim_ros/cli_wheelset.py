@@ -163,8 +163,8 @@ def wheel_twist(pose: Pose, speed: float, axle_spin: float, lateral_speed: float
                         (float(w[0]), float(w[1]), float(w[2])))
 
 
-def solve_pose(args: argparse.Namespace, dy: float, yaw: float) -> tuple[ProfileCycle,
-                                                                        ProfilePipeline]:
+def solve_pose(args: argparse.Namespace, dy: float,
+               yaw: float) -> tuple[ProfileCycle, ProfilePipeline]:
     """Solve one pose as the node would; the pose's roll solved first when not given."""
     config = _config(args)
     solver = ExactSolver(args.nu, args.shear_modulus) if args.method == "exact" else None

@@ -142,7 +142,7 @@ class ProfilePipeline:
         return self.pipeline.on_rail_twist(twist)
 
     def on_load(self, load: StampedTwist | bytes | memoryview) -> str:
-        """Take a ``wheelset/load`` (force in ``linear``, torque in ``angular``); ``"ok"`` or why not."""
+        """Take a ``wheelset/load`` (``linear`` the force, ``angular`` the torque): "ok" or why."""
         if not isinstance(load, StampedTwist):
             try:
                 load = read_load(load)
@@ -236,11 +236,19 @@ class ProfilePipeline:
             out: list[Vector] = []
             for wp in patches:
                 cloud = patch_cloud(stamp_ns, frame, wp.points, wp.normal, wp.pressure)
-                patch = patch_from_cloud(cloud, max_cells=max_cells)
-                if patch is None:
+                try:
+                    patch = patch_from_cloud(cloud, max_cells=max_cells)
+                    if patch is None:
+                        raise RejectedInput("degenerate", "an empty patch")
+                    _, f = self.pipeline.solve_patch(patch, wheel, rail)
+                except RejectedInput as e:
+                    if e.reason in ("standstill", "too_large", "nonfinite"):
+                        raise
+                    # a sliver on the way to the balance (a trial position barely
+                    # touching) that the solver refuses: its creep force is left out;
+                    # the final patches are solved, or refused, by on_patch
                     out.append((0.0, 0.0, 0.0))
                     continue
-                _, f = self.pipeline.solve_patch(patch, wheel, rail)
                 f_w = patch.frame.to_wheelset((f.fx, f.fy, 0.0))
                 f_t = rot @ np.asarray(f_w)
                 out.append((float(f_t[0]), float(f_t[1]), float(f_t[2])))

@@ -118,7 +118,7 @@ def read_inputs(name: str) -> list[tuple[float, ...]]:
 
 
 def read_ref_out(name: str) -> list[CaseResult]:
-    """Read one of the shipped ``.ref_out`` files (``mbench_a22_left`` etc.), poses from its ``.inp``."""
+    """Read a shipped ``.ref_out`` (``mbench_a22_left`` etc.); poses from its ``.inp``."""
     inputs = read_inputs(name)
     text = (DATA / f"{name}.ref_out").read_text()
     chunks = re.split(r"^\s*Case\s+(\d+)\s*$", text, flags=re.MULTILINE)

@@ -25,7 +25,7 @@ FloatArray = NDArray[np.float64]
 ComplexArray = NDArray[np.complex128]
 
 #: relative pressure change of one iteration at which the solve stops
-TOLERANCE = 1e-11
+TOLERANCE = 1e-10
 MAX_ITERATIONS = 2000
 #: influence spectra kept (grid shapes recur from one pose to the next)
 CACHE_SIZE = 64

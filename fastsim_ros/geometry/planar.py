@@ -86,7 +86,7 @@ def plane_axes(angle: float, pose: Pose) -> tuple[FloatArray, FloatArray, FloatA
 
 def grid_extent(region: Region, rail: RailSide, cell: float,
                 margin: int = 1) -> tuple[int, int, int, int]:
-    """Return the cell index ranges ``ix_lo, ix_hi, iy_lo, iy_hi`` (CONTACT's guard of one cell)."""
+    """Return the cell index ranges ``ix_lo, ix_hi, iy_lo, iy_hi`` (CONTACT's guard: a cell)."""
     x_ref, y_ref, _ = region.reference
     arc_ref = float(np.interp(y_ref, rail.y, rail.arc))
     s_lo = float(np.interp(region.y_range[0], rail.y, rail.arc)) - arc_ref
@@ -156,8 +156,8 @@ def _wheel_distance(points: FloatArray, normal: FloatArray, start: FloatArray,
         if float(a.min()) < a_lo or float(a.max()) > a_hi:
             raise DerailmentError("the contact plane reaches beyond the wheel profile")
         f = rho - np.interp(a, wheel.axial, wheel.radius)
-        df = (q[..., 0] * m[0] + q[..., 2] * m[2]) / rho - np.interp(a, wheel.axial,
-                                                                       wheel.slope) * m[1]
+        slope = np.interp(a, wheel.axial, wheel.slope)
+        df = (q[..., 0] * m[0] + q[..., 2] * m[2]) / rho - slope * m[1]
         step = f / df
         t = t - step
         if float(np.abs(step).max()) < NEWTON_TOLERANCE:

@@ -99,11 +99,13 @@ class Profile:
 
     def z_at(self, y: FloatArray | float) -> FloatArray:
         """Return ``z`` (m, down) of the surface at lateral positions ``y`` (m); NaN outside."""
-        return np.interp(y, self.dense_y, self.dense_z, left=math.nan, right=math.nan)
+        return np.asarray(np.interp(y, self.dense_y, self.dense_z, left=math.nan,
+                                    right=math.nan), dtype=np.float64)
 
     def slope_at(self, y: FloatArray | float) -> FloatArray:
         """Return ``dz/dy`` of the surface at ``y`` (m); NaN outside."""
-        return np.interp(y, self.dense_y, self.dense_slope, left=math.nan, right=math.nan)
+        return np.asarray(np.interp(y, self.dense_y, self.dense_slope, left=math.nan,
+                                    right=math.nan), dtype=np.float64)
 
 
 def resolve_path(name: str | Path) -> Path:
@@ -125,7 +127,8 @@ def read_profile(name: str | Path, *, kind: Kind | None = None,
     path = resolve_path(name)
     label = str(name)
     suffix = path.suffix.lower()
-    file_kind: Kind | None = {".prw": "wheel", ".prr": "rail"}.get(suffix)  # type: ignore[assignment]
+    file_kind: Kind | None = ("wheel" if suffix == ".prw" else "rail" if suffix == ".prr"
+                              else None)
     if kind is None:
         kind = file_kind
     if kind not in ("wheel", "rail"):
@@ -233,7 +236,8 @@ def _parse_simpack(text: str, label: str) -> tuple[FloatArray, FloatArray, NDArr
         raise ProfileError(f"{label}: no points")
     header_kind: Kind | None = None
     if "header.type" in options:
-        header_kind = {"0": "rail", "1": "wheel"}.get(options["header.type"].split()[0])
+        code = options["header.type"].split()[0]
+        header_kind = "rail" if code == "0" else "wheel" if code == "1" else None
 
     def opt(key: str, default: float) -> float:
         if key not in options:
@@ -494,4 +498,5 @@ def _smoothed(y: FloatArray, z: FloatArray, wavelength: float) -> tuple[FloatArr
     d2[rows, rows + 1] = -2.0 / (h[:-1] * h[1:])
     d2[rows, rows + 2] = 2.0 / (h[1:] * (h[:-1] + h[1:]))
     a = np.diag(w) + lam * d2.T @ (w[1:-1, None] * d2)
-    return np.linalg.solve(a, w * y), np.linalg.solve(a, w * z)
+    return (np.asarray(np.linalg.solve(a, w * y), dtype=np.float64),
+            np.asarray(np.linalg.solve(a, w * z), dtype=np.float64))

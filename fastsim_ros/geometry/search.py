@@ -147,7 +147,8 @@ def vertical_gap(rail: RailSide, wheel: WheelSide, pose: Pose, nominal_radius: f
     wheel_axial = np.interp(y, locus[:, 1], locus[:, 3])
     rail_z = np.interp(y, rail.y, rail.z)
     rail_angle = np.interp(y, rail.y, rail.angle)
-    return Locus(y, wheel_z, wheel_x, wheel_axial, rail_z, rail_angle, wheel_z - rail_z)
+    return Locus(np.asarray(y, dtype=np.float64), wheel_z, wheel_x, wheel_axial, rail_z,
+                 rail_angle, wheel_z - rail_z)
 
 
 def _region(locus: Locus, i0: int, i1: int, curvature: float) -> Region:
@@ -292,6 +293,8 @@ def _check_inside(region: Region, rail: RailSide, wheel: WheelSide, locus: Locus
                               "the flange tip: the wheel has climbed the rail")
     lo_y, hi_y = float(locus.y[0]), float(locus.y[-1])
     if region.y_range[0] <= lo_y + EDGE_MARGIN or region.y_range[1] >= hi_y - EDGE_MARGIN:
-        side = "track-centre" if region.y_range[0] <= lo_y + EDGE_MARGIN else "field"
+        centre_side = region.y_range[0] <= lo_y + EDGE_MARGIN
+        where = region.y_range[0] if centre_side else region.y_range[1]
+        side = "track-centre" if centre_side else "field"
         raise DerailmentError(f"the contact reaches the {side} end of the profiles at "
-                              f"y = {region.y_range[0] if side != 'field' else region.y_range[1]:.4f} m")
+                              f"y = {where:.4f} m")
