@@ -319,8 +319,8 @@ def _chord_length(y: FloatArray, z: FloatArray) -> float:
 
 
 def _to_metres(y: FloatArray, z: FloatArray, label: str) -> tuple[FloatArray, FloatArray]:
-    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(z))):
-        return y, z  # refused with the point named by _canonical
+    if not (np.all(np.isfinite(y)) and np.all(np.isfinite(z))) or y.size < MIN_POINTS:
+        return y, z  # refused, with the point named, by _canonical
     length = _chord_length(y, z)
     if MIN_LENGTH_MM <= length <= MAX_LENGTH_MM:
         return y * 1e-3, z * 1e-3

@@ -76,9 +76,10 @@ class WheelPatch:
     undeformed surfaces); ``load``: ``N = sum p dA`` (N); ``region``: the
     interpenetration region it came from (side frame).  ``points`` and
     ``normal``: the cell centres (``(ny, nx, 3)``, m) and the plane's normal
-    pointing into the wheel, in the wheelset frame; ``reference``: CONTACT's
-    weighted reference point and ``origin``: the pressure centroid, both in
-    the track frame (m).
+    pointing into the wheel, in the wheelset frame of ``frame_pose``;
+    ``points_track``, ``normal_track``: the same in the track frame;
+    ``reference``: CONTACT's weighted reference point and ``origin``: the
+    pressure centroid, both in the track frame (m).
     """
 
     side: Side
@@ -93,6 +94,18 @@ class WheelPatch:
     reference: Vector
     origin: Vector
     angle: float
+    points_track: FloatArray
+    frame_pose: Pose
+
+    def in_frame(self, pose: Pose, nominal_radius: float) -> WheelPatch:
+        """Return the patch with ``points`` and ``normal`` in the wheelset frame of ``pose``."""
+        if pose == self.frame_pose:
+            return self
+        rot = pose.rotation()
+        centre = np.array([0.0, pose.dy, nominal_radius + pose.dz])
+        points = (self.points_track - centre) @ rot
+        points.setflags(write=False)
+        return replace(self, points=points, normal=rot.T @ self.normal_track, frame_pose=pose)
 
     @property
     def cells(self) -> int:
@@ -239,9 +252,10 @@ class Wheelset:
         else:
             origin = tuple(float(v) for v in ref)
         points_w.setflags(write=False)
+        centres_t.setflags(write=False)
         return WheelPatch(side, grid, pressure, approach, load, region, points_w, normal_w,
                           normal_t, (float(ref[0]), float(ref[1]), float(ref[2])),
-                          (origin[0], origin[1], origin[2]), grid.angle)
+                          (origin[0], origin[1], origin[2]), grid.angle, centres_t, pose)
 
     def wheel_at(self, side: Side, pose: Pose,
                  tangential: TangentialForces | None = None) -> WheelContact:
@@ -299,9 +313,22 @@ class Wheelset:
         if loads is not None and not solve_roll:
             left = self.wheel_loaded("left", pose, loads[0], tangential)
             right = self.wheel_loaded("right", pose, loads[1], tangential)
-            dz = 0.5 * (left.dz + right.dz)
-            return WheelsetContact(replace(pose, dz=dz), (left, right))
+            return self._one_frame(replace(pose, dz=0.5 * (left.dz + right.dz)), left, right)
         return self._solve_roll(pose, loads, tangential)
+
+    def _one_frame(self, pose: Pose, left: WheelContact, right: WheelContact) -> WheelsetContact:
+        """Both wheels' patches in the one wheelset frame of ``pose``.
+
+        With the roll given, each wheel carries its load at its own height
+        (CONTACT's half-wheelset cases); the frame's origin is the mean, so
+        each wheel's patches lie where its own solve put them, expressed
+        from there (their heights differ by what the roll did not balance,
+        micrometres for a roll near the equilibrium).
+        """
+        r0 = self.placement.nominal_radius
+        wheels = tuple(replace(w, patches=tuple(p.in_frame(pose, r0) for p in w.patches))
+                       for w in (left, right))
+        return WheelsetContact(pose, (wheels[0], wheels[1]))
 
     def _solve_roll(self, pose: Pose, loads: tuple[float, float] | None,
                     tangential: TangentialForces | None) -> WheelsetContact:
@@ -315,8 +342,8 @@ class Wheelset:
                 right = self.wheel_loaded("right", p, loads[1], tangential)
                 mismatch = left.dz - right.dz
                 if abs(mismatch) <= ROLL_TOLERANCE:
-                    dz = 0.5 * (left.dz + right.dz)
-                    return WheelsetContact(replace(p, dz=dz), (left, right))
+                    return self._one_frame(replace(p, dz=0.5 * (left.dz + right.dz)), left,
+                                           right)
                 roll += mismatch / (2.0 * half_track)
                 _check_roll(roll)
             raise NoContactError("the roll that levels both wheels was not found")
