@@ -94,8 +94,8 @@ def test_patch_cloud_bytes_decode_in_rclpy_and_back_to_the_same_patch():
     raw = cloud_cdr(cloud)
     msg = deserialize_message(raw, PointCloud2)
     assert (msg.height, msg.width, msg.point_step, msg.row_step) == (ny, nx, 56, 56 * nx)
-    assert [f.name for f in msg.fields] == ["x", "y", "z", "normal_x", "normal_y", "normal_z",
-                                           "pressure"]
+    names = ["x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure"]
+    assert [f.name for f in msg.fields] == names
     assert msg.header.frame_id == "wheelset"
     assert msg.header.stamp.sec == 123 and msg.header.stamp.nanosec == 456
     data = np.frombuffer(bytes(msg.data), dtype="<f8").reshape(ny, nx, 7)
