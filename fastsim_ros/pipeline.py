@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -162,6 +162,27 @@ class ContactStats:
         return float(p50) * 1e6, float(p99) * 1e6
 
 
+#: a handler of one input message (CDR bytes): the outcomes it gave (none for kinematics)
+InputHandler = Callable[[bytes | memoryview], tuple[Outcome, ...]]
+
+
+@dataclass(frozen=True)
+class InputTopic:
+    """One input topic of the pipeline and its handler (front ends dispatch on these).
+
+    ``topic``: relative name; ``msgtype``: its ROS type; ``kind``:
+    ``"patch"`` (of ``contact``), ``"wheel_twist"`` or ``"rail_twist"``;
+    ``take``: the pipeline's handler of one message (CDR bytes), returning
+    the outcomes it gave (none for kinematics).
+    """
+
+    topic: str
+    msgtype: str
+    kind: str
+    contact: str | None
+    take: InputHandler
+
+
 @dataclass(frozen=True)
 class ContactReport:
     """One contact's diagnostics: level (0 OK, 1 WARN, 2 ERROR), message, key-values."""
@@ -256,6 +277,31 @@ class Pipeline:
             if config[name] != self.config[name]:
                 raise parameters.ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config)
+
+    def inputs(self) -> tuple[InputTopic, ...]:
+        """Return every input topic the pipeline takes, with its handler, in this order.
+
+        The one table of inputs: a new input (a topic and its ``on_*``
+        method) is added here, and the replay dispatches on it.
+        """
+        def kinematics(on: Callable[[bytes | memoryview], str]) -> InputHandler:
+            def take(raw: bytes | memoryview) -> tuple[Outcome, ...]:
+                on(raw)  # counted in kinematics_counts; no outcome
+                return ()
+            return take
+
+        def patch(contact: str) -> InputHandler:
+            def take(raw: bytes | memoryview) -> tuple[Outcome, ...]:
+                return (self.on_patch(contact, raw),)
+            return take
+
+        twist = "geometry_msgs/msg/TwistStamped"
+        return ((InputTopic(WHEEL_TWIST_TOPIC, twist, "wheel_twist", None,
+                            kinematics(self.on_wheel_twist)),
+                 InputTopic(RAIL_TWIST_TOPIC, twist, "rail_twist", None,
+                            kinematics(self.on_rail_twist)))
+                + tuple(InputTopic(patch_topic(c), "sensor_msgs/msg/PointCloud2", "patch", c,
+                                   patch(c)) for c in self.config.contacts))
 
     # ---------------------------------------------------------------- kinematics
 

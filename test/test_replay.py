@@ -71,6 +71,9 @@ ATOL = {"xi": 1e-9 * 1e-3, "eta": 1e-9 * 1e-3, "phi": 1e-9, "V": 1e-9, "N": 1e-9
         "slip_fraction": 1e-9}
 
 
+CSV_HEADER_VALUES = [k for k in replay.CSV_HEADER if k != "contact"]
+
+
 # ------------------------------------------------------------------------ helpers
 
 def run(args, capsys=None):
@@ -305,11 +308,115 @@ def test_roller_rig_is_served_with_its_rail_twist(replayed):
     assert np.abs(fx[np.abs(xi) < 1e-7]).max() < 1.0  # passes zero at xi = 0
 
 
-def test_roller_rig_without_its_params_solves_nothing_and_warns(tmp_path, capsys):
-    status, out, err = run([BAGS / "roller_rig", "-o", tmp_path], capsys)
+def test_roller_rig_without_its_params_takes_its_contact_from_the_bag(tmp_path, capsys):
+    status, out, err = run([BAGS / "roller_rig", "-o", tmp_path, "--csv"], capsys)
+    assert status == 0 and err == ""
+    assert "contacts found in the bag (no --params): wheel\n" in out
+    assert "wheel: 400 patches, 400 wrenches (400 solved" in out
+    meta = yaml.safe_load((tmp_path / "roller_rig" / "metadata.yaml").read_text())
+    stored = json.loads(meta["rosbag2_bagfile_information"]["custom_data"][replay.PARAMETERS_KEY])
+    assert stored["contacts"] == ["wheel"] and stored["method"] == "mae_calibrated"
+    # the rail twist is used when fresh (rail_twist_required only makes it compulsory)
+    assert column(rows_of(tmp_path / "roller_rig.csv"), "V") == pytest.approx(15.0, rel=0.01)
+
+
+def test_roller_rig_with_other_contacts_solves_nothing_and_warns(tmp_path, capsys):
+    params = tmp_path / "params.yaml"
+    params.write_text("fastsim:\n  ros__parameters:\n    contacts: [left, right]\n")
+    status, out, err = run([BAGS / "roller_rig", "-o", tmp_path / "out", "--params", params],
+                           capsys)
     assert status == 0
     assert "no patch topic of the configured contacts (left, right)" in err
     assert "left: 0 patches" in out
+
+
+# ------------------------------------------------------------------------ namespaces
+
+def _namespaced_copy(source, target, renames):
+    """Write ``source`` again with its topics renamed (``renames``: old -> new name)."""
+    with Reader(source) as reader, \
+            Writer(target, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conns = {c.id: writer.add_connection(renames.get(c.topic, c.topic), c.msgtype,
+                                             typestore=TYPES,
+                                             offered_qos_profiles=c.ext.offered_qos_profiles)
+                 for c in reader.connections}
+        for conn, log_ns, raw in reader.messages():
+            writer.write(conns[conn.id], log_ns, raw)
+
+
+@pytest.fixture(scope="module")
+def rig1_front(tmp_path_factory):
+    """hertz_ramp's left wheel recorded under /rig1 as contact ``front`` (twists relative)."""
+    path = tmp_path_factory.mktemp("rig1") / "rig1_front"
+    _namespaced_copy(BAGS / "hertz_ramp", path, {
+        "/contact/left/patch": "/rig1/contact/front/patch",
+        "/contact/right/patch": "/contact/right/patch",  # outside the namespace: copied only
+        "/wheelset/twist": "rig1/wheelset/twist"})        # relative: in the root namespace
+    return path
+
+
+def test_namespaced_recording_with_a_front_contact_replays_without_params(tmp_path, capsys,
+                                                                          rig1_front):
+    out = tmp_path / "out"
+    status, stdout, err = run([rig1_front, "-o", out, "--namespace", "/rig1", "--csv"], capsys)
+    assert status == 0 and err == ""
+    assert "contacts found in the bag (no --params): front; namespace /rig1\n" in stdout
+    assert "front: 400 patches, 400 wrenches (400 solved" in stdout
+    assert "twists: 800 wheelset" in stdout
+    topics, _, meta = bag_contents(out / "rig1_front")
+    for topic in ("/rig1/contact/front/wrench", "/rig1/contact/front/creepage",
+                  "/rig1/wheelset/wrench"):
+        assert len(topics[topic][1]) == 400, topic
+    assert topics["/rig1/contact/front/wrench"][1][0][1].header.frame_id == "front_contact"
+    assert "/rig1/contact/markers" in topics and "/diagnostics" in topics
+    assert not any(t.startswith("/contact/") and not t.endswith("/patch") for t in topics)
+    assert len(topics["/contact/right/patch"][1]) == 400  # copied, not solved
+    stored = json.loads(meta["custom_data"][replay.PARAMETERS_KEY])
+    assert stored["contacts"] == ["front"]
+    # the same physics as hertz_ramp's left wheel replayed with its own name, defaults
+    params = tmp_path / "left.yaml"
+    params.write_text("fastsim:\n  ros__parameters:\n    contacts: [left]\n")
+    assert run([BAGS / "hertz_ramp", "-o", tmp_path / "plain", "--csv",
+                "--params", params])[0] == 0
+    got, want = rows_of(out / "rig1_front.csv"), rows_of(tmp_path / "plain" / "hertz_ramp.csv")
+    assert len(got) == len(want) == 400
+    for g, w in zip(got, want):
+        assert g["contact"] == "front" and w["contact"] == "left"
+        assert [g[k] for k in CSV_HEADER_VALUES] == [w[k] for k in CSV_HEADER_VALUES]
+
+
+def test_namespaced_recording_in_the_root_namespace(tmp_path, capsys, rig1_front):
+    # in /, the one patch topic is /contact/right/patch; the twists are under /rig1
+    status, out, err = run([rig1_front, "-o", tmp_path], capsys)
+    assert status == 0 and err == ""
+    assert "contacts found in the bag (no --params): right\n" in out
+    assert "right: 400 patches, 0 wrenches (0 solved, 0 no_contact), rejected 400 " \
+        "(no_kinematics 400)" in out
+
+
+def test_namespace_without_patch_topics_warns(tmp_path, capsys):
+    status, out, err = run([BAGS / "hertz_ramp", "-o", tmp_path, "--namespace", "rig2"], capsys)
+    assert status == 0
+    assert "no patch topic under /rig2 (no --params: the contacts are those with a " \
+        "/rig2/contact/<name>/patch topic)" in err
+    assert "left: 0 patches" in out
+
+
+@pytest.mark.parametrize("text, resolved", [("rig1", "/rig1"), ("/rig1", "/rig1"), ("/", "/"),
+                                            ("/a/b_2", "/a/b_2"), ("_x", "/_x")])
+def test_namespace_flag_is_made_absolute(text, resolved):
+    assert replay.parser().parse_args(["in", "-o", "out", "--namespace", text]).namespace \
+        == resolved
+
+
+def test_topics_resolve_as_ros_resolves_them():
+    assert replay.resolve("contact/left/patch") == "/contact/left/patch"
+    assert replay.resolve("contact/left/patch", "/rig1") == "/rig1/contact/left/patch"
+    assert replay.resolve("/diagnostics", "/rig1") == "/diagnostics"
+    assert replay.bag_contacts(["/rig1/contact/front/patch", "rig1/contact/rear/patch",
+                                "/contact/left/patch", "/rig1/contact/a/b/patch",
+                                "/rig1/contact/9x/patch", "/rig1/contact/front/patch"],
+                               "/rig1") == ("front", "rear")
 
 
 # ------------------------------------------------------------------------ (b) bad inputs
@@ -577,6 +684,9 @@ def test_existing_target_exits_before_work(tmp_path, capsys, existing, flags):
     (["--par", "x.yaml"], "unrecognized arguments: --par"),
     (["--bogus"], "unrecognized arguments: --bogus"),
     (["-o"], "argument -o/--output: expected one argument"),
+    (["--namespace", "rig 1"], "argument --namespace: 'rig 1' is not a ROS namespace"),
+    (["--namespace", "/rig1/"], "argument --namespace: '/rig1/' is not a ROS namespace"),
+    (["--namespace", "//rig1"], "argument --namespace: '//rig1' is not a ROS namespace"),
 ])
 def test_bad_flags_one_line_exit_2(tmp_path, capsys, args, message):
     with pytest.raises(SystemExit) as e:

@@ -1,0 +1,75 @@
+"""``fastsim_replay``: replay recorded bags offline through the node's pipeline.
+
+Usage (INTERFACE.md, "The offline replay fastsim_replay")::
+
+    fastsim_replay IN [IN ...] -o OUT [--params FILE] [--namespace NS] [--plot] [--csv]
+                   [--jobs N]
+
+Each ``IN`` (a rosbag2 directory, or a single ``.mcap``) named ``NAME`` (the
+directory's name, or the file's without ``.mcap``) gives:
+
+- ``OUT/NAME/``: a rosbag2 bag (version 9, MCAP, zstd chunk compression)
+  with the input's topics copied (an input message on one of the node's
+  output topics is not copied) and the node's outputs on the node's topic
+  names, each logged at the log time of the patch that gave it:
+  ``/contact/<name>/wrench``, ``creepage``, ``frame`` (and ``traction``
+  when asked for), ``/wheelset/wrench``, ``/contact/markers`` and
+  ``/diagnostics`` (one array each time the log time passes a whole second
+  since the first message, stamped with that message's log time, and one
+  at the end).  Output connections offer the node's publisher QoS
+  (``output_reliability``, keep last ``qos_depth``: reliable, 10 by
+  default).  The metadata's ``custom_data`` holds ``fastsim.parameters``
+  (JSON of every checked parameter, defaults filled), ``fastsim.input``
+  (the input's path) and ``fastsim.replay`` (this program).
+- with ``--plot``, ``OUT/NAME.png``: per contact, Fx and Fy against time
+  (with +-mu N dashed) and against the creepage that varies most on that
+  contact (``phi`` counted as ``phi * 5 mm``, a typical semi-axis, when
+  comparing spreads).
+- with ``--csv``, ``OUT/NAME.csv``: one row per wrench, header
+  :data:`CSV_HEADER`; floats in Python's shortest round-trip form.  A
+  ``no_contact`` row (an empty patch, zero wrench) has ``N, Fx, Fy, Mz`` =
+  0 and ``xi, eta, phi, V, slip_fraction`` blank (undefined: no contact).
+
+Messages are fed to :class:`~fastsim_ros.pipeline.Pipeline` in the bag's
+log-time order, raw CDR as read.  Topic names resolve as ROS resolves them:
+a bag's relative names are in the root namespace, the node's in
+``--namespace`` (default ``/``: patches on ``NS/contact/<name>/patch``,
+outputs under ``NS``, ``/diagnostics`` absolute).  Without ``--params``
+every parameter has its default and the contacts are those with a
+``NS/contact/<name>/patch`` topic in the bag, in the bag's order (the
+summary names them).  Everything is written under a temporary name inside ``OUT``
+and renamed at the end; on failure, Ctrl-C or SIGTERM nothing is left of
+an unfinished input (inputs already done, whose summaries were printed, stay).
+A progress bar (tqdm, on stderr) appears when stderr is a terminal, ``--jobs``
+is 1 and a bag takes more than a second.
+
+Exit status: 0 all done; 2 bad flags, a bad params file, two inputs with the
+same NAME or a target that exists (all before any work), or a bad, corrupt,
+truncated or empty input (the others are still done); 1 an output that could
+not be written or an internal error; 130 interrupted.  Every problem is one
+line on stderr naming the file.
+
+The package, each module one concern (dependencies point down):
+
+- :mod:`~fastsim_ros.replay.cli`: flags, checks before any work, the summary;
+- :mod:`~fastsim_ros.replay.executors`: where tasks run (this process, a
+  local pool): the one seam between the command line and one input's replay;
+- :mod:`~fastsim_ros.replay.run`: one input, replayed and committed atomically;
+- :mod:`~fastsim_ros.replay.records` (CSV rows, plot samples),
+  :mod:`~fastsim_ros.replay.plot`, :mod:`~fastsim_ros.replay.results`
+  (:class:`Result`, its summary), :mod:`~fastsim_ros.replay.bagio`
+  (rosbags reading and writing), :mod:`~fastsim_ros.replay.errors`.
+"""
+
+from fastsim_ros.pipeline import Pipeline, output_topics
+from fastsim_ros.replay.bagio import input_name
+from fastsim_ros.replay.cli import main, parser
+from fastsim_ros.replay.errors import BadInput, OutputError
+from fastsim_ros.replay.records import CSV_HEADER
+from fastsim_ros.replay.results import Profile, Result
+from fastsim_ros.replay.run import (PARAMETERS_KEY, PROG, Task, bag_contacts, replay_bag,
+                                    resolve, run_task, targets)
+
+__all__ = ["BadInput", "CSV_HEADER", "OutputError", "PARAMETERS_KEY", "PROG", "Pipeline",
+           "Profile", "Result", "Task", "bag_contacts", "input_name", "main", "output_topics",
+           "parser", "replay_bag", "resolve", "run_task", "targets"]

@@ -1,0 +1,164 @@
+"""The command line of ``fastsim_replay``: flags, checks before any work, summaries, status."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import re
+import shutil
+import signal
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from fastsim_ros.params import ParameterError, defaults, load_params_file
+from fastsim_ros.replay.bagio import input_name
+from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
+from fastsim_ros.replay.run import PROG, Task, targets
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> Any:  # one line, exit 2 (argparse prints usage too)
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def parser() -> argparse.ArgumentParser:
+    """Return the command-line parser."""
+    p = _Parser(prog=PROG, allow_abbrev=False,
+                description="Replay rosbag2 bags (directories or .mcap files) through the "
+                            "fastsim node's pipeline; write bags with the creep forces.")
+    p.add_argument("inputs", nargs="+", metavar="IN", type=Path,
+                   help="a rosbag2 directory or a single .mcap file")
+    p.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
+                   help="output directory (made if missing)")
+    p.add_argument("--params", type=Path, metavar="FILE",
+                   help="the node's ROS 2 parameter file (default: every default, and the "
+                        "contacts those with a patch topic in the bag)")
+    p.add_argument("--namespace", type=namespace, default="/", metavar="NS",
+                   help="the node's namespace: patches on NS/contact/<name>/patch, outputs "
+                        "under NS (default /; a bag's relative topic names are in /)")
+    p.add_argument("--plot", action="store_true", help="write OUT/NAME.png")
+    p.add_argument("--csv", action="store_true", help="write OUT/NAME.csv, one row per wrench")
+    p.add_argument("--jobs", type=_jobs, default=1, metavar="N",
+                   help="replay the inputs on N worker processes (default 1)")
+    p.add_argument("--no-progress", action="store_true",
+                   help="no progress bar (it shows only on a terminal anyway)")
+    return p
+
+
+_TOKEN = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def namespace(text: str) -> str:
+    """Return a ROS namespace made absolute (``rig1`` -> ``/rig1``); refuse a malformed one.
+
+    Tokens of letters, digits and underscores, not starting with a digit,
+    separated by single slashes (ROS 2 name rules); ``/`` is the root.
+    """
+    name = text if text.startswith("/") else "/" + text
+    if name == "/":
+        return name
+    tokens = name[1:].split("/")
+    if not all(_TOKEN.match(t) for t in tokens):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a ROS namespace (tokens of letters, digits and underscores, "
+            "not starting with a digit, separated by single slashes)")
+    return name
+
+
+def _jobs(text: str) -> int:
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if not 1 <= n <= 256:
+        raise argparse.ArgumentTypeError(f"{n} is outside [1, 256]")
+    return n
+
+
+def _fail(message: str) -> int:
+    print(f"{PROG}: {message}", file=sys.stderr)
+    return 2
+
+
+def _terminate(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the replay; return the exit status (see the package docstring)."""
+    args = parser().parse_args(argv)
+    out: Path = args.output
+    values = defaults()
+    if args.params is not None:
+        try:
+            values = load_params_file(args.params)
+        except ParameterError as e:
+            return _fail(str(e))
+    names: dict[str, Path] = {}
+    for src in args.inputs:
+        name = input_name(src)
+        if not name or name.startswith("."):
+            return _fail(f"{src}: cannot name an output after it")
+        if name in names:
+            return _fail(f"{src}: same name {name!r} as {names[name]}; outputs would clash")
+        names[name] = src
+    if os.path.lexists(out) and not out.is_dir():
+        return _fail(f"{out}: exists and is not a directory")
+    for name in names:
+        for target in targets(out, name, args.plot, args.csv):
+            if os.path.lexists(target):
+                return _fail(f"{target}: exists already; not overwritten")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        print(f"{PROG}: {out}: cannot make the output directory: {e.strerror or e}",
+              file=sys.stderr)
+        return 1
+    tag = f"{os.getpid()}"
+    jobs = min(args.jobs, len(names))
+    tasks = [Task(src, name, out, values, plot=args.plot, write_csv=args.csv,
+                  contacts_from_bag=args.params is None, namespace=args.namespace, tag=tag,
+                  progress=not args.no_progress and jobs == 1)
+             for name, src in names.items()]
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    status = 0
+    executor: Executor | None = None
+    try:
+        from fastsim_ros.contact import compiled
+        from msg_adapters import patch as patch_adapter
+        compiled.warm_up()  # load the kernels once (forked workers inherit them)
+        patch_adapter.warm_up()
+        executor = InProcess() if jobs == 1 else LocalPool(jobs)
+        for r in executor.results(tasks):
+            for w in r.warnings:
+                print(f"{PROG}: warning: {w}", file=sys.stderr)
+            if r.ok:
+                print(r.summary(), flush=True)
+            else:
+                print(f"{PROG}: {r.error}", file=sys.stderr, flush=True)
+                status = max(status, r.status)
+    except KeyboardInterrupt:
+        if executor is not None:
+            executor.stop()
+            executor = None
+        _clean(out, tag)
+        print(f"{PROG}: interrupted; nothing left of the unfinished inputs", file=sys.stderr)
+        return 130
+    finally:
+        if executor is not None:
+            executor.close()
+        signal.signal(signal.SIGTERM, previous)
+    return status
+
+
+def _clean(out: Path, tag: str) -> None:
+    """Remove this run's temporary directories from OUT."""
+    try:
+        entries = list(out.iterdir())
+    except OSError:
+        return
+    for p in entries:
+        if p.name.startswith(".") and p.name.endswith(f".{tag}.replay-tmp"):
+            shutil.rmtree(p, ignore_errors=True)
