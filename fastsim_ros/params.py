@@ -208,6 +208,12 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("cell_size", "double", 2.0e-4,
                   "cell size of the potential contact grids computed from profiles (m)",
                   low=2.0e-5, high=5.0e-3),
+    ParameterSpec("separation_distance", "double", 8.0e-3,
+                  "interpenetration regions of one wheel further apart than this (m) are "
+                  "separate patches (CONTACT's D_SEP)", low=0.0, high=0.1),
+    ParameterSpec("combination_distance", "double", 4.0e-3,
+                  "regions within this (m) are combined first (CONTACT's D_COMB; at most "
+                  "separation_distance)", low=0.0, high=0.1),
     ParameterSpec("wheel_load", "double", 0.0,
                   "vertical load per wheel (N) when no wheelset/load arrived; 0: the pose's "
                   "vertical position is used as given", low=0.0, high=1.0e7, dynamic=True),

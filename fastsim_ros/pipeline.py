@@ -64,10 +64,15 @@ CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "traction": "sensor_msgs/msg/PointCloud2"}
 
 
-def output_topics(contacts: tuple[str, ...]) -> dict[str, str]:
-    """Return every output topic (relative, but /diagnostics) with its message type."""
+def output_topics(contacts: tuple[str, ...], *, patches: bool = False) -> dict[str, str]:
+    """Return every output topic (relative, but /diagnostics) with its message type.
+
+    ``patches``: the patches are outputs too (profiles mode computes them).
+    """
     topics = {f"contact/{c}/{kind}": msgtype for c in contacts
               for kind, msgtype in CONTACT_OUTPUTS.items()}
+    if patches:
+        topics.update({patch_topic(c): "sensor_msgs/msg/PointCloud2" for c in contacts})
     topics[WHEELSET_WRENCH_TOPIC] = "geometry_msgs/msg/WrenchStamped"
     topics[MARKERS_TOPIC] = "visualization_msgs/msg/MarkerArray"
     topics[DIAGNOSTICS_TOPIC] = "diagnostic_msgs/msg/DiagnosticArray"

@@ -43,12 +43,14 @@ from fastsim_ros.geometry.placement import Placement, Pose
 from fastsim_ros.geometry.profiles import read_profile
 from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Wheelset,
                                            WheelsetContact)
-from fastsim_ros.params import PROFILE_CONTACTS, ParameterError
-from fastsim_ros.pipeline import Outcome, Pipeline, PipelineConfig
+from fastsim_ros.params import PROFILE_CONTACTS, SPECS, ParameterError
+from fastsim_ros.pipeline import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic, Outcome,
+                                  Pipeline, PipelineConfig, patch_topic)
 from msg_adapters.cdr import Cloud, StampedTwist
 from msg_adapters.errors import MalformedMessageError, RejectedInput
 from msg_adapters.patch import MIN_CONTACT_CELLS, patch_from_cloud
-from msg_adapters.profile_msgs import StampedPose, patch_cloud, read_load, read_pose
+from msg_adapters.profile_msgs import (StampedPose, cloud_cdr, patch_cloud, read_load,
+                                       read_pose)
 
 POSE_TOPIC, LOAD_TOPIC = "wheelset/pose", "wheelset/load"
 #: loads kept for matching pose stamps
@@ -80,10 +82,15 @@ def wheelset_of(config: PipelineConfig) -> Wheelset:
                        if config["right_wheel_profile"] else None)
         right_rail = (read_profile(config["right_rail_profile"], kind="rail", smooth=smooth)
                       if config["right_rail_profile"] else None)
+        d_sep, d_comb = float(config["separation_distance"]), float(config["combination_distance"])
+        if d_comb > d_sep:
+            raise ParameterError(f"parameter 'combination_distance' ({d_comb:g} m) must be at "
+                                 f"most separation_distance ({d_sep:g} m)")
         return Wheelset(wheel, rail, placement_of(config.values), right_wheel=right_wheel,
                         right_rail=right_rail, cell=float(config["cell_size"]),
                         shear_modulus=float(config["shear_modulus"]),
-                        poisson_ratio=float(config["poisson_ratio"]))
+                        poisson_ratio=float(config["poisson_ratio"]), d_sep=d_sep,
+                        d_comb=d_comb)
     except ContactError as e:
         raise ParameterError(str(e)) from None
 
@@ -113,6 +120,7 @@ class ProfilePipeline:
         self.solve_roll = solve_roll
         self._loads: deque[StampedTwist] = deque(maxlen=LOAD_HISTORY)
         self._last_pose_ns: int | None = None
+        self._clouds: dict[str, Cloud] = {}
         self.pose_counts = {"pose": 0, "load": 0, "malformed": 0, "wrong_frame": 0,
                             "nonfinite": 0, "old_stamp": 0}
 
@@ -121,13 +129,64 @@ class ProfilePipeline:
         """Return the wrapped pipeline's configuration."""
         return self.pipeline.config
 
+    # --- the wrapped pipeline's face, for the node and the replay
+
+    @property
+    def kinematics_counts(self) -> dict[str, int]:
+        """Return the twists' counts, and the poses' and loads' (``pose/<what>``)."""
+        return {**self.pipeline.kinematics_counts,
+                **{f"pose/{k}": v for k, v in self.pose_counts.items()}}
+
+    def counts(self, contact: str) -> dict[str, int]:
+        """Return a contact's cumulative counts by status."""
+        return self.pipeline.counts(contact)
+
+    def solve_time_percentiles(self, contact: str) -> tuple[float, float]:
+        """Return a contact's solve-time p50 and p99 (us)."""
+        return self.pipeline.solve_time_percentiles(contact)
+
+    def diagnostics(self, stamp_ns: int) -> Any:
+        """Return the wrapped pipeline's ``DiagnosticArray``."""
+        return self.pipeline.diagnostics(stamp_ns)
+
+    def inputs(self) -> tuple[InputTopic, ...]:
+        """Return the input topics of profiles mode: the twists, the pose and the load."""
+        def kinematics(on: Any) -> Any:
+            def take(raw: bytes | memoryview) -> tuple[Outcome, ...]:
+                on(raw)
+                return ()
+            return take
+
+        def pose(raw: bytes | memoryview) -> tuple[Outcome, ...]:
+            return self.on_pose(raw).outcomes
+
+        twist = "geometry_msgs/msg/TwistStamped"
+        return (InputTopic(WHEEL_TWIST_TOPIC, twist, "wheel_twist", None,
+                           kinematics(self.on_wheel_twist)),
+                InputTopic(RAIL_TWIST_TOPIC, twist, "rail_twist", None,
+                           kinematics(self.on_rail_twist)),
+                InputTopic(LOAD_TOPIC, "geometry_msgs/msg/WrenchStamped", "load", None,
+                           kinematics(self.on_load)),
+                InputTopic(POSE_TOPIC, "geometry_msgs/msg/PoseStamped", "pose", None, pose))
+
+    def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
+        """Return the ``(topic, message)`` pairs of an outcome: its patch, then the pipeline's.
+
+        The patch (CDR bytes) goes out with every outcome of the pose it
+        came from, solved or refused by the solver; a pose dropped whole has
+        no patches.
+        """
+        cloud = self._clouds.get(outcome.contact)
+        head: list[tuple[str, Any]] = []
+        if cloud is not None and cloud.stamp_ns == outcome.stamp_ns:
+            head.append((patch_topic(outcome.contact), cloud_cdr(cloud)))
+        return head + self.pipeline.messages(outcome)
+
     def update(self, changes: dict[str, Any]) -> None:
-        """Apply changes of parameters that may change while running."""
-        for name in ("patch_source", "wheel_profile", "rail_profile", "right_wheel_profile",
-                     "right_rail_profile", "profile_smoothing", "gauge_width", "gauge_height",
-                     "cant", "flange_back_distance", "flange_back_position", "nominal_radius",
-                     "cell_size", "track_frame"):
-            if name in changes and changes[name] != self.config[name]:
+        """Apply changes of parameters that may change while running (the rest are refused)."""
+        for name, value in changes.items():
+            spec = SPECS.get(name)
+            if spec is not None and not spec.dynamic and value != self.config[name]:
                 raise ParameterError(f"parameter {name!r} is set at start only")
         self.pipeline.update(changes)
 
@@ -222,6 +281,7 @@ class ProfilePipeline:
         except ContactError as e:
             return self._dropped(stamp, "degenerate", str(e))
         patches = self.clouds(contact, stamp)
+        self._clouds = dict(patches)
         outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
         return ProfileCycle(stamp, patches, outcomes, contact, loads)
 
@@ -276,10 +336,17 @@ class ProfilePipeline:
         return ProfileCycle(stamp, (), outcomes, None, None)
 
 
+def make_pipeline(config: PipelineConfig) -> Pipeline | ProfilePipeline:
+    """Return the pipeline of the configured patch source (the node's and the replay's)."""
+    if config["patch_source"] == "profiles":
+        return ProfilePipeline(config)
+    return Pipeline(config)
+
+
 def _tread_first(patches: Sequence[WheelPatch]) -> list[WheelPatch]:
     """Order a wheel's patches: nearest the tread (the field side, larger side-frame y) first."""
     return sorted(patches, key=lambda p: -p.region.reference[1])
 
 
 __all__ = ["LOAD_TOPIC", "POSE_TOPIC", "ProfileCycle", "ProfilePipeline", "SIDES",
-           "contact_name", "placement_of", "wheelset_of", "MIN_CONTACT_CELLS"]
+           "contact_name", "make_pipeline", "placement_of", "wheelset_of", "MIN_CONTACT_CELLS"]

@@ -63,8 +63,9 @@ def test_the_json_has_both_wheels_with_their_patches_and_track_forces(done_when)
 
 
 def test_the_pipeline_given_that_roll_answers_with_the_same_numbers(done_when):
-    # what the node does with a pose and a load message: the command line's numbers (the
-    # pose's quaternion rounds roll and yaw by 1e-16: INTERFACE.md asks 1e-9)
+    # what the node does with a pose and a load message: the command line's numbers
+    # within INTERFACE.md's 1e-9 (the pose's quaternion rounds roll and yaw by 1e-16,
+    # which the iterative solves carry to about 4e-12 here)
     r = done_when
     config = PipelineConfig.from_values({"patch_source": "profiles", "wheel_load": 0.0})
     p = ProfilePipeline(config)
@@ -78,7 +79,7 @@ def test_the_pipeline_given_that_roll_answers_with_the_same_numbers(done_when):
         for patch in wheel["patches"]:
             f = by[patch["name"]].forces
             assert (f.fx, f.fy, f.mz, f.n) == pytest.approx(
-                (patch["Fx"], patch["Fy"], patch["Mz"], patch["N"]), rel=1e-12, abs=1e-9)
+                (patch["Fx"], patch["Fy"], patch["Mz"], patch["N"]), rel=1e-9)
 
 
 def test_roll_given_solves_each_wheel_at_its_own_height(capsys):

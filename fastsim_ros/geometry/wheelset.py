@@ -227,6 +227,7 @@ class Wheelset:
             extent = (lo_x - 2 * grow[0], hi_x + 2 * grow[1], lo_s - 2 * grow[2],
                       hi_s + 2 * grow[3])
         load = float(pressure.sum()) * grid.dx * grid.ds
+        grid, pressure = _cropped(grid, pressure)
         return self._placed(side, pose, grid, pressure, approach, load, region)
 
     def _placed(self, side: Side, pose: Pose, grid: PlanarGrid, pressure: FloatArray,
@@ -381,6 +382,25 @@ def _normal_force(patches: Sequence[WheelPatch]) -> Vector:
     for p in patches:
         f += p.load * p.normal_track
     return (float(f[0]), float(f[1]), float(f[2]))
+
+
+def _cropped(grid: PlanarGrid, pressure: FloatArray) -> tuple[PlanarGrid, FloatArray]:
+    """The grid and pressure cut to the cells in contact and one empty cell around them.
+
+    The potential contact area is about three times the contact; the patch
+    the node publishes and solves needs only the contact (and keeps an
+    empty border, as the bundled bags' patches do).
+    """
+    rows = np.flatnonzero(pressure.any(axis=1))
+    cols = np.flatnonzero(pressure.any(axis=0))
+    if rows.size == 0:
+        return grid, pressure
+    j0, j1 = max(0, int(rows[0]) - 1), min(pressure.shape[0], int(rows[-1]) + 2)
+    i0, i1 = max(0, int(cols[0]) - 1), min(pressure.shape[1], int(cols[-1]) + 2)
+    gap = grid.gap[j0:j1, i0:i1]
+    gap.setflags(write=False)
+    cut = replace(grid, x0=grid.x0 + i0 * grid.dx, s0=grid.s0 + j0 * grid.ds, gap=gap)
+    return cut, np.ascontiguousarray(pressure[j0:j1, i0:i1])
 
 
 def _edges_in_contact(pressure: FloatArray) -> tuple[int, int, int, int]:

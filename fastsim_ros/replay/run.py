@@ -29,8 +29,8 @@ from typing import Any
 from rclpy.serialization import serialize_message
 
 from fastsim_ros.params import SPECS, ParameterError
-from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, Pipeline, PipelineConfig,
-                                  output_topics)
+from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig, output_topics
+from fastsim_ros.profile_pipeline import make_pipeline
 from fastsim_ros.replay import bagio
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
@@ -194,13 +194,13 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
             if found:
                 values = dict(values, contacts=list(found))
         config = PipelineConfig.from_values(values)
-        pipeline = Pipeline(config)
+        pipeline = make_pipeline(config)
         contacts = config.contacts
         result.contacts = contacts
         result.contacts_found = found
         result.namespace = namespace
-        absolute = {resolve(t, namespace): msgtype
-                    for t, msgtype in output_topics(contacts).items()}
+        absolute = {resolve(t, namespace): msgtype for t, msgtype in output_topics(
+            contacts, patches=config["patch_source"] == "profiles").items()}
         inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
         if not any(resolve(conn.topic) in inputs
                    and inputs[resolve(conn.topic)].kind not in _KINEMATICS
