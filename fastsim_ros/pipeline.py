@@ -420,17 +420,25 @@ class Pipeline:
                        wheelset, self._markers_due(state, stamp))
 
     def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
-                    rail: StampedTwist = REST) -> tuple[Creepage, ContactForces]:
+                    rail: StampedTwist = REST, *,
+                    method: str | None = None) -> tuple[Creepage, ContactForces]:
         """Return the creepages and creep forces of one converted patch under given twists.
 
         The rules of :meth:`on_patch` (standstill, the solver's refusals as
         :class:`RejectedInput`), without its stamps, counts or outputs: the
         profiles patch source balances a wheel's vertical load with it.
+        ``method``: another of the pipeline's methods than the configured one.
         """
         creep = creepages(patch.frame, wheel, rail)
         if not abs(creep.speed) >= self._min_speed:
             raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
-        return creep, self._solve(patch, creep, ContactStats())
+        if method is None or method == self.config["method"]:
+            return creep, self._solve(patch, creep, ContactStats())
+        configured, self._solver = self._solver, self._solvers[method]
+        try:
+            return creep, self._solve(patch, creep, ContactStats())
+        finally:
+            self._solver = configured
 
     def reject(self, contact: str, stamp_ns: int, reason: str, detail: str) -> Outcome:
         """Count an input of ``contact`` dropped upstream of its patch (profiles mode)."""

@@ -133,9 +133,13 @@ class ProfilePipeline:
 
     @property
     def kinematics_counts(self) -> dict[str, int]:
-        """Return the twists' counts, and the poses' and loads' (``pose/<what>``)."""
-        return {**self.pipeline.kinematics_counts,
-                **{f"pose/{k}": v for k, v in self.pose_counts.items()}}
+        """Return the twists' counts and the poses and loads dropped (``pose_<reason>``).
+
+        The poses and loads taken are in :attr:`pose_counts`.
+        """
+        dropped = {f"pose_{k}": v for k, v in self.pose_counts.items()
+                   if k not in ("pose", "load") and v}
+        return {**self.pipeline.kinematics_counts, **dropped}
 
     def counts(self, contact: str) -> dict[str, int]:
         """Return a contact's cumulative counts by status."""
@@ -300,13 +304,20 @@ class ProfilePipeline:
                     patch = patch_from_cloud(cloud, max_cells=max_cells)
                     if patch is None:
                         raise RejectedInput("degenerate", "an empty patch")
-                    _, f = self.pipeline.solve_patch(patch, wheel, rail)
+                    try:
+                        _, f = self.pipeline.solve_patch(patch, wheel, rail)
+                    except RejectedInput as e:
+                        if e.reason in ("standstill", "too_large", "nonfinite"):
+                            raise
+                        # a patch the method refuses (an MAE zone beyond its tables, a
+                        # sliver at a trial position): the balance takes FastSim on its
+                        # equivalent ellipse, so that it stays continuous; on_patch then
+                        # solves, or refuses, the final patch with the configured method
+                        _, f = self.pipeline.solve_patch(patch, wheel, rail,
+                                                         method="fastsim_ellipse")
                 except RejectedInput as e:
                     if e.reason in ("standstill", "too_large", "nonfinite"):
                         raise
-                    # a sliver on the way to the balance (a trial position barely
-                    # touching) that the solver refuses: its creep force is left out;
-                    # the final patches are solved, or refused, by on_patch
                     out.append((0.0, 0.0, 0.0))
                     continue
                 f_w = patch.frame.to_wheelset((f.fx, f.fy, 0.0))

@@ -31,6 +31,9 @@ sys.path.insert(0, str(ROOT))
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact.normal import hertz_ellipse, solve_normal  # noqa: E402
 from fastsim_ros.contact.samples import semi_ellipses_patch  # noqa: E402
+from fastsim_ros.geometry import benchmark  # noqa: E402
+from fastsim_ros.geometry.placement import rotation  # noqa: E402
+from msg_adapters.profile_msgs import quaternion  # noqa: E402
 from rosbags.interfaces import (  # noqa: E402
     Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime)
 from rosbags.rosbag2 import Reader, Writer  # noqa: E402
@@ -41,6 +44,8 @@ TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 T = TYPESTORE.types
 CLOUD = "sensor_msgs/msg/PointCloud2"
 TWIST = "geometry_msgs/msg/TwistStamped"
+POSE = "geometry_msgs/msg/PoseStamped"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
 
 #: first stamp of every bag (ns since the epoch): realistic, the same every run
 T0_NS = 1_700_000_000 * 10**9
@@ -88,6 +93,20 @@ def twist_msg(ns: int, linear: Any, angular: Any) -> Any:
     """Make a ``geometry_msgs/TwistStamped`` in the wheelset frame."""
     return T[TWIST](header=header(ns),
                     twist=T["geometry_msgs/msg/Twist"](linear=vec(linear), angular=vec(angular)))
+
+
+def pose_msg(ns: int, dy: float, dz: float, roll: float, yaw: float) -> Any:
+    """Make a ``geometry_msgs/PoseStamped`` of the wheelset in the track frame."""
+    qx, qy, qz, qw = quaternion(roll, yaw)
+    return T[POSE](header=header(ns, "track"), pose=T["geometry_msgs/msg/Pose"](
+        position=T["geometry_msgs/msg/Point"](x=0.0, y=float(dy), z=float(dz)),
+        orientation=T["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw)))
+
+
+def load_msg(ns: int, total: float, roll_moment: float = 0.0) -> Any:
+    """Make a ``wheelset/load``: the total vertical load (N) and its roll moment (N m)."""
+    return T[WRENCH](header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
+        force=vec((0.0, 0.0, total)), torque=vec((roll_moment, 0.0, 0.0))))
 
 
 def contact_axes(normal: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -586,6 +605,36 @@ def expected_counts(outcomes: list[tuple[str, str, int]]) -> dict[str, Any]:
     return res
 
 
+def mbench_a22() -> tuple[Bag, dict[str, Any]]:
+    """Build the Manchester benchmark A-2.2 as a recording of a rig with profiles.
+
+    The 21 poses of CONTACT's ``mbench_a22`` cases (shift 0..10 mm to the
+    right, yaw 0..24 mrad, their roll), one every 10 ms; the wheelset twist
+    at 200 Hz (2 m/s along the track, the case's axle spin, in the wheelset
+    frame of the case's roll and yaw); the load, 10 kN per wheel (20 kN, no
+    roll moment), with each twist.  No patches: the node or the replay in
+    profiles mode computes them (params: profiles mode, the benchmark's G).
+    """
+    bag = Bag("mbench_a22")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/load", WRENCH)
+    bag.topic("/wheelset/pose", POSE)
+    for k, case in enumerate(benchmark.a22("left")):
+        rot = rotation(case.roll, case.yaw)
+        v = rot.T @ np.array([case.forward_speed, 0.0, 0.0])
+        for t in (PATCH_DT * k, PATCH_DT * k + TWIST_DT):
+            ns = stamp_ns(t)
+            bag.add("/wheelset/twist", ns, twist_msg(ns, v, (0.0, case.axle_spin, 0.0)))
+            bag.add("/wheelset/load", ns, load_msg(ns, 2.0 * benchmark.LOAD))
+        ns = stamp_ns(PATCH_OFFSET + PATCH_DT * k)
+        bag.add("/wheelset/pose", ns, pose_msg(ns, case.dy, 0.0, case.roll, case.yaw))
+    return bag, {"contacts": ["left", "right", "left_flange", "right_flange"],
+                 "patch_source": "profiles", "shear_modulus": benchmark.SHEAR_MODULUS,
+                 "poisson_ratio": benchmark.POISSON, "friction_coefficient": benchmark.MU,
+                 "method": "mae_calibrated", "cell_size": benchmark.CELL,
+                 "wheel_load": 0.0}
+
+
 # ------------------------------------------------------------------ params, main
 
 SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
@@ -594,6 +643,7 @@ SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
     "flange_shift": flange_shift,
     "roller_rig": roller_rig,
     "bad_inputs": bad_inputs,
+    "mbench_a22": mbench_a22,
 }
 
 BASE_PARAMS: dict[str, Any] = {

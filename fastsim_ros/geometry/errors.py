@@ -35,3 +35,7 @@ class DerailmentError(GeometryError):
 
 class NoContactError(GeometryError):
     """Profiles that never meet (no lateral overlap), or a load no position can carry."""
+
+
+class BalanceError(GeometryError):
+    """No vertical position of a wheel carries its load (the balance did not converge)."""

@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.checks import check_material
 from fastsim_ros.geometry import normal_fast
-from fastsim_ros.geometry.errors import NoContactError, PoseError
+from fastsim_ros.geometry.errors import BalanceError, NoContactError, PoseError
 from fastsim_ros.geometry.placement import (Placement, Pose, RailSide, WheelSide, place_rail,
                                             place_wheel)
 from fastsim_ros.geometry.planar import PlanarGrid, grid_extent, planar_grid
@@ -292,9 +292,9 @@ class Wheelset:
             points.append((dz, phi))
             dz = _next_position(points, dz_touch)
         if best is None:  # pragma: no cover - MAX_ITERATIONS > 0
-            raise NoContactError("no vertical position found")
-        raise NoContactError(f"the {side} wheel's vertical balance did not converge: "
-                             f"{best.vertical_force:.6g} N for a load of {load:.6g} N")
+            raise BalanceError("no vertical position found")
+        raise BalanceError(f"the {side} wheel's vertical balance did not converge: "
+                           f"{best.vertical_force:.6g} N for a load of {load:.6g} N")
 
     # ------------------------------------------------------------------ both wheels
 
