@@ -46,6 +46,7 @@ from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, RAIL_TWIST_TOPIC,
                                   WHEEL_TWIST_TOPIC, WHEELSET_WRENCH_TOPIC, Outcome, Pipeline,
                                   PipelineConfig, patch_topic)
+from fastsim_ros.profile_pipeline import LOAD_TOPIC, POSE_TOPIC, ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
 _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
@@ -101,7 +102,11 @@ class FastsimNode(Node):
         start = time.perf_counter()
         patch_adapter.warm_up()
         warm += time.perf_counter() - start
-        self.pipeline = Pipeline(config)
+        try:
+            self.pipeline = make_pipeline(config)
+        except parameters.ParameterError as e:  # a profile file or placement: one line
+            raise StartupError(str(e)) from None
+        profiles = isinstance(self.pipeline, ProfilePipeline)
         depth = int(config["qos_depth"])
         qos_in = _qos(config["patch_reliability"], depth)
         qos_out = _qos(config["output_reliability"], depth)
@@ -113,18 +118,30 @@ class FastsimNode(Node):
         self._pubs[WHEELSET_WRENCH_TOPIC] = self.create_publisher(
             WrenchStamped, WHEELSET_WRENCH_TOPIC, qos_out)
         self._pubs[MARKERS_TOPIC] = self.create_publisher(MarkerArray, MARKERS_TOPIC, qos_out)
+        if profiles:
+            # profiles mode: the node computes the patches and publishes them too
+            for c in config.contacts:
+                self._pubs[patch_topic(c)] = self.create_publisher(PointCloud2, patch_topic(c),
+                                                                   qos_out)
         self._diagnostics = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
         self.create_subscription(TwistStamped, WHEEL_TWIST_TOPIC, self._on_wheel_twist, qos_in,
                                  raw=True)
         self.create_subscription(TwistStamped, RAIL_TWIST_TOPIC, self._on_rail_twist, qos_in,
                                  raw=True)
-        for c in config.contacts:
-            self.create_subscription(PointCloud2, patch_topic(c), self._patch_callback(c),
-                                     qos_in, raw=True)
+        if profiles:
+            self.create_subscription(PoseStamped, POSE_TOPIC, self._on_pose, qos_in, raw=True)
+            self.create_subscription(WrenchStamped, LOAD_TOPIC, self._on_load, qos_in, raw=True)
+        else:
+            for c in config.contacts:
+                self.create_subscription(PointCloud2, patch_topic(c), self._patch_callback(c),
+                                         qos_in, raw=True)
         self.create_timer(1.0, self._publish_diagnostics)
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        source = (f"patches from the profiles {config['wheel_profile']} on "
+                  f"{config['rail_profile']} and wheelset/pose" if profiles
+                  else "patches from contact/<name>/patch")
         self.get_logger().info(
-            f"solving {', '.join(config.contacts)} with {config['method']} "
+            f"{source}; solving {', '.join(config.contacts)} with {config['method']} "
             f"(mu {config['friction_coefficient']:g}, bound {config['traction_bound']}); "
             f"kernels ready in {warm:.2f} s")
 
@@ -146,6 +163,7 @@ class FastsimNode(Node):
         return callback
 
     def _on_patch(self, contact: str, raw: bytes) -> None:
+        assert isinstance(self.pipeline, Pipeline)
         outcome: Outcome = self.pipeline.on_patch(contact, raw)
         if not outcome.has_wrench:
             self.get_logger().warning(f"{contact}: patch rejected, {outcome.status}: "
@@ -154,6 +172,25 @@ class FastsimNode(Node):
         pubs = self._pubs
         for topic, msg in self.pipeline.messages(outcome):
             pubs[topic].publish(msg)
+
+    def _on_load(self, raw: bytes) -> None:
+        assert isinstance(self.pipeline, ProfilePipeline)
+        verdict = self.pipeline.on_load(raw)
+        if verdict != "ok":
+            self.get_logger().warning(f"wheelset load dropped: {verdict}",
+                                      throttle_duration_sec=1.0)
+
+    def _on_pose(self, raw: bytes) -> None:
+        """One rig cycle of profiles mode: both wheels' patches, then every contact's outputs."""
+        assert isinstance(self.pipeline, ProfilePipeline)
+        cycle = self.pipeline.on_pose(raw)
+        pubs = self._pubs
+        for outcome in cycle.outcomes:
+            if not outcome.has_wrench:
+                self.get_logger().warning(f"{outcome.contact}: pose rejected, {outcome.status}: "
+                                          f"{outcome.detail}", throttle_duration_sec=1.0)
+            for topic, msg in self.pipeline.messages(outcome):
+                pubs[topic].publish(msg)
 
     def _publish_diagnostics(self) -> None:
         self._diagnostics.publish(self.pipeline.diagnostics(self.get_clock().now().nanoseconds))
