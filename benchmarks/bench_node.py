@@ -198,13 +198,31 @@ def startup(trials: int) -> None:
           f"({', '.join(f'{t:.2f}' for t in times)})")
 
 
+FLOOR = Path(__file__).resolve().parent / "dds_floor.py"
+
+
+def target_command(target: str, names: list[str], executor: str,
+                   node_args: list[str]) -> list[str]:
+    """Return the command line of the node or of the floor relay serving ``names``."""
+    if target == "floor":
+        return [sys.executable, str(FLOOR), "--contacts", *names]
+    return [str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",
+            "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]", *node_args]
+
+
 def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
-        node_args: list[str]) -> None:
-    """Drive one node with ``contacts`` contacts at ``rate`` Hz each and print the figures."""
+        node_args: list[str], target: str = "node",
+        py_spy: str | None = None) -> dict[str, float]:
+    """Drive the node (or the floor) with ``contacts`` contacts at ``rate`` Hz each.
+
+    Prints the figures and returns them: ``received`` (share of the patches
+    answered, %), ``p50``, ``p99`` (latency, ms), ``cpu`` (the target's share
+    of one core, %), ``late`` (times the driver re-anchored).  ``py_spy``: a
+    file to which py-spy (``pip install py-spy``) writes the target's
+    sampled stacks over the run (collapsed, the flame graph format).
+    """
     names = [f"c{k}" for k in range(contacts)]
-    proc = subprocess.Popen([str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",
-                             "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]",
-                             *node_args],
+    proc = subprocess.Popen(target_command(target, names, executor, node_args),
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     ctx, node, ex = driver("bench_driver")
     qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
@@ -224,22 +242,31 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
 
     pubs = [node.create_publisher(PointCloud2, f"contact/{n}/patch", qos) for n in names]
     twist_pub = node.create_publisher(TwistStamped, "wheelset/twist", qos)
-    for k, n in enumerate(names):
-        node.create_subscription(WrenchStamped, f"contact/{n}/wrench", on_wrench(k), qos,
-                                 raw=True)
+    subs = [node.create_subscription(WrenchStamped, f"contact/{n}/wrench", on_wrench(k), qos,
+                                     raw=True) for k, n in enumerate(names)]
     patches = [patch_cdr(k) for k in range(contacts)]
     twist = twist_cdr()
     start = time.monotonic()
-    while not (all(p.get_subscription_count() for p in pubs)
-               and node.count_publishers(f"/contact/{names[-1]}/wrench")):
+    # matched on this side; the far side's readers are given the 0.5 s below (a lost
+    # first patch would count as one drop in ~10^4)
+    while not (all(p.get_subscription_count() for p in pubs + [twist_pub])
+               and all(s.get_publisher_count() for s in subs)):
         ex.spin_once(timeout_sec=0.05)
         if time.monotonic() - start > 30 or proc.poll() is not None:
-            raise SystemExit("the node did not come up")
+            raise SystemExit(f"the {target} did not come up")
     for _ in range(50):
         ex.spin_once(timeout_sec=0.01)
     duration = soak * 60.0 if soak else seconds
     period = 1.0 / rate
     rss = [(0.0, rss_mib(proc.pid))]
+    spy = None
+    if py_spy:
+        duration_s = soak * 60.0 if soak else seconds
+        spy = subprocess.Popen([str(Path(sys.executable).parent / "py-spy"), "record",
+                                "--pid", str(proc.pid), "--rate", "250", "--nonblocking",
+                                "--format", "raw", "--duration", str(int(duration_s)),
+                                "--output", py_spy],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     cpu0, wall0 = cpu_seconds(proc.pid), time.perf_counter()
     t_next = wall0
     stamp = 1_700_000_000 * 1_000_000_000
@@ -271,23 +298,58 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
     while time.perf_counter() - drain < 1.0:
         ex.spin_once(timeout_sec=0.01)
     rss.append((time.perf_counter() - wall0, rss_mib(proc.pid)))
+    if spy is not None:
+        spy.wait(30)
     proc.send_signal(signal.SIGTERM)
     status = proc.wait(10)
     node.destroy_node()
     rclpy.shutdown(context=ctx)
     got = sum(received)
     lat = np.array(latency) * 1e3 if latency else np.array([np.nan])
-    extra = " ".join([executor, *node_args])
+    extra = " ".join([target, executor, *node_args]) if target == "node" else target
+    figures = {"received": 100.0 * got / inputs, "p50": float(np.median(lat)),
+               "p99": float(np.percentile(lat, 99)), "cpu": 100.0 * cpu / wall,
+               "late": float(late)}
     print(f"{extra}: {contacts} contacts x {rate:g} Hz for {wall:.1f} s: sent {inputs}, "
           f"wrenches {got}, dropped {inputs - got} ({100.0 * (inputs - got) / inputs:.2f}%), "
-          f"latency p50 {np.median(lat):.3f} ms, p99 {np.percentile(lat, 99):.3f} ms, "
-          f"max {lat.max():.3f} ms; node CPU {100.0 * cpu / wall:.0f}% of one core; "
-          f"driver re-anchored {late} times; node exit {status}")
+          f"latency p50 {figures['p50']:.3f} ms, p99 {figures['p99']:.3f} ms, "
+          f"max {lat.max():.3f} ms; {target} CPU {figures['cpu']:.0f}% of one core; "
+          f"driver re-anchored {late} times; exit {status}", flush=True)
     if soak:
         first = rss[1][1] if len(rss) > 2 else rss[0][1]
         samples_text = ", ".join(f"{t:.0f}: {m:.1f}" for t, m in rss)
-        print(f"  node RSS (MiB) over time (s): {samples_text}")
+        print(f"  {target} RSS (MiB) over time (s): {samples_text}")
         print(f"  growth after the first 10 s: {100.0 * (rss[-1][1] - first) / first:+.1f}%")
+    return figures
+
+
+def against_floor(contacts: int, rate: float, seconds: float, rounds: int, executor: str,
+                  node_args: list[str]) -> None:
+    """Run the node and the floor alternately ``rounds`` times; print medians and ratios.
+
+    TARGETS.md (4 x 1 kHz): received share within 0.2 points of the floor's,
+    p99 at most 2x the floor's, CPU at most 1.5x the floor's.
+    """
+    runs: dict[str, list[dict[str, float]]] = {"node": [], "floor": []}
+    for r in range(rounds):
+        # alternate which goes first, so that a drift of the machine weighs on both
+        order = ("node", "floor") if r % 2 == 0 else ("floor", "node")
+        for target in order:
+            runs[target].append(run(contacts, rate, seconds, 0.0, executor, node_args,
+                                    target))
+    keys = ("received", "p50", "p99", "cpu")
+    med = {t: {k: statistics.median(f[k] for f in runs[t]) for k in keys} for t in runs}
+    n, f = med["node"], med["floor"]
+    print(f"medians of {rounds} alternating runs, {contacts} contacts x {rate:g} Hz, "
+          f"{seconds:g} s each:")
+    for t in ("node", "floor"):
+        m = med[t]
+        print(f"  {t:5s} received {m['received']:.2f}%, latency p50 {m['p50']:.3f} ms, "
+              f"p99 {m['p99']:.3f} ms, CPU {m['cpu']:.0f}% of one core")
+    print(f"  node/floor: received {n['received'] / f['received']:.4f} "
+          f"({n['received'] - f['received']:+.2f} points; target >= -0.2), "
+          f"p99 {n['p99'] / f['p99']:.2f}x (target <= 2), "
+          f"CPU {n['cpu'] / f['cpu']:.2f}x (target <= 1.5)", flush=True)
 
 
 def main() -> None:
@@ -307,6 +369,11 @@ def main() -> None:
                         help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
                         help="first time the per-message path in-process")
+    parser.add_argument("--py-spy", default=None, metavar="FILE",
+                        help="record the node with py-spy (collapsed stacks to FILE)")
+    parser.add_argument("--floor", type=int, default=0, metavar="ROUNDS",
+                        help="drive the node and the DDS floor (dds_floor.py) alternately, "
+                        "ROUNDS times each, and print node/floor ratios of the medians")
     args = parser.parse_args()
     print(f"machine: {machine()}")
     if not NODE.exists():
@@ -317,7 +384,12 @@ def main() -> None:
         profile(args.profile)
     for n in args.contacts:
         for executor in args.executors:
-            run(n, args.rate, args.seconds, args.soak, executor, shlex.split(args.node_args))
+            if args.floor:
+                against_floor(n, args.rate, args.seconds, args.floor, executor,
+                              shlex.split(args.node_args))
+            else:
+                run(n, args.rate, args.seconds, args.soak, executor,
+                    shlex.split(args.node_args), py_spy=args.py_spy)
 
 
 if __name__ == "__main__":

@@ -3,10 +3,13 @@
 Topics, frames and parameters: INTERFACE.md (and the README's "Running the
 node").  The node declares every parameter of :mod:`fastsim_ros.params`
 with its descriptor and range, builds one :class:`~fastsim_ros.pipeline.Pipeline`
-and wires topics to it.  The hot path is lean on purpose: patches and
-twists arrive raw (CDR bytes, decoded by :mod:`msg_adapters.cdr` with numpy
-views on the point buffer, no Python message built), and the per-patch
-outputs are published as bytes.
+and wires topics to it: it subscribes to every input of the pipeline's one
+table (:meth:`~fastsim_ros.pipeline.Pipeline.inputs`: a topic, its type and
+its handler; a new input is added there) and publishes the outcomes each
+handler returns.  The hot path is lean on purpose: inputs arrive raw (CDR
+bytes, decoded by :mod:`msg_adapters.cdr` with numpy views on the point
+buffer, no Python message built), and every output is published as the
+CDR bytes :meth:`~fastsim_ros.pipeline.Pipeline.messages` encodes.
 
 QoS, chosen so that every peer matches: subscriptions best effort (a best
 effort subscription matches reliable and best-effort publishers, and a
@@ -17,6 +20,7 @@ every subscriber), depth ``qos_depth``; both configurable at start.
 from __future__ import annotations
 
 import gc
+import importlib
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -31,10 +35,12 @@ from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.publisher import Publisher
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.subscription import Subscription
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PoseStamped, TwistStamped, Vector3Stamped, WrenchStamped
+from geometry_msgs.msg import PoseStamped, Vector3Stamped, WrenchStamped
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 ParameterType, SetParametersResult)
 from sensor_msgs.msg import PointCloud2
@@ -43,10 +49,9 @@ from visualization_msgs.msg import MarkerArray
 from fastsim_ros import params as parameters
 from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
-from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, RAIL_TWIST_TOPIC,
-                                  WHEEL_TWIST_TOPIC, WHEELSET_WRENCH_TOPIC, Outcome, Pipeline,
-                                  PipelineConfig, patch_topic)
-from fastsim_ros.profile_pipeline import LOAD_TOPIC, POSE_TOPIC, ProfilePipeline, make_pipeline
+from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
+                                  InputTopic, Outcome, PipelineConfig, patch_topic)
+from fastsim_ros.profile_pipeline import ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
 _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
@@ -102,15 +107,17 @@ class FastsimNode(Node):
         start = time.perf_counter()
         patch_adapter.warm_up()
         warm += time.perf_counter() - start
-        try:
+        try:  # profiles mode reads and places its profiles here
             self.pipeline = make_pipeline(config)
         except parameters.ParameterError as e:  # a profile file or placement: one line
             raise StartupError(str(e)) from None
-        profiles = isinstance(self.pipeline, ProfilePipeline)
         depth = int(config["qos_depth"])
         qos_in = _qos(config["patch_reliability"], depth)
         qos_out = _qos(config["output_reliability"], depth)
-        self._pubs: dict[str, Any] = {}
+        # every topic by its name as configured: the diagnostics report how many
+        # peers each has matched (publishers of an input, subscribers of an output)
+        self._pubs: dict[str, Publisher] = {}
+        self._subs: dict[str, Subscription] = {}
         for c in config.contacts:
             for kind, msgtype in _MESSAGE_TYPES.items():
                 topic = f"contact/{c}/{kind}"
@@ -118,82 +125,85 @@ class FastsimNode(Node):
         self._pubs[WHEELSET_WRENCH_TOPIC] = self.create_publisher(
             WrenchStamped, WHEELSET_WRENCH_TOPIC, qos_out)
         self._pubs[MARKERS_TOPIC] = self.create_publisher(MarkerArray, MARKERS_TOPIC, qos_out)
-        if profiles:
-            # profiles mode: the node computes the patches and publishes them too
+        if isinstance(self.pipeline, ProfilePipeline):
+            # profiles mode computes the patches and publishes them, so that a recording
+            # replays in either mode (INTERFACE.md)
             for c in config.contacts:
                 self._pubs[patch_topic(c)] = self.create_publisher(PointCloud2, patch_topic(c),
                                                                    qos_out)
         self._diagnostics = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
-        self.create_subscription(TwistStamped, WHEEL_TWIST_TOPIC, self._on_wheel_twist, qos_in,
-                                 raw=True)
-        self.create_subscription(TwistStamped, RAIL_TWIST_TOPIC, self._on_rail_twist, qos_in,
-                                 raw=True)
-        if profiles:
-            self.create_subscription(PoseStamped, POSE_TOPIC, self._on_pose, qos_in, raw=True)
-            self.create_subscription(WrenchStamped, LOAD_TOPIC, self._on_load, qos_in, raw=True)
-        else:
-            for c in config.contacts:
-                self.create_subscription(PointCloud2, patch_topic(c), self._patch_callback(c),
-                                         qos_in, raw=True)
-        self.create_timer(1.0, self._publish_diagnostics)
+        # the pipeline's one table of inputs: each topic raw to its handler
+        for entry in self.pipeline.inputs():
+            self._subs[entry.topic] = self.create_subscription(
+                message_type(entry.msgtype), entry.topic, self._input_callback(entry), qos_in,
+                raw=True)
+        self.create_timer(float(config["diagnostics_period"]), self._publish_diagnostics)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         source = (f"patches from the profiles {config['wheel_profile']} on "
-                  f"{config['rail_profile']} and wheelset/pose" if profiles
+                  f"{config['rail_profile']} at each wheelset/pose"
+                  if isinstance(self.pipeline, ProfilePipeline)
                   else "patches from contact/<name>/patch")
         self.get_logger().info(
             f"{source}; solving {', '.join(config.contacts)} with {config['method']} "
             f"(mu {config['friction_coefficient']:g}, bound {config['traction_bound']}); "
             f"kernels ready in {warm:.2f} s")
 
-    def _on_wheel_twist(self, raw: bytes) -> None:
-        verdict = self.pipeline.on_wheel_twist(raw)
-        if verdict != "ok":
-            self.get_logger().warning(f"wheelset twist dropped: {verdict}",
-                                      throttle_duration_sec=1.0)
+    def connections(self) -> dict[str, list[tuple[str, str]]]:
+        """Return each contact's matched peers as diagnostic key-values.
 
-    def _on_rail_twist(self, raw: bytes) -> None:
-        verdict = self.pipeline.on_rail_twist(raw)
-        if verdict != "ok":
-            self.get_logger().warning(f"rail twist dropped: {verdict}",
-                                      throttle_duration_sec=1.0)
+        ``publishers/<topic>`` for the contact's patch and the twists,
+        ``subscribers/<topic>`` for its outputs and the shared ones: the
+        counts DDS matched on the node's side, which a client cannot see
+        from its own (a message sent before both sides matched is lost).
+        """
+        shared = [(f"publishers/{t}", str(s.get_publisher_count()))
+                  for t, s in self._subs.items() if not t.startswith("contact/")]
+        shared += [(f"subscribers/{t}", str(p.get_subscription_count()))
+                   for t, p in self._pubs.items() if not t.startswith("contact/")
+                   or t == MARKERS_TOPIC]
+        out: dict[str, list[tuple[str, str]]] = {}
+        for c in self.pipeline.config.contacts:
+            own = f"contact/{c}/"
+            out[c] = [(f"publishers/{t}", str(s.get_publisher_count()))
+                      for t, s in self._subs.items() if t.startswith(own)]
+            out[c] += [(f"subscribers/{t}", str(p.get_subscription_count()))
+                       for t, p in self._pubs.items() if t.startswith(own)]
+            out[c] += shared
+        return out
 
-    def _patch_callback(self, contact: str) -> Callable[[bytes], None]:
+    def _input_callback(self, spec: InputTopic) -> Callable[[bytes], None]:
+        """Return the subscription callback of an input: its handler, then the outputs."""
+        if spec.kind in ("wheel_twist", "rail_twist"):
+            on = (self.pipeline.on_wheel_twist if spec.kind == "wheel_twist"
+                  else self.pipeline.on_rail_twist)
+            what = "wheelset" if spec.kind == "wheel_twist" else "rail"
+
+            def kinematics(raw: bytes) -> None:
+                verdict = on(raw)
+                if verdict != "ok":
+                    self.get_logger().warning(f"{what} twist dropped: {verdict}",
+                                              throttle_duration_sec=1.0)
+            return kinematics
+        take, publish = spec.take, self._publish
+
         def callback(raw: bytes) -> None:
-            self._on_patch(contact, raw)
+            for outcome in take(raw):
+                publish(outcome)
         return callback
 
-    def _on_patch(self, contact: str, raw: bytes) -> None:
-        assert isinstance(self.pipeline, Pipeline)
-        outcome: Outcome = self.pipeline.on_patch(contact, raw)
+    def _publish(self, outcome: Outcome) -> None:
+        """Publish an outcome's messages (CDR bytes), or log why there are none."""
         if not outcome.has_wrench:
-            self.get_logger().warning(f"{contact}: patch rejected, {outcome.status}: "
+            self.get_logger().warning(f"{outcome.contact}: patch rejected, {outcome.status}: "
                                       f"{outcome.detail}", throttle_duration_sec=1.0)
             return
         pubs = self._pubs
-        for topic, msg in self.pipeline.messages(outcome):
-            pubs[topic].publish(msg)
-
-    def _on_load(self, raw: bytes) -> None:
-        assert isinstance(self.pipeline, ProfilePipeline)
-        verdict = self.pipeline.on_load(raw)
-        if verdict != "ok":
-            self.get_logger().warning(f"wheelset load dropped: {verdict}",
-                                      throttle_duration_sec=1.0)
-
-    def _on_pose(self, raw: bytes) -> None:
-        """One rig cycle of profiles mode: both wheels' patches, then every contact's outputs."""
-        assert isinstance(self.pipeline, ProfilePipeline)
-        cycle = self.pipeline.on_pose(raw)
-        pubs = self._pubs
-        for outcome in cycle.outcomes:
-            if not outcome.has_wrench:
-                self.get_logger().warning(f"{outcome.contact}: pose rejected, {outcome.status}: "
-                                          f"{outcome.detail}", throttle_duration_sec=1.0)
-            for topic, msg in self.pipeline.messages(outcome):
-                pubs[topic].publish(msg)
+        for topic, data in self.pipeline.messages(outcome):
+            pubs[topic].publish(data)
 
     def _publish_diagnostics(self) -> None:
-        self._diagnostics.publish(self.pipeline.diagnostics(self.get_clock().now().nanoseconds))
+        self._diagnostics.publish(self.pipeline.diagnostics(
+            self.get_clock().now().nanoseconds, self.connections()))
 
     def _on_set_parameters(self, changes: list[Parameter]) -> SetParametersResult:
         values = {}
@@ -224,6 +234,12 @@ def _one_line(error: Exception, spec: parameters.ParameterSpec) -> str:
         return str(error)
     return (f"parameter {spec.name!r}: {str(error).splitlines()[0]}; it must be "
             f"{spec.allowed()}")
+
+
+def message_type(name: str) -> Any:
+    """Return the message class of a type name such as ``geometry_msgs/msg/TwistStamped``."""
+    package, _, cls = name.split("/")
+    return getattr(importlib.import_module(f"{package}.msg"), cls)
 
 
 def make_executor(kind: str) -> Executor:

@@ -168,6 +168,8 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   choices=("events", "single_threaded")),
     ParameterSpec("qos_depth", "integer", 10, "history depth of every subscription and "
                   "publisher", low=1, high=10000),
+    ParameterSpec("diagnostics_period", "double", 1.0,
+                  "seconds between /diagnostics messages", low=0.01, high=60.0),
     # --- the patch source (INTERFACE.md "Patches from wheel and rail profiles")
     ParameterSpec("patch_source", "string", "topics",
                   "where patches come from: topics (contact/<name>/patch) or profiles "

@@ -33,7 +33,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from msg_adapters import outputs as out
-from msg_adapters.cdr import Cloud, StampedTwist, read_cloud, read_twist
+from msg_adapters.cdr import Cloud, CloudReader, StampedTwist, read_twist
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
 from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud
@@ -200,9 +200,10 @@ class ContactReport:
 
 class _ContactState:
     __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
-                 "wrench_fresh", "stats")
+                 "wrench_fresh", "stats", "reader")
 
     def __init__(self) -> None:
+        self.reader = CloudReader()  # the topic's header parsed once
         self.last_stamp_ns: int | None = None
         self.last_frame: ContactFrame | None = None
         self.last_marker_ns: int | None = None
@@ -216,6 +217,8 @@ class _ContactState:
 def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
     if a is None:
         return True
+    if a.origin == b.origin and a.axes == b.axes:  # the usual case on a steady rig
+        return False
     moved = max(abs(u - v) for u, v in zip(a.origin, b.origin))
     turned = max(abs(u - v) for ea, eb in zip(a.axes, b.axes) for u, v in zip(ea, eb))
     return moved > FRAME_TOLERANCE or turned > FRAME_TOLERANCE
@@ -374,7 +377,7 @@ class Pipeline:
         stats = state.stats
         if not isinstance(cloud, Cloud):
             try:
-                cloud = read_cloud(cloud)
+                cloud = state.reader.read(cloud)
             except MalformedMessageError as e:  # not a PointCloud2: its fields are missing
                 stats.counts["missing_field"] += 1
                 stats.last_detail = f"missing_field: {e}"
@@ -527,10 +530,10 @@ class Pipeline:
     def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
         """Return the ``(topic, message)`` pairs to publish for an outcome, in order.
 
-        Per-patch messages come as CDR bytes, the rest as message objects
-        (INTERFACE.md "Outputs"): the contact's wrench and creepage, its
-        frame when it moved, its traction cloud when asked for, its marker
-        when due, and the wheelset wrench when the rig cycle is complete.
+        Each as CDR bytes (INTERFACE.md "Outputs"): the contact's wrench and
+        creepage, its frame when it moved, its traction cloud when asked
+        for, its marker when due, and the wheelset wrench when the rig cycle
+        is complete.
         """
         if not outcome.has_wrench:
             return []
@@ -548,31 +551,34 @@ class Pipeline:
                 msgs.append((base + "frame", out.pose_cdr(stamp, frame_id, outcome.frame)))
             if (f.tau_x is not None and f.tau_y is not None and f.slip is not None
                     and f.grid is not None):
-                msgs.append((base + "traction", out.traction_cloud(
+                msgs.append((base + "traction", out.traction_cloud_cdr(
                     stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid)))
         if outcome.markers:
             index = self.config.contacts.index(c)
             fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)
-            marker = out.force_marker(stamp, frame_id, index, c, outcome.frame, fx, fy,
-                                      float(self.config["marker_scale"]))
-            msgs.append((MARKERS_TOPIC, out.marker_array([marker])))
+            msgs.append((MARKERS_TOPIC, out.force_marker_cdr(
+                stamp, frame_id, index, c, outcome.frame, fx, fy,
+                float(self.config["marker_scale"]))))
         w = outcome.wheelset
         if w is not None:
             msgs.append((WHEELSET_WRENCH_TOPIC, out.wrench_cdr(w.stamp_ns, frame_id, w.force,
                                                                w.torque)))
         return msgs
 
-    def diagnostics(self, stamp_ns: int) -> Any:
+    def diagnostics(self, stamp_ns: int,
+                    extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> Any:
         """Return the ``DiagnosticArray`` at ``stamp_ns``: one status per contact.
 
         Each carries the twist counts too (``twists/<what>``: taken for the
-        wheel and the rail, dropped by reason), the kinematics being shared.
+        wheel and the rail, dropped by reason), the kinematics being shared,
+        then the key-values ``extra[contact]`` if given (the node's connections).
         """
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
         statuses: list[tuple[str, int, str, Sequence[tuple[str, str]]]] = []
         for c in self.config.contacts:
             r = self.report(c)
-            statuses.append((r.name, r.level, r.message, r.values + twists))
+            more = tuple(extra.get(c, ())) if extra is not None else ()
+            statuses.append((r.name, r.level, r.message, r.values + twists + more))
         return out.diagnostic_array(stamp_ns, statuses)
 
     # ---------------------------------------------------------------- diagnostics

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import struct
 from dataclasses import dataclass
+from typing import Any
 
 from msg_adapters.errors import MalformedMessageError
 
@@ -151,6 +152,11 @@ def read_cloud(buf: bytes | memoryview) -> Cloud:
 
     The returned ``fields`` dict may be shared between calls: do not change it.
     """
+    return _read_cloud(buf)[0]
+
+
+def _read_cloud(buf: bytes | memoryview) -> tuple[Cloud, int]:
+    """Return the cloud and where its points start in ``buf`` (bytes)."""
     r = _Reader(buf)
     stamp = r.stamp_ns()
     frame = r.string()
@@ -164,7 +170,42 @@ def read_cloud(buf: bytes | memoryview) -> Cloud:
     size = r.u32()
     start = r._take(size, 1)
     return Cloud(stamp, frame, int(height), int(width), fields, bool(bigendian),
-                 int(point_step), int(row_step), r.buf[start:start + size])
+                 int(point_step), int(row_step), r.buf[start:start + size]), 4 + start
+
+
+class CloudReader:
+    """:func:`read_cloud` for one topic: the header parsed once while it stays the same.
+
+    A topic's patches differ in their stamp and their points only: when the
+    bytes between the stamp and the points (frame id, sizes, fields, steps,
+    the data's length) equal the last message's, the cloud is rebuilt from
+    the last parse with the new stamp and data (a comparison of ~200 bytes
+    instead of a parse).  Anything else is parsed afresh.
+    """
+
+    __slots__ = ("_key", "_start", "_cloud")
+
+    def __init__(self) -> None:
+        self._key = b""
+        self._start = 0
+        self._cloud: Cloud | None = None
+
+    def read(self, buf: bytes | memoryview) -> Cloud:
+        """Decode a serialized ``sensor_msgs/PointCloud2`` (as :func:`read_cloud`)."""
+        last, start = self._cloud, self._start
+        if last is not None and len(buf) >= start + len(last.data) \
+                and buf[:4] == self._key[:4] and buf[12:start] == self._key[4:]:
+            sec, nanosec = _I32U32[">" if buf[1] == 0 else "<"].unpack_from(buf, 4)
+            view = memoryview(buf)
+            return Cloud(int(sec) * 1_000_000_000 + int(nanosec), last.frame_id, last.height,
+                         last.width, last.fields, last.is_bigendian, last.point_step,
+                         last.row_step, view[start:start + len(last.data)])
+        cloud, start = _read_cloud(buf)
+        if isinstance(buf, bytes):  # (a memoryview's slices would compare otherwise)
+            self._key = buf[:4] + buf[12:start]
+            self._start = start
+            self._cloud = cloud
+        return cloud
 
 
 def read_twist(buf: bytes | memoryview) -> StampedTwist:
@@ -176,19 +217,101 @@ def read_twist(buf: bytes | memoryview) -> StampedTwist:
     return StampedTwist(stamp, frame, (v[0], v[1], v[2]), (v[3], v[4], v[5]))
 
 
-def _header(stamp_ns: int, frame_id: str) -> bytearray:
-    """Return encapsulation + ``std_msgs/Header`` (little endian), unpadded."""
-    sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
-    name = frame_id.encode("utf-8") + b"\x00"
-    out = bytearray(_CDR_LE)
-    out += struct.pack("<iII", sec, nanosec, len(name))
-    out += name
-    return out
+class Writer:
+    """A little-endian CDR buffer being written, for building message templates.
+
+    Primitives are aligned to their size relative to the payload (after the
+    encapsulation header); the ``f64``, ``stamp`` and ``doubles`` writers
+    return where their bytes start, so that a :class:`Template` can patch
+    them later.
+    """
+
+    __slots__ = ("buf",)
+
+    def __init__(self) -> None:
+        self.buf = bytearray(_CDR_LE)
+
+    def _align(self, size: int) -> None:
+        self.buf += b"\x00" * (-(len(self.buf) - 4) % size)
+
+    def _put(self, fmt: str, size: int, *values: Any) -> int:
+        self._align(size)
+        at = len(self.buf)
+        self.buf += struct.pack("<" + fmt, *values)
+        return at
+
+    def u8(self, value: int) -> None:
+        """Write a uint8 (or a bool)."""
+        self.buf.append(value)
+
+    def i32(self, value: int) -> None:
+        """Write an int32."""
+        self._put("i", 4, value)
+
+    def u32(self, value: int) -> None:
+        """Write a uint32 (also a sequence's length)."""
+        self._put("I", 4, value)
+
+    def f32(self, *values: float) -> None:
+        """Write float32s."""
+        self._put(f"{len(values)}f", 4, *values)
+
+    def doubles(self, *values: float) -> int:
+        """Write float64s; return where the first starts."""
+        return self._put(f"{len(values)}d", 8, *values)
+
+    def string(self, text: str) -> None:
+        """Write a string: uint32 length (NUL included), the UTF-8 bytes, NUL."""
+        raw = text.encode("utf-8") + b"\x00"
+        self.u32(len(raw))
+        self.buf += raw
+
+    def stamp(self, stamp_ns: int = 0) -> int:
+        """Write a ``builtin_interfaces/Time``; return where it starts."""
+        sec, nanosec = divmod(int(stamp_ns), 1_000_000_000)
+        return self._put("iI", 4, sec, nanosec)
+
+    def header(self, frame_id: str, stamp_ns: int = 0) -> int:
+        """Write a ``std_msgs/Header``; return where its stamp starts."""
+        at = self.stamp(stamp_ns)
+        self.string(frame_id)
+        return at
 
 
-def _pad8(out: bytearray) -> None:
-    """Pad to the next multiple of 8 of the payload (which starts at byte 4)."""
-    out += b"\x00" * (-(len(out) - 4) % 8)
+class Template:
+    """A serialized message whose stamp and one run of doubles change from message to message.
+
+    Built once (by a :class:`Writer`) for what stays (frame ids, names,
+    layout); :meth:`encode` packs the stamp and the values into the one
+    buffer it keeps and returns a copy: no message object, no allocation
+    but the returned bytes.
+    """
+
+    __slots__ = ("_buf", "_stamp_at", "_values_at", "_pack")
+
+    def __init__(self, buf: bytearray, stamp_at: int, values_at: int, count: int) -> None:
+        self._buf = buf
+        self._stamp_at = stamp_at
+        self._values_at = values_at
+        self._pack = struct.Struct(f"<{count}d").pack_into
+
+    def encode(self, stamp_ns: int, *values: float) -> bytes:
+        """Return the message with ``stamp_ns`` and ``values`` in place."""
+        buf = self._buf
+        _STAMP_LE.pack_into(buf, self._stamp_at, *divmod(stamp_ns, 1_000_000_000))
+        self._pack(buf, self._values_at, *values)
+        return bytes(buf)
+
+
+_STAMP_LE = struct.Struct("<iI")
+_STAMPED: dict[tuple[str, int], Template] = {}
+
+
+def stamped_doubles_template(frame_id: str, count: int) -> Template:
+    """Return the template of a header and ``count`` doubles (as :func:`stamped_doubles`)."""
+    w = Writer()
+    stamp_at = w.header(frame_id)
+    return Template(w.buf, stamp_at, w.doubles(*([0.0] * count)), count)
 
 
 def stamped_doubles(stamp_ns: int, frame_id: str, values: tuple[float, ...]) -> bytes:
@@ -196,9 +319,13 @@ def stamped_doubles(stamp_ns: int, frame_id: str, values: tuple[float, ...]) -> 
 
     That is the layout of ``WrenchStamped`` (6 doubles), ``Vector3Stamped``
     (3), ``PointStamped`` (3) and ``PoseStamped`` (7: position, then the
-    orientation quaternion ``x, y, z, w``).
+    orientation quaternion ``x, y, z, w``).  The template of each frame id
+    and count is built once (a few hundred kept).
     """
-    out = _header(stamp_ns, frame_id)
-    _pad8(out)
-    out += struct.pack(f"<{len(values)}d", *values)
-    return bytes(out)
+    key = (frame_id, len(values))
+    template = _STAMPED.get(key)
+    if template is None:
+        template = stamped_doubles_template(frame_id, len(values))
+        if len(_STAMPED) < 512:
+            _STAMPED[key] = template
+    return template.encode(stamp_ns, *values)

@@ -1,13 +1,15 @@
 """Results -> messages: wrenches, creepages, frames, traction clouds, markers, diagnostics.
 
-The per-patch messages (``WrenchStamped``, ``Vector3Stamped``,
-``PoseStamped``) are written straight to CDR bytes (:mod:`msg_adapters.cdr`):
-the node publishes them raw and the replay writes them to bags as they are.
-The occasional ones (traction cloud, markers, diagnostics) are message
-objects; ``rclpy.serialization.serialize_message`` turns them into bytes.
-Frames (INTERFACE.md "Outputs"): a contact's wrench and creepage in
-``<name>_contact``; frame, markers, traction cloud and the wheelset wrench in
-the wheelset frame.
+Every per-patch message (``WrenchStamped``, ``Vector3Stamped``,
+``PoseStamped``, the traction ``PointCloud2`` and the ``MarkerArray``) is
+written straight to CDR bytes (:mod:`msg_adapters.cdr`), from a template
+built once per frame id and contact where only the stamp and the numbers
+change: the node publishes them raw and the replay writes them to bags as
+they are.  Diagnostics (once a second) are a message object;
+``rclpy.serialization.serialize_message`` turns it into bytes.  Frames
+(INTERFACE.md "Outputs"): a contact's wrench and creepage in
+``<name>_contact``; frame, markers, traction cloud and the wheelset wrench
+in the wheelset frame.
 """
 
 from __future__ import annotations
@@ -17,11 +19,8 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Point
-from sensor_msgs.msg import PointCloud2, PointField
-from visualization_msgs.msg import Marker, MarkerArray
 
-from msg_adapters.cdr import stamped_doubles
+from msg_adapters.cdr import Template, Writer, stamped_doubles
 from msg_adapters.kinematics import Creepage
 from msg_adapters.patch import ContactFrame
 
@@ -68,15 +67,16 @@ def pose_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame) -> bytes:
     return stamped_doubles(stamp_ns, wheelset_frame, frame.origin + frame.quaternion())
 
 
-def traction_cloud(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
-                   tau_x: np.ndarray, tau_y: np.ndarray, slip: np.ndarray,
-                   grid: tuple[float, float, float, float]) -> PointCloud2:
-    """Return the solved traction as an organised ``PointCloud2`` in the wheelset frame.
+def traction_cloud_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
+                       tau_x: np.ndarray, tau_y: np.ndarray, slip: np.ndarray,
+                       grid: tuple[float, float, float, float]) -> bytes:
+    """Return the solved traction as a serialized organised ``PointCloud2`` in the wheelset frame.
 
     One point per cell of the solve's grid (``grid = (x0, y0, dx, dy)`` in
     the contact plane), placed at ``origin + x e_x + y e_y``; ``tau_x``,
     ``tau_y``: traction of the rail on the wheel along the contact frame's
     axes (Pa); ``slip``: 1 where the cell is on the traction bound.
+    Fields ``x y z tau_x tau_y`` float32 and ``slip`` uint8 (TRACTION_DTYPE).
     """
     ny, nx = tau_x.shape
     x0, y0, dx, dy = grid
@@ -87,51 +87,84 @@ def traction_cloud(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
     pts = np.zeros((ny, nx), dtype=TRACTION_DTYPE)
     pts["x"], pts["y"], pts["z"] = pos[..., 0], pos[..., 1], pos[..., 2]
     pts["tau_x"], pts["tau_y"], pts["slip"] = tau_x, tau_y, slip
-    msg = PointCloud2()
-    msg.header.stamp = stamp_msg(stamp_ns)
-    msg.header.frame_id = wheelset_frame
-    msg.height, msg.width = ny, nx
-    msg.fields = [PointField(name=name, offset=offset,
-                             datatype=_UINT8 if name == "slip" else _FLOAT32, count=1)
-                  for name, offset in _TRACTION_OFFSETS]
-    msg.is_bigendian = False
-    msg.point_step = TRACTION_DTYPE.itemsize
-    msg.row_step = TRACTION_DTYPE.itemsize * nx
-    msg.data = pts.tobytes()
-    msg.is_dense = True
-    return msg
+    w = Writer()
+    w.header(wheelset_frame, stamp_ns)
+    w.u32(ny)
+    w.u32(nx)
+    w.u32(len(_TRACTION_OFFSETS))
+    for name, offset in _TRACTION_OFFSETS:
+        w.string(name)
+        w.u32(offset)
+        w.u8(_UINT8 if name == "slip" else _FLOAT32)
+        w.u32(1)
+    w.u8(0)  # is_bigendian
+    w.u32(TRACTION_DTYPE.itemsize)
+    w.u32(TRACTION_DTYPE.itemsize * nx)
+    w.u32(pts.nbytes)
+    w.buf += pts.tobytes()
+    w.u8(1)  # is_dense
+    return bytes(w.buf)
 
 
-def force_marker(stamp_ns: int, wheelset_frame: str, index: int, contact: str,
-                 frame: ContactFrame | None, fx: float, fy: float, scale: float) -> Marker:
-    """Return an arrow from the contact origin along the creep force (``scale`` m/N).
+#: visualization_msgs/Marker's type ARROW and actions ADD, DELETE
+_ARROW, _ADD, _DELETE = 0, 0, 2
+#: the arrow's shaft diameter, head diameter and head length (m), and its colour (RGBA)
+ARROW_SCALE = (0.004, 0.008, 0.01)
+ARROW_COLOR = (0.9, 0.2, 0.1, 1.0)
+_MARKERS: dict[tuple[str, int, str, bool], Template] = {}
 
-    Without a frame (no contact) the arrow of that contact is deleted.
+
+def _marker_template(wheelset_frame: str, index: int, contact: str, add: bool) -> Template:
+    """Return the template of a ``MarkerArray`` holding one arrow (or its deletion)."""
+    w = Writer()
+    w.u32(1)  # markers: one
+    stamp_at = w.header(wheelset_frame)
+    w.string("creep_force")  # ns
+    w.i32(index)
+    w.i32(_ARROW)
+    w.i32(_ADD if add else _DELETE)
+    w.doubles(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)  # pose: at the origin, not turned
+    w.doubles(*(ARROW_SCALE if add else (0.0, 0.0, 0.0)))
+    w.f32(*(ARROW_COLOR if add else (0.0, 0.0, 0.0, 0.0)))
+    w.i32(0)  # lifetime: forever
+    w.u32(0)
+    w.u8(0)  # frame_locked
+    w.u32(2 if add else 0)  # points: from the contact origin to the arrow's tip
+    values_at = w.doubles(*([0.0] * 6)) if add else 0
+    w.u32(0)  # colors
+    w.string("")  # texture_resource
+    w.header("")  # texture (sensor_msgs/CompressedImage): header, format, data
+    w.string("")
+    w.u32(0)
+    w.u32(0)  # uv_coordinates
+    w.string(contact)  # text
+    w.string("")  # mesh_resource
+    w.string("")  # mesh_file: filename, data
+    w.u32(0)
+    w.u8(0)  # mesh_use_embedded_materials
+    return Template(w.buf, stamp_at, values_at, 6 if add else 0)
+
+
+def force_marker_cdr(stamp_ns: int, wheelset_frame: str, index: int, contact: str,
+                     frame: ContactFrame | None, fx: float, fy: float, scale: float) -> bytes:
+    """Return a serialized ``MarkerArray``: an arrow from the contact origin along the creep force.
+
+    ``scale`` m/N; marker ``id`` = ``index``, namespace ``creep_force``, text
+    the contact's name.  Without a frame (no contact) the arrow of that
+    contact is deleted.
     """
-    m = Marker()
-    m.header.stamp = stamp_msg(stamp_ns)
-    m.header.frame_id = wheelset_frame
-    m.ns = "creep_force"
-    m.id = index
-    m.text = contact
+    key = (wheelset_frame, index, contact, frame is not None)
+    template = _MARKERS.get(key)
+    if template is None:
+        template = _marker_template(*key)
+        if len(_MARKERS) < 512:
+            _MARKERS[key] = template
     if frame is None:
-        m.action = Marker.DELETE
-        return m
-    m.type = Marker.ARROW
-    m.action = Marker.ADD
+        return template.encode(stamp_ns)
     tip = frame.to_wheelset((fx * scale, fy * scale, 0.0))
     o = frame.origin
-    m.points = [Point(x=o[0], y=o[1], z=o[2]),
-                Point(x=o[0] + tip[0], y=o[1] + tip[1], z=o[2] + tip[2])]
-    m.pose.orientation.w = 1.0
-    m.scale.x, m.scale.y, m.scale.z = 0.004, 0.008, 0.01  # shaft, head diameter and length
-    m.color.r, m.color.g, m.color.b, m.color.a = 0.9, 0.2, 0.1, 1.0
-    return m
-
-
-def marker_array(markers: Iterable[Marker]) -> MarkerArray:
-    """Return a ``MarkerArray`` of the markers."""
-    return MarkerArray(markers=list(markers))
+    return template.encode(stamp_ns, o[0], o[1], o[2], o[0] + tip[0], o[1] + tip[1],
+                           o[2] + tip[2])
 
 
 def diagnostic_array(stamp_ns: int, statuses: Iterable[tuple[str, int, str,

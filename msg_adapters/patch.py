@@ -124,11 +124,23 @@ class _Layout:
 _LAYOUTS: dict[tuple[Any, ...], _Layout] = {}
 
 
+#: the layout of a fields dict (by identity: read_cloud hands out the same dict for the
+#: same field list) with the byte order and steps it was checked with
+_BY_FIELDS: dict[int, tuple[Any, bool, int, int, _Layout]] = {}
+
+
 def _layout(cloud: Cloud) -> _Layout:
     """Check the patch fields; return their layout (cached: a topic keeps its layout)."""
+    seen = _BY_FIELDS.get(id(cloud.fields))
+    if seen is not None and seen[0] is cloud.fields and seen[1] == cloud.is_bigendian \
+            and seen[2] == cloud.point_step and seen[3] == cloud.row_step:
+        return seen[4]
     key = (tuple(cloud.fields.items()), cloud.is_bigendian, cloud.point_step, cloud.row_step)
     hit = _LAYOUTS.get(key)
     if hit is not None:
+        if len(_BY_FIELDS) < 256:
+            _BY_FIELDS[id(cloud.fields)] = (cloud.fields, cloud.is_bigendian,
+                                            cloud.point_step, cloud.row_step, hit)
         return hit
     order = ">" if cloud.is_bigendian else "<"
     offsets: list[int] = []
@@ -253,9 +265,11 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
         return None
     words, row, step, cols = _words(cloud)
     pressure = np.empty((ny, nx))
-    xyz = np.empty((ny, nx, 3))
-    status, cells, total, low, sums = kernels.scan_points(words, ny, nx, row, step, cols,
-                                                          pressure, xyz)
+    out = np.empty(kernels.OUT_SIZE)
+    kernels.adapt(words, ny, nx, row, step, cols, pressure, out)
+    (status, cells_, total, low, o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2, ez0, ez1, ez2,
+     fx0, fdx, worst_x, fy0, fdy, worst_y) = out.tolist()
+    cells = int(cells_)
     if status == kernels.NONFINITE:
         raise RejectedInput("nonfinite", "NaN or infinite values in the patch")
     if status == kernels.NEGATIVE:
@@ -265,10 +279,11 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
     if cells < MIN_CONTACT_CELLS or ny < 2 or nx < 2:
         raise RejectedInput("degenerate", f"{cells} cells in contact on a {ny} x {nx} grid "
                             f"(at least {MIN_CONTACT_CELLS} on a grid of 2 x 2 or more)")
-    # origin: the pressure-weighted centroid; e_z along sum p n
-    origin = (float(sums[0]) / total, float(sums[1]) / total, float(sums[2]) / total)
-    ex, ey, ez = contact_axes((float(sums[3]), float(sums[4]), float(sums[5])))
-    fx0, fdx, worst_x, fy0, fdy, worst_y = kernels.fit_grid(xyz, origin, ex, ey)
+    # origin: the pressure-weighted centroid; e_z along sum p n (contact_axes's checks)
+    if status == kernels.ZERO_NORMAL:
+        raise RejectedInput("degenerate", "the cells' normals cancel out")
+    if status == kernels.NORMAL_ALONG_X:
+        raise RejectedInput("degenerate", "the contact normal lies along the wheelset's x")
     # each checks the whole grid: x must not vary across strips, nor y along them
     x0, dx, column_order = _grid_axis(fx0, fdx, worst_x, nx, "along a strip")
     y0, dy, row_order = _grid_axis(fy0, fdy, worst_y, ny, "across the strips")
@@ -278,13 +293,13 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
         raise RejectedInput("degenerate", f"cell area {cell_area:.3g} m^2, load {load:.3g} N")
     if row_order < 0 or column_order < 0:
         pressure = np.ascontiguousarray(pressure[::row_order, ::column_order])
-    frame = ContactFrame(origin, (ex, ey, ez))
+    frame = ContactFrame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
     return ContactPatch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, cells,
                         row_order, column_order)
 
 
 def warm_up() -> None:
-    """Compile (or load from numba's disk cache) the adapter's loops for both float widths.
+    """Compile (or load from numba's disk cache) the adapter's loop for both float widths.
 
     Each width read-only too: the usual layout's words are a view of the
     message's buffer (read-only, its own numba specialisation), a copy
@@ -294,9 +309,8 @@ def warm_up() -> None:
         for writeable in (False, True):
             words = np.zeros(4 * 7, dtype=width)
             words.setflags(write=writeable)
-            kernels.scan_points(words, 2, 2, 14, 7, _PLAIN_COLUMNS, np.empty((2, 2)),
-                                np.empty((2, 2, 3)))
-    kernels.fit_grid(np.zeros((2, 2, 3)), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+            kernels.adapt(words, 2, 2, 14, 7, _PLAIN_COLUMNS, np.empty((2, 2)),
+                          np.empty(kernels.OUT_SIZE))
 
 
 def planar_points(origin: tuple[float, float, float], axes: ContactFrame | None, x0: float,

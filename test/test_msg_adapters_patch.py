@@ -227,3 +227,27 @@ def test_round_trip_of_the_cdr_view():
     assert bytes(view.data) == bytes(back.data)
     assert {n: (f.offset, f.datatype, f.count) for n, f in view.fields.items()} == {
         f.name: (f.offset, f.datatype, f.count) for f in back.fields}
+
+
+def test_a_topic_reader_parses_the_header_once_and_anything_new_afresh():
+    reader = cdr.CloudReader()
+    area = egg()
+    first = to_cdr(cloud_msg(area, stamp_ns=5))
+    assert reader.read(first) == cdr.read_cloud(first)
+    # the same header, a new stamp and new points: the last parse, the new numbers
+    p = area.pressure * 2.0
+    again = to_cdr(cloud_msg(area, stamp_ns=1_700_000_000_000_000_001, pressure=p))
+    got = reader.read(again)
+    assert got == cdr.read_cloud(again)
+    assert got.stamp_ns == 1_700_000_000_000_000_001
+    assert patch_from_cloud(got, max_cells=MAX).load == pytest.approx(2.0 * area.load, rel=1e-5)
+    # another frame id, another size, another byte order: each parsed as it comes
+    for msg in (cloud_msg(area, stamp_ns=6, frame_id="base"),
+                cloud_msg(areas.ellipse(6e-3, 4e-3, nx=9, ny=7).with_load(5e4), stamp_ns=7),
+                cloud_msg(area, stamp_ns=8, dtype=">f8")):
+        raw = to_cdr(msg)
+        assert reader.read(raw) == cdr.read_cloud(raw)
+    # cut short behind the same header: not read from the last parse
+    reader.read(first)
+    with pytest.raises(cdr.MalformedMessageError, match="truncated"):
+        reader.read(first[:-40])

@@ -65,18 +65,18 @@ def run_node(tmp_path):
         proc.stop()
 
 
-def exchange(client, contact, msg, *, count=1, timeout=5.0):
-    """Publish a patch and return the wrenches that arrive for it (by stamp)."""
-    stamp = msg.header.stamp.sec * 1_000_000_000 + msg.header.stamp.nanosec
-    client.patch[contact].publish(msg)
-    client.wait_for(lambda: sum(stamp_ns(w) == stamp for w in client.wrenches[contact])
-                    >= count, timeout)
-    return [w for w in client.wrenches[contact] if stamp_ns(w) == stamp]
+def exchange(client, contact, msg, rejected=None):
+    """Publish a patch; once the node counted it, return the wrenches that came for it.
+
+    ``rejected``: the reason the node must count it under (then no wrench).
+    """
+    outcome = client.send_patch(contact, msg)
+    assert outcome == (rejected or "wrench"), f"{contact}: {outcome}, expected {rejected}"
+    return [w for w in client.wrenches[contact] if stamp_ns(w) == stamp_ns(msg)]
 
 
 def send_twist(client, msg, rail=False):
-    (client.rail if rail else client.twist).publish(msg)
-    client.spin(0.3)  # twists and patches travel on different topics: let it land first
+    client.send_twist(msg, rail=rail)  # returns once the node took it: before the patches
 
 
 def force(w):
@@ -112,7 +112,7 @@ def test_wrenches_equal_the_library_for_every_method(run_node, contacts):
             assert got[0].header.frame_id == f"{c}_contact"
             assert_library_equal(got[0], library(method, shapes[k], xi, 0.0, 0.0))
     # one wheelset wrench per rig cycle: the sum once every contact had a new wrench
-    client.spin(0.2)
+    client.wait_for(lambda: len(client.wheelset) >= len(SOLVERS))
     assert len(client.wheelset) == len(SOLVERS)
     assert client.wheelset[-1].header.frame_id == "wheelset"
     assert client.wheelset[-1].wrench.force.z == pytest.approx(
@@ -128,7 +128,7 @@ def test_roller_rig_config(run_node):
     origin = (0.0, 0.0, -R)
     send_twist(client, twist_msg((0, 0, 0), (0, omega_w, 0), stamp_ns=T0))
     assert exchange(client, "wheel", cloud_msg(ellipse(), origin=origin, stamp_ns=T0 + MS,
-                                               dtype="<f8"), timeout=1.0) == []
+                                               dtype="<f8"), rejected="stale_kinematics") == []
     # v_r = w_r x (0 - c_r), c_r = (0, 0, -(R + rr)), w_r = (0, -omega_r, 0)
     send_twist(client, twist_msg((-omega_r * (R + rr), 0, 0), (0, -omega_r, 0),
                                  stamp_ns=T0 + 2 * MS), rail=True)
@@ -212,28 +212,31 @@ def bad_inputs():
 def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
     _, client = run_node("-p", "max_patch_cells:=10000", contacts=("left",))
     # before any twist: no kinematics
-    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 - MS), timeout=0.5) == []
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 - MS),
+                    rejected="no_kinematics") == []
     send_twist(client, rolling_twist(1e-3, stamp_ns=T0))
     stamp = T0 + MS
     expected = {"no_kinematics": 1}
     for reason, build in bad_inputs():
         stamp += MS
-        assert exchange(client, "left", build(stamp), timeout=0.5) == [], reason
+        assert exchange(client, "left", build(stamp), rejected=reason) == [], reason
         expected[reason] = expected.get(reason, 0) + 1
         stamp += MS
         good = exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp, dtype="<f8"))
         assert len(good) == 1, f"no wrench after {reason}"
     # a stamp older than the last one
     assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp - MS // 2),
-                    timeout=0.5) == []
+                    rejected="old_stamp") == []
     expected["old_stamp"] = 1
     # kinematics too old by stamp, then standstill
     stamp += 60 * MS
-    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp), timeout=0.5) == []
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp),
+                    rejected="stale_kinematics") == []
     expected["stale_kinematics"] = 1
     send_twist(client, twist_msg((0.01, 0, 0), (0, 0.01 / R, 0), stamp_ns=stamp + MS))
     stamp += 2 * MS
-    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp), timeout=0.5) == []
+    assert exchange(client, "left", cloud_msg(egg(), stamp_ns=stamp),
+                    rejected="standstill") == []
     expected["standstill"] = 1
     # an empty patch is no rejection: a zero wrench, counted as no_contact
     stamp += MS
@@ -276,6 +279,22 @@ def test_refused_parameter_keeps_the_node_and_its_value(run_node):
     (w,) = exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 + 2 * MS, dtype="<f8"))
     fx, fy, n, _ = force(w)
     assert math.hypot(fx, fy) == pytest.approx(0.4 * n, rel=0.03)
+
+
+def test_diagnostics_report_the_peers_each_topic_matched(run_node):
+    """What a client cannot see from its side: the node's own matches, per topic."""
+    _, client = run_node(contacts=("left",))  # the node serves left and right
+    left, right = client.diagnostic_values("left"), client.diagnostic_values("right")
+    assert left["publishers/contact/left/patch"] == "1"
+    assert right["publishers/contact/right/patch"] == "0"
+    assert "publishers/contact/right/patch" not in left  # each status its own contact's
+    assert left["subscribers/contact/left/wrench"] == "1"
+    assert left["subscribers/contact/left/creepage"] == "0"
+    for status in (left, right):  # the shared topics in every status
+        assert status["publishers/wheelset/twist"] == "1"
+        assert status["publishers/rail/twist"] == "1"
+        assert status["subscribers/wheelset/wrench"] == "1"
+        assert status["subscribers/contact/markers"] == "0"
 
 
 def test_sigterm_and_sigint_end_cleanly(tmp_path):

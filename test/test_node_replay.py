@@ -2,31 +2,35 @@
 
 They must equal the offline replay's (``fastsim_replay``) wrench for wrench:
 the node and the replay share one pipeline, and stamps come from the
-messages, so the same inputs in the same order give the same numbers.  The
-player publishes at real time in log-time order, except that twists go out
-``TWIST_LEAD`` early: different topics carry no order between them over DDS,
-and a twist that arrived after its patch would change the kinematics that
-patch is solved with; an early twist changes nothing, since a patch only
-uses twists stamped at or before it.
+messages, so the same inputs in the same order give the same numbers.  Two
+topics carry no order between them over DDS, so the player sends every
+twist of the bag first and waits until the node's diagnostics count them
+all, then the patches at real time: each patch is solved with the newest
+twist stamped at or before it, which is the one the offline replay used as
+long as no twist is logged after a patch it is stamped before (checked).
+Nothing is lost on the way: every topic matched on both sides before the
+first message, and the node runs with reliable subscriptions deep enough
+to hold a whole bag (a test of equal numbers, not of speed).
 """
 
-import gc
 import time
 
 import pytest
 from geometry_msgs.msg import WrenchStamped
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from rosbags.rosbag2 import Reader
 from sensor_msgs.msg import PointCloud2
 
 from fastsim_ros import replay
 from fastsim_ros.params import load_params_file
+from fastsim_ros.pipeline import TWIST_HISTORY
+from msg_adapters.cdr import read_cloud, read_twist
 from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
 
 BAGS = PACKAGE_ROOT / "bags"
 SPEED = 1.0
-TWIST_LEAD = 50_000_000  # ns of log time
+#: the node's queues: deeper than a bag's messages on any topic
+DEPTH = 1000
 
 pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
                                 reason="fastsim_node is not installed (run colcon build)")
@@ -53,46 +57,48 @@ def force(w):
 @pytest.mark.parametrize("bag", ["hertz_ramp", "roller_rig", "flange_shift"])
 def test_node_fed_by_a_player_equals_the_offline_replay(bag, tmp_path):
     want = offline_wrenches(bag, tmp_path / "offline")
+    with Reader(BAGS / bag) as reader:
+        messages = [(conn.topic, t_ns, bytes(raw)) for conn, t_ns, raw in reader.messages()]
+    twists = [m for m in messages if m[0].endswith("/twist")]
+    patches = [m for m in messages if m[0].endswith("/patch")]
+    assert len(twists) + len(patches) == len(messages)
+    # twists first gives each patch the twist the offline replay gave it: no twist is
+    # logged after a patch it is stamped at or before
+    newest_patch = -1
+    for topic, _, raw in messages:
+        if topic.endswith("/patch"):
+            newest_patch = max(newest_patch, read_cloud(raw).stamp_ns)
+        else:
+            assert read_twist(raw).stamp_ns > newest_patch, topic
+    for topic in {m[0] for m in twists}:
+        assert sum(m[0] == topic for m in twists) <= TWIST_HISTORY  # the node keeps them all
     contacts = load_params_file(BAGS / f"{bag}.params.yaml")["contacts"]
-    proc = NodeProcess("--params-file", str(BAGS / f"{bag}.params.yaml"), log_dir=tmp_path)
+    proc = NodeProcess("--params-file", str(BAGS / f"{bag}.params.yaml"),
+                       "-p", "patch_reliability:=reliable", "-p", f"qos_depth:={DEPTH}",
+                       log_dir=tmp_path)
     client = Client(tuple(contacts), name="player")
-    # a full pass of the cyclic collector over a whole test session's objects
-    # stalls this process for tens of ms: the player would then send a burst
-    # (the node's best-effort queue keeps 10 per topic) and the recorder fall
-    # behind the node's reliable keep-last-10 writers.  None while playing.
-    gc.collect()
-    gc.disable()
     try:
+        pubs = {f"/{topic}": pub for topic, pub in (("wheelset/twist", client.twist),
+                                                    ("rail/twist", client.rail))}
+        pubs.update({f"/contact/{c}/patch": p for c, p in client.patch.items()})
+        for topic in {m[0] for m in messages} - pubs.keys():
+            pubs[topic] = client.publisher(PointCloud2, topic)
         client.wait_connected(proc)
-        qos = QoSProfile(depth=100, reliability=ReliabilityPolicy.RELIABLE)
-        pubs = {}
-        with Reader(BAGS / bag) as reader:
-            for conn in reader.connections:
-                if conn.topic == "/wheelset/twist":
-                    pubs[conn.topic] = client.twist
-                elif conn.topic == "/rail/twist":
-                    pubs[conn.topic] = client.rail
-                else:
-                    pubs[conn.topic] = client.node.create_publisher(PointCloud2, conn.topic,
-                                                                    qos)
-            client.spin(0.5)
-            schedule = sorted(((t_ns - TWIST_LEAD if conn.topic.endswith("/twist") else t_ns,
-                                k, conn, bytes(raw))
-                               for k, (conn, t_ns, raw) in enumerate(reader.messages())),
-                              key=lambda item: item[:2])
-            start, first = time.monotonic(), schedule[0][0]
-            for t_ns, _, conn, raw in schedule:
-                due = start + (t_ns - first) * 1e-9 / SPEED
-                while time.monotonic() < due:
-                    client.executor.spin_once(timeout_sec=max(0.0, due - time.monotonic()))
-                pubs[conn.topic].publish(raw)
+        for topic, _, raw in twists:
+            pubs[topic].publish(raw)
+        client.wait_twists_handled(len(twists))
+        start, first = time.monotonic(), patches[0][1]
+        for topic, t_ns, raw in patches:
+            due = start + (t_ns - first) * 1e-9 / SPEED
+            while time.monotonic() < due:
+                client.executor.spin_once(timeout_sec=max(0.0, due - time.monotonic()))
+            pubs[topic].publish(raw)
 
         def recorded():
             return sum(len(v) for v in client.wrenches.values())
-        client.wait_for(lambda: recorded() >= len(want), 10.0)
+        client.wait_for(lambda: recorded() >= len(want), 20.0)
         got = {(c, stamp_ns(w)): force(w) for c, ws in client.wrenches.items() for w in ws}
     finally:
-        gc.enable()
         client.close()
         assert proc.stop() == 0
     assert len(want) > 300

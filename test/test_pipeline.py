@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped, Vector3Stamped, WrenchStamped
 from rclpy.serialization import deserialize_message
+from sensor_msgs.msg import PointCloud2
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import samples
@@ -263,7 +264,7 @@ def test_messages_of_a_solve():
     assert pose.header.frame_id == "wheelset"
     assert (pose.pose.position.x, pose.pose.position.y,
             pose.pose.position.z) == pytest.approx(out.frame.origin)
-    cloud = msgs["contact/left/traction"]
+    cloud = deserialize_message(msgs["contact/left/traction"], PointCloud2)
     tau = np.frombuffer(bytes(cloud.data), dtype=np.dtype(
         {"names": ["tau_x"], "formats": ["<f4"], "offsets": [12], "itemsize": 24}))
     # the traction integrates to the force

@@ -1,0 +1,90 @@
+"""The DDS floor: a relay that answers each raw patch with a fixed wrench (rclpy + Fast DDS only).
+
+What ``fastsim_node`` cannot go below on this stack: the same topics, QoS,
+executor and process shape as the node (subscriptions best effort, the
+wrench publishers reliable, depth 10; rclpy's events executor in a
+``spin_once`` loop; the twist taken too), but no work: each patch's stamp
+is copied into a pre-serialised ``WrenchStamped`` of that contact, which is
+published as bytes.  ``bench_node.py --floor`` drives it alternately with
+the node and prints node/floor ratios.
+
+    .venv/bin/python benchmarks/dds_floor.py --contacts c0 c1 c2 c3
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.experimental import EventsExecutor
+from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import serialize_message
+
+from geometry_msgs.msg import TwistStamped, WrenchStamped
+from sensor_msgs.msg import PointCloud2
+
+#: a header stamp (int32 sec, uint32 nanosec) sits at bytes 4..12 of a little-endian
+#: CDR message: right after the encapsulation header, first in std_msgs/Header
+STAMP = slice(4, 12)
+
+
+class Floor(Node):
+    """Answer ``contact/<name>/patch`` with a fixed ``contact/<name>/wrench``, stamp copied."""
+
+    def __init__(self, contacts: Sequence[str], depth: int = 10) -> None:
+        super().__init__("fastsim_floor")
+        qos_in = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                            reliability=ReliabilityPolicy.BEST_EFFORT)
+        qos_out = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                             reliability=ReliabilityPolicy.RELIABLE)
+        self.create_subscription(TwistStamped, "wheelset/twist", self._on_twist, qos_in,
+                                 raw=True)
+        for name in contacts:
+            wrench = WrenchStamped()
+            wrench.header.frame_id = f"{name}_contact"
+            wrench.wrench.force.x, wrench.wrench.force.z = -1000.0, 60000.0
+            pub = self.create_publisher(WrenchStamped, f"contact/{name}/wrench", qos_out)
+            self.create_subscription(PointCloud2, f"contact/{name}/patch",
+                                     self._answer(pub, bytearray(serialize_message(wrench))),
+                                     qos_in, raw=True)
+
+    def _on_twist(self, raw: bytes) -> None:
+        pass
+
+    @staticmethod
+    def _answer(pub, wrench: bytearray) -> Callable[[bytes], None]:
+        def callback(raw: bytes) -> None:
+            wrench[STAMP] = raw[STAMP]
+            pub.publish(bytes(wrench))
+        return callback
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Relay until SIGINT or SIGTERM."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
+    parser.add_argument("--contacts", nargs="+", default=["left", "right"])
+    parser.add_argument("--depth", type=int, default=10, help="QoS depth (the node's qos_depth)")
+    args, ros_args = parser.parse_known_args(argv)
+    rclpy.init(args=[sys.argv[0], *ros_args])  # its signal handlers end spin_once
+    node = None
+    try:
+        node = Floor(args.contacts, args.depth)
+        executor = EventsExecutor()
+        executor.add_node(node)
+        while rclpy.ok():  # as the node: spin_once, which returns on SIGTERM
+            executor.spin_once(timeout_sec=0.25)
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
