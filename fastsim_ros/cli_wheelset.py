@@ -211,7 +211,7 @@ def _refused(cycle: ProfileCycle) -> None:
 
 
 def result_of(cycle: ProfileCycle, pipeline: ProfilePipeline, method: str) -> dict[str, Any]:
-    """The JSON object of INTERFACE.md for one solved pose."""
+    """Return the JSON object of INTERFACE.md for one solved pose."""
     contact = cycle.contact
     assert contact is not None
     pose = contact.pose

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -97,9 +97,12 @@ def wheelset_of(config: PipelineConfig) -> Wheelset:
 
 @dataclass(frozen=True, eq=False)
 class ProfileCycle:
-    """What one pose gave: the patches (``(name, cloud)``, all four names, in order),
-    the wrapped pipeline's outcomes (one per contact), and the geometry (``None`` when
-    the pose was dropped)."""
+    """What one pose gave.
+
+    ``patches``: ``(name, cloud)`` for all four names, in order; ``outcomes``:
+    the wrapped pipeline's, one per contact; ``contact``: the geometry
+    (``None`` when the pose was dropped); ``loads``: the wheel loads used.
+    """
 
     stamp_ns: int
     patches: tuple[tuple[str, Cloud], ...]
@@ -149,9 +152,15 @@ class ProfilePipeline:
         """Return a contact's solve-time p50 and p99 (us)."""
         return self.pipeline.solve_time_percentiles(contact)
 
-    def diagnostics(self, stamp_ns: int) -> Any:
-        """Return the wrapped pipeline's ``DiagnosticArray``."""
-        return self.pipeline.diagnostics(stamp_ns)
+    def diagnostics(self, stamp_ns: int,
+                    extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> Any:
+        """Return the wrapped pipeline's ``DiagnosticArray``, the poses' counts added.
+
+        ``extra``: more key-values per contact (the node's matched peers).
+        """
+        counts = tuple((f"poses/{k}", str(v)) for k, v in self.pose_counts.items())
+        merged = {c: tuple((extra or {}).get(c, ())) + counts for c in self.config.contacts}
+        return self.pipeline.diagnostics(stamp_ns, merged)
 
     def inputs(self) -> tuple[InputTopic, ...]:
         """Return the input topics of profiles mode: the twists, the pose and the load."""
@@ -215,8 +224,8 @@ class ProfilePipeline:
         if load.frame_id != self.config["wheelset_frame"]:
             reason = "wrong_frame"
         elif not all(math.isfinite(v) for v in load.linear + load.angular) \
-                or not load.linear[2] > 0.0:
-            reason = "nonfinite"
+                or min(self.split_load(load.linear[2], load.angular[0])) < 0.0:
+            reason = "nonfinite"  # a negative share cannot press a wheel onto its rail
         elif self._loads and load.stamp_ns < self._loads[-1].stamp_ns:
             reason = "old_stamp"
         else:
@@ -227,7 +236,10 @@ class ProfilePipeline:
         return reason
 
     def wheel_loads(self, stamp_ns: int) -> tuple[float, float] | None:
-        """Return the per-wheel loads (N) for a pose stamped ``stamp_ns``, or ``None``."""
+        """Return the per-wheel loads (N) for a pose stamped ``stamp_ns``, or ``None``.
+
+        A share of zero lifts that wheel (no patches, a zero wrench).
+        """
         max_age = round(float(self.config["max_kinematics_age"]) * 1e9)
         for load in reversed(self._loads):
             if load.stamp_ns <= stamp_ns:
@@ -329,7 +341,7 @@ class ProfilePipeline:
                                    tangential=creep_forces)
 
     def clouds(self, contact: WheelsetContact, stamp_ns: int) -> tuple[tuple[str, Cloud], ...]:
-        """Return the four contacts' patch clouds (empty where a wheel has no such patch)."""
+        """Return the patch cloud of each of the four contacts (empty without such a patch)."""
         frame = self.config["wheelset_frame"]
         by_name: dict[str, Cloud] = {}
         for wheel in contact.wheels:

@@ -60,7 +60,7 @@ PATCH_OFFSET = 0.0025  # patches lie between twists: no stamp ties, no boundary 
 FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure")
 REASONS = ("nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",
            "old_stamp", "no_kinematics", "stale_kinematics", "standstill", "too_large",
-           "degenerate", "out_of_table")
+           "degenerate", "out_of_table", "derailment")
 #: parameters of the node that the bad-input bag relies on
 MAX_PATCH_CELLS = 4096
 MAX_KINEMATICS_AGE = 0.05

@@ -207,7 +207,7 @@ def cell_shape_check(ratios: list[float]) -> int:
 
 
 def _rows(path: Path) -> list[list[str]]:
-    """The data rows of a shipped table (comments and the column line dropped)."""
+    """Return the data rows of a shipped table (comments and the column line dropped)."""
     lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
     return [row for row in csv.reader(lines[1:])]
 

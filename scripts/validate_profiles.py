@@ -130,7 +130,7 @@ def solve_case(case: benchmark.CaseResult, method: str) -> dict[str, Any]:
 
 
 def _pressure_picture(patches: list[Any]) -> list[dict[str, Any]]:
-    """The patches' pressure on their planar grids (for the figure), in MPa, float16-ish."""
+    """Return the patches' pressure on their planar grids (for the figure), in MPa."""
     out = []
     for wp in patches:
         g = wp.grid

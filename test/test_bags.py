@@ -14,6 +14,8 @@ ROOT = Path(__file__).resolve().parents[1]
 BAGS = ROOT / "bags"
 CLOUD = "sensor_msgs/msg/PointCloud2"
 TWIST = "geometry_msgs/msg/TwistStamped"
+POSE = "geometry_msgs/msg/PoseStamped"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
 FIELDS = ["x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure"]
 
 #: topic -> (type, message count) of each bundled bag
@@ -29,6 +31,8 @@ EXPECTED = {
                    "/contact/wheel/patch": (CLOUD, 400)},
     "bad_inputs": {"/wheelset/twist": (TWIST, 540), "/contact/left/patch": (CLOUD, 300),
                    "/contact/right/patch": (CLOUD, 300)},
+    "mbench_a22": {"/wheelset/twist": (TWIST, 42), "/wheelset/load": (WRENCH, 42),
+                   "/wheelset/pose": (POSE, 21)},
 }
 
 

@@ -1,5 +1,4 @@
-"""``fastsim_contact wheelset``: the JSON of INTERFACE.md, the sweep, the same numbers as the
-pipeline, bad input in one line."""
+"""``fastsim_contact wheelset``: its JSON, the sweep, the pipeline's numbers, bad input."""
 
 from __future__ import annotations
 
@@ -28,7 +27,7 @@ def run(capsys, *argv):
 
 @pytest.fixture(scope="module")
 def done_when(tmp_path_factory):
-    """The issue's command: both wheels' patches and forces, the roll solved."""
+    """Run the issue's command: both wheels' patches and forces, the roll solved."""
     import io
     import contextlib
     out = io.StringIO()

@@ -113,9 +113,20 @@ def test_a_load_message_splits_by_its_roll_moment():
     assert _vertical_force(by["right"]) == pytest.approx(10e3, rel=10 * LOAD_TOLERANCE)
 
 
+def test_a_load_all_on_one_wheel_lifts_the_other():
+    p = ProfilePipeline(_config(wheel_load=0.0))
+    b = p.wheelset.placement.wheel_offset
+    assert p.on_load(StampedTwist(0, "wheelset", (0.0, 0.0, 1e4), (1e4 * b, 0.0, 0.0))) == "ok"
+    p.on_wheel_twist(_twist(0))
+    by = {o.contact: o for o in p.on_pose(_pose(1 * MS, 0.0)).outcomes}
+    assert by["right"].status == "no_contact" and by["left"].status == "solved"
+    assert _vertical_force(by["left"]) == pytest.approx(1e4, rel=10 * LOAD_TOLERANCE)
+
+
 @pytest.mark.parametrize("load, why", [
     (StampedTwist(0, "other", (0.0, 0.0, 2e4), (0.0, 0.0, 0.0)), "wrong_frame"),
     (StampedTwist(0, "wheelset", (0.0, 0.0, -2e4), (0.0, 0.0, 0.0)), "nonfinite"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, 2e4), (2e5, 0.0, 0.0)), "nonfinite"),
     (StampedTwist(0, "wheelset", (0.0, 0.0, math.nan), (0.0, 0.0, 0.0)), "nonfinite"),
 ])
 def test_bad_loads_are_not_taken(load, why):

@@ -167,9 +167,12 @@ MAX_SHIFT, MAX_ANGLE = 0.1, 0.2
 
 @dataclass(frozen=True)
 class Pose:
-    """A wheelset pose in the track frame: lateral shift ``dy`` (m, positive left),
-    vertical position ``dz`` (m, positive up, 0 with the axle at the nominal radius
-    above the track plane), ``yaw`` about ``z`` and ``roll`` about ``x`` (rad)."""
+    """A wheelset pose in the track frame.
+
+    Lateral shift ``dy`` (m, positive left), vertical position ``dz`` (m,
+    positive up, 0 with the axle at the nominal radius above the track
+    plane), ``yaw`` about ``z`` and ``roll`` about ``x`` (rad).
+    """
 
     dy: float
     dz: float = 0.0

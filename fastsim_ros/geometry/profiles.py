@@ -483,7 +483,7 @@ def _dense(y: FloatArray, z: FloatArray) -> tuple[FloatArray, FloatArray, FloatA
 
 
 def _smoothed(y: FloatArray, z: FloatArray, wavelength: float) -> tuple[FloatArray, FloatArray]:
-    """CONTACT's weighted smoothing spline (2nd-order penalty) on the chord length."""
+    """Smooth as CONTACT's weighted smoothing spline (2nd-order penalty) on the chord length."""
     s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(y), np.diff(z)))])
     n = s.size
     w = np.empty(n)

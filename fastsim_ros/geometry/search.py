@@ -156,7 +156,7 @@ def vertical_gap(rail: RailSide, wheel: WheelSide, pose: Pose, nominal_radius: f
 
 
 def _region(locus: Locus, i0: int, i1: int, curvature: float) -> Region:
-    """Reference and extent of the run ``i0..i1`` (inclusive) of ``gap < 0``."""
+    """Return the reference and extent of the run ``i0..i1`` (inclusive) of ``gap < 0``."""
     sl = slice(i0, i1 + 1)
     pen = -locus.gap[sl]
     # CONTACT: the depth along x is pen - a t^2 with a = 1/(2 R0); the weight
@@ -189,7 +189,7 @@ def _region(locus: Locus, i0: int, i1: int, curvature: float) -> Region:
 
 
 def _box_distance(a: Region, b: Region) -> float:
-    """CONTACT's ``cpatch_distance``: between the regions' bounding boxes (m)."""
+    """Return the distance of the regions' bounding boxes (m; CONTACT's ``cpatch_distance``)."""
     dx = max(0.0, a.x_range[0] - b.x_range[1], b.x_range[0] - a.x_range[1])
     if a.y_range[0] > b.y_range[1]:
         dy, dz = a.y_range[0] - b.y_range[1], a.z_range[0] - b.z_range[1]

@@ -265,6 +265,10 @@ class Wheelset:
         forces = tuple(tangential(side, patches)) if (tangential and patches) else ()
         return WheelContact(side, patches, pose.dz, _normal_force(patches), forces)
 
+    def lifted(self, side: Side, pose: Pose) -> WheelContact:
+        """Return a wheel that carries no load: no patches, no force (a lifted wheel)."""
+        return WheelContact(side, (), pose.dz, (0.0, 0.0, 0.0))
+
     def wheel_loaded(self, side: Side, pose: Pose, load: float,
                      tangential: TangentialForces | None = None) -> WheelContact:
         """Return one wheel's contact where its vertical force is ``load`` (N).
@@ -312,9 +316,17 @@ class Wheelset:
             return WheelsetContact(pose, (self.wheel_at("left", pose, tangential),
                                           self.wheel_at("right", pose, tangential)))
         if loads is not None and not solve_roll:
-            left = self.wheel_loaded("left", pose, loads[0], tangential)
-            right = self.wheel_loaded("right", pose, loads[1], tangential)
-            return self._one_frame(replace(pose, dz=0.5 * (left.dz + right.dz)), left, right)
+            if loads[0] <= 0.0 and loads[1] <= 0.0:  # nothing presses the wheels down
+                return WheelsetContact(pose, (self.lifted("left", pose),
+                                              self.lifted("right", pose)))
+            left = (self.wheel_loaded("left", pose, loads[0], tangential) if loads[0] > 0.0
+                    else None)
+            right = (self.wheel_loaded("right", pose, loads[1], tangential) if loads[1] > 0.0
+                     else None)
+            heights = [w.dz for w in (left, right) if w is not None]
+            frame = replace(pose, dz=sum(heights) / len(heights))
+            return self._one_frame(frame, left or self.lifted("left", frame),
+                                   right or self.lifted("right", frame))
         return self._solve_roll(pose, loads, tangential)
 
     def _one_frame(self, pose: Pose, left: WheelContact, right: WheelContact) -> WheelsetContact:
@@ -385,7 +397,7 @@ def _normal_force(patches: Sequence[WheelPatch]) -> Vector:
 
 
 def _cropped(grid: PlanarGrid, pressure: FloatArray) -> tuple[PlanarGrid, FloatArray]:
-    """The grid and pressure cut to the cells in contact and one empty cell around them.
+    """Return the grid and pressure cut to the cells in contact and one empty cell around.
 
     The potential contact area is about three times the contact; the patch
     the node publishes and solves needs only the contact (and keeps an
@@ -410,7 +422,7 @@ def _edges_in_contact(pressure: FloatArray) -> tuple[int, int, int, int]:
 
 
 def _next_position(points: list[tuple[float, float]], dz_touch: float) -> float:
-    """The next vertical position: a safeguarded secant on ``phi(dz) = F^(2/3) - L^(2/3)``.
+    """Return the next vertical position: a safeguarded secant on ``F^(2/3) - L^(2/3)``.
 
     ``phi`` falls as the wheel is lowered (``dz`` falls); the root is kept
     bracketed between the lowest ``dz`` with ``phi < 0``... and the highest
