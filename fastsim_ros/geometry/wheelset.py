@@ -53,6 +53,10 @@ TangentialForces = Callable[[Side, Sequence["WheelPatch"]], Sequence[Vector]]
 #: below what the normal solver resolves; the node and the command line run the same
 #: steps, so they agree to rounding whatever this is)
 LOAD_TOLERANCE = 1e-7
+#: the balance's bracket on the vertical position is closed at this width (m); the force
+#: may step there (a cell entering the contact): then it holds to STEP_LOAD_TOLERANCE
+STEP_TOLERANCE = 1e-13
+STEP_LOAD_TOLERANCE = 1e-3
 #: the roll is solved until the wheels' vertical positions agree to this (m)
 ROLL_TOLERANCE = 1e-10
 MAX_ITERATIONS = 60
@@ -289,14 +293,21 @@ class Wheelset:
         for _ in range(MAX_ITERATIONS):
             contact = self.wheel_at(side, replace(pose, dz=dz), tangential)
             force = contact.vertical_force
-            best = contact
+            if best is None or abs(force - load) < abs(best.vertical_force - load):
+                best = contact
             if abs(force - load) <= LOAD_TOLERANCE * load:
                 return contact
             phi = math.copysign(abs(force) ** (2.0 / 3.0), force) - target
             points.append((dz, phi))
             dz = _next_position(points, dz_touch)
+            if _bracket_width(points) <= STEP_TOLERANCE:
+                # the force steps over the load here (a cell of the grid entering or
+                # leaving the contact): the nearest side of the step is the balance
+                break
         if best is None:  # pragma: no cover - MAX_ITERATIONS > 0
             raise BalanceError("no vertical position found")
+        if abs(best.vertical_force - load) <= STEP_LOAD_TOLERANCE * load:
+            return best
         raise BalanceError(f"the {side} wheel's vertical balance did not converge: "
                            f"{best.vertical_force:.6g} N for a load of {load:.6g} N")
 
@@ -348,18 +359,30 @@ class Wheelset:
         half_track = self.placement.wheel_offset
         roll = pose.roll
         if loads is not None:
-            # both wheels at one centre height: a roll d raises the left wheel by y_L d
+            # both wheels at one centre height: the root of m(roll) = dz_L - dz_R.  A roll
+            # d raises the left wheel by y_L d (m' = -2 y_L) on treads; on a flange the
+            # wheel also slides sideways, so secant steps, kept in a bracket once found
+            # (Illinois), take it from the first geometric step on
+            best: tuple[float, WheelContact, WheelContact, Pose] | None = None
+            tried: list[tuple[float, float]] = []
             for _ in range(MAX_ITERATIONS):
+                _check_roll(roll)
                 p = replace(pose, roll=roll)
                 left = self.wheel_loaded("left", p, loads[0], tangential)
                 right = self.wheel_loaded("right", p, loads[1], tangential)
                 mismatch = left.dz - right.dz
+                if best is None or abs(mismatch) < abs(best[0]):
+                    best = (mismatch, left, right, p)
                 if abs(mismatch) <= ROLL_TOLERANCE:
-                    return self._one_frame(replace(p, dz=0.5 * (left.dz + right.dz)), left,
-                                           right)
-                roll += mismatch / (2.0 * half_track)
-                _check_roll(roll)
-            raise NoContactError("the roll that levels both wheels was not found")
+                    break
+                tried.append((roll, mismatch))
+                roll = _next_roll(tried, half_track)
+                if roll is None:  # the bracket closed on a step of the mismatch
+                    break
+            if best is None or abs(best[0]) > 1e3 * ROLL_TOLERANCE:
+                raise BalanceError("the roll that levels both wheels was not found")
+            _, left, right, p = best
+            return self._one_frame(replace(p, dz=0.5 * (left.dz + right.dz)), left, right)
         # vertical position given: the roll that makes both wheels' vertical forces equal
         lo, hi = roll - 0.01, roll + 0.01
         f_lo = self._load_difference(replace(pose, roll=lo), tangential)
@@ -419,6 +442,42 @@ def _edges_in_contact(pressure: FloatArray) -> tuple[int, int, int, int]:
     """Which grid edges carry pressure: ``(x low, x high, s low, s high)`` as 0/1."""
     return (int(bool(np.any(pressure[:, 0] > 0.0))), int(bool(np.any(pressure[:, -1] > 0.0))),
             int(bool(np.any(pressure[0, :] > 0.0))), int(bool(np.any(pressure[-1, :] > 0.0))))
+
+
+def _next_roll(tried: list[tuple[float, float]], half_track: float) -> float | None:
+    """Return the next roll (rad) for the levelling, or ``None`` once the bracket closed.
+
+    ``tried``: ``(roll, dz_left - dz_right)``.  The first step is the
+    geometric one; then secants, kept inside the bracket once the mismatch
+    changed sign (bisection where a secant leaves it).
+    """
+    roll, m = tried[-1]
+    if len(tried) == 1:
+        return roll + m / (2.0 * half_track)
+    pos = [(r, f) for r, f in tried if f > 0.0]
+    neg = [(r, f) for r, f in tried if f < 0.0]
+    (r1, f1), (r2, f2) = tried[-2], tried[-1]
+    guess = r2 - f2 * (r2 - r1) / (f2 - f1) if f2 != f1 else r2 + m / (2.0 * half_track)
+    if pos and neg:
+        # the mismatch falls as the roll grows: the root lies between the largest
+        # roll still positive and the smallest negative one
+        lo = max(r for r, _ in pos)
+        hi = min(r for r, _ in neg)
+        lo, hi = min(lo, hi), max(lo, hi)
+        if hi - lo <= 1e-13:
+            return None
+        if not lo < guess < hi:
+            guess = 0.5 * (lo + hi)
+    return guess
+
+
+def _bracket_width(points: list[tuple[float, float]]) -> float:
+    """Return the width of the bracket the balance keeps (``inf`` before there is one)."""
+    below = [z for z, f in points if f < 0.0]
+    above = [z for z, f in points if f > 0.0]
+    if not below or not above:
+        return math.inf
+    return abs(min(below) - max(above))
 
 
 def _next_position(points: list[tuple[float, float]], dz_touch: float) -> float:
