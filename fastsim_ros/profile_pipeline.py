@@ -311,7 +311,7 @@ class ProfilePipeline:
             rot = pose.rotation()
             out: list[Vector] = []
             for wp in patches:
-                cloud = patch_cloud(stamp_ns, frame, wp.points, wp.normal, wp.pressure)
+                cloud = patch_cloud(stamp_ns, frame, *wp.cloud_arrays())
                 try:
                     patch = patch_from_cloud(cloud, max_cells=max_cells)
                     if patch is None:
@@ -347,7 +347,7 @@ class ProfilePipeline:
         for wheel in contact.wheels:
             for index, wp in enumerate(_tread_first(wheel.patches)):
                 by_name[contact_name(wheel.side, index)] = patch_cloud(
-                    stamp_ns, frame, wp.points, wp.normal, wp.pressure)
+                    stamp_ns, frame, *wp.cloud_arrays())
         empty = np.zeros((0, 0))
         return tuple((name, by_name.get(name) or patch_cloud(stamp_ns, frame, np.zeros((0, 0, 3)),
                                                              np.zeros(3), empty))

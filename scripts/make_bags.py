@@ -345,57 +345,71 @@ def _side_gap(rx: float, ry_neg: float, ry_pos: float) -> Callable[..., np.ndarr
     return gap
 
 
-def flange_shift() -> tuple[Bag, dict[str, Any]]:
-    """Build (c): normal-solver patches, lateral shift tread -> flange root, two-point stretch.
+#: flange_shift's holds: the lateral shift to the left (m), tread -> two-point -> flange
+FLANGE_SHIFTS = (0.0, 2.0e-3, 4.0e-3, 4.75e-3, 4.85e-3, 4.95e-3, 5.05e-3, 6.0e-3, 6.4e-3,
+                 8.0e-3)
+#: its profiles-mode parameters (the geometry the patches were computed with)
+FLANGE_PROFILE_PARAMS: dict[str, Any] = {
+    "patch_source": "profiles", "cell_size": 4.0e-4, "separation_distance": 2.0e-3,
+    "combination_distance": 1.0e-3, "shear_modulus": G, "poisson_ratio": NU, "method": "mae"}
 
-    Ten shifts ``s = k/9`` held 0.4 s each.  Left tread: contact angle
-    0.03 -> 0.5 rad, rolling radius 0.46 -> 0.466 m, lateral radius on the
-    flange side (in-plane ``y < 0``) 0.3 -> 0.03 m.  Right tread: angle
-    0.03 -> 0.01 rad, radius 0.46 -> 0.458 m, field-side radius 0.45 -> 0.75 m.
-    From ``k = 7`` on the left flange (angle 1.1 rad, radius 0.475 m) carries
-    15, 30, 45 kN and the left tread the rest of 60 kN.  The axle spins at
-    ``v0 / mean(R_left, R_right)``: the wheels get opposite creepages.
+
+def flange_shift() -> tuple[Bag, dict[str, Any]]:
+    """Build (c): patches from the profiles, the wheelset shifted from the treads to the flange.
+
+    The shipped S1002 wheels on UIC60 rails (the Manchester benchmark's
+    placement), 20 kN per wheel, 20 m/s with the axle spinning at ``v0 /
+    R0``, no yaw; ten lateral shifts to the left (:data:`FLANGE_SHIFTS`) held
+    0.4 s each, each with the roll that levels both wheels under their loads.
+    The patches are the profile pipeline's (0.4 mm cells; regions more than 2
+    mm apart kept as separate patches): from 4.75 to 5.05 mm the left wheel
+    touches its rail on the tread and on the gauge corner (``left_flange``),
+    from 6.4 mm on its flange.  The bag has the pose, the load and the
+    twist too, so it replays in either mode; its parameters are topics mode.
     """
-    dur, v0, hold, nshift = 4.0, 20.0, 0.4, 10
-    bag = track_bag("flange_shift", ["left", "right", "left_flange"])
-    radii, clouds = [], []
-    fl_area = None
-    for k in range(nshift):
-        s = k / (nshift - 1)
-        d = 0.008 * s
-        g_l, r_l = 0.03 + 0.47 * s, 0.46 + 0.006 * s
-        g_r, r_r = 0.03 - 0.02 * s, 0.46 - 0.002 * s
-        flange_load = 15.0e3 * (k - 6) if k >= 7 else 0.0
-        left = normal_area(r_l / math.cos(g_l), 0.3 * 0.1**s, 0.3, 6.0e4 - flange_load, 24)
-        right = normal_area(r_r / math.cos(g_r), 0.3, 0.45 + 0.3 * s, 6.0e4, 24)
-        pl = (0.0, Y_WHEEL - d, -r_l)
-        pr = (0.0, -Y_WHEEL - d, -r_r)
-        c = {"left": cloud_points(left, pl, left_normal(g_l)),
-             "right": cloud_points(right, pr, right_normal(g_r))}
-        g_f, r_f = 1.1, 0.475
-        pf = (0.0, Y_WHEEL - d - 0.035, -r_f)
-        if flange_load > 0.0:
-            fl_area = normal_area(r_f / math.cos(g_f), 0.04, 0.08, flange_load, 24)
-            c["left_flange"] = cloud_points(fl_area, pf, left_normal(g_f))
-        clouds.append(c)
-        radii.append((r_l, r_r))
-    # no flange contact: empty patches on the first flange patch's grid
-    assert fl_area is not None
-    empty = cloud_points(fl_area.with_pressure(np.ones_like(fl_area.pressure)),
-                         (0.0, Y_WHEEL - 0.035, -0.475), left_normal(1.1))
-    empty[..., 6] = 0.0
+    from fastsim_ros.geometry.placement import Pose
+    from fastsim_ros.pipeline import PipelineConfig
+    from fastsim_ros.profile_pipeline import ProfilePipeline, contact_name
+
+    dur, v0, hold = 4.0, 20.0, 0.4
+    names = ["left", "right", "left_flange", "right_flange"]
+    bag = Bag("flange_shift")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/load", WRENCH)
+    bag.topic("/wheelset/pose", POSE)
+    for c in names:
+        bag.topic(f"/contact/{c}/patch", CLOUD)
+    config = PipelineConfig.from_values({**FLANGE_PROFILE_PARAMS, "wheel_load": 2.0e4})
+    twist = (v0, 0.0, 0.0), (0.0, v0 / R, 0.0)
+    holds = []
+    for dy in FLANGE_SHIFTS:
+        pipeline = ProfilePipeline(config, solve_roll=True)
+        from msg_adapters.cdr import StampedTwist
+        wheel = StampedTwist(0, FRAME, twist[0], twist[1])
+        contact = pipeline.solve(Pose(dy), wheel, StampedTwist(0, "", (0.0, 0.0, 0.0),
+                                                                (0.0, 0.0, 0.0)),
+                                 0, loads=(2.0e4, 2.0e4))
+        clouds: dict[str, np.ndarray] = {}
+        for w in contact.wheels:
+            for k, wp in enumerate(sorted(w.patches, key=lambda p: -p.region.reference[1])):
+                points, normal, pressure = wp.cloud_arrays()
+                pts = np.empty(pressure.shape + (7,))
+                pts[..., 0:3] = points
+                pts[..., 3:6] = normal
+                pts[..., 6] = pressure
+                clouds[contact_name(w.side, k)] = pts
+        holds.append((contact.pose, clouds))
     for t in twist_times(dur):
-        k = min(int(t / hold), nshift - 1)
-        omega = v0 / (0.5 * (radii[k][0] + radii[k][1]))
-        bag.add("/wheelset/twist", stamp_ns(t), twist_msg(stamp_ns(t), (v0, 0, 0),
-                                                          (0, omega, 0)))
+        bag.add("/wheelset/twist", stamp_ns(t), twist_msg(stamp_ns(t), *twist))
+        bag.add("/wheelset/load", stamp_ns(t), load_msg(stamp_ns(t), 4.0e4))
+    empty = np.zeros((0, 0, 7))
     for t in patch_times(dur):
-        k = min(int(t / hold), nshift - 1)
+        pose, clouds = holds[min(int(t / hold), len(holds) - 1)]
         ns = stamp_ns(t)
-        for name in ("left", "right", "left_flange"):
-            pts = clouds[k].get(name, empty)
-            bag.add(f"/contact/{name}/patch", ns, cloud_msg(ns, pts))
-    return bag, {"contacts": ["left", "right", "left_flange"]}
+        bag.add("/wheelset/pose", ns, pose_msg(ns, pose.dy, pose.dz, pose.roll, pose.yaw))
+        for name in names:
+            bag.add(f"/contact/{name}/patch", ns, cloud_msg(ns, clouds.get(name, empty)))
+    return bag, {"contacts": names}
 
 
 def roller_rig() -> tuple[Bag, dict[str, Any]]:

@@ -151,3 +151,59 @@ def test_a_bad_profile_stops_the_node_at_start(tmp_path, profile, match):
     assert done.returncode == 2
     lines = [line for line in done.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and match in lines[0], done.stderr
+
+
+def test_a_recorded_rig_replays_to_the_node_as_offline(node, tmp_path):
+    # bags/mbench_a22 (poses, loads, twists: no patches) played to the node in profiles
+    # mode equals fastsim_replay's output wrench for wrench: one pipeline, stamps from
+    # the messages.  The twists and loads go first (two topics carry no order between
+    # them), then each pose, waiting for the node to have served it.
+    from rclpy.serialization import deserialize_message
+    from rosbags.rosbag2 import Reader
+
+    from fastsim_ros import replay
+    from geometry_msgs.msg import WrenchStamped
+
+    bags = PACKAGE_ROOT / "bags"
+    params = bags / "mbench_a22.params.yaml"
+    out = tmp_path / "offline"
+    assert replay.main([str(bags / "mbench_a22"), "-o", str(out), "--params", str(params),
+                        "--no-progress"]) == 0
+    want = {}
+    with Reader(out / "mbench_a22") as reader:
+        for conn, _, raw in reader.messages():
+            parts = conn.topic.split("/")
+            if len(parts) == 4 and parts[1] == "contact" and parts[3] == "wrench":
+                w = deserialize_message(raw, WrenchStamped)
+                want[(parts[2], w.header.stamp.sec, w.header.stamp.nanosec)] = w.wrench
+    with Reader(bags / "mbench_a22") as reader:
+        messages = [(conn.topic, bytes(raw)) for conn, _, raw in reader.messages()]
+    proc = NodeProcess("--params-file", str(params), "-p", "patch_reliability:=reliable",
+                       "-p", "qos_depth:=1000", log_dir=tmp_path)
+    client = Client(CONTACTS, name="player", patches=False)
+    try:
+        pose = client.publisher(PoseStamped, "wheelset/pose")
+        load = client.publisher(WrenchStamped, "wheelset/load")
+        client.wait_connected(proc)
+        twists = [raw for topic, raw in messages if topic == "/wheelset/twist"]
+        loads = [raw for topic, raw in messages if topic == "/wheelset/load"]
+        for raw in twists:
+            client.twist.publish(raw)
+        for raw in loads:
+            load.publish(raw)
+        client.wait_twists_handled(len(twists))
+        assert client.wait_for(lambda: int(client.node_values().get("poses/load", "0"))
+                               >= len(loads), 20.0)
+        for topic, raw in messages:
+            if topic == "/wheelset/pose":
+                client.send_pose(pose, deserialize_message(raw, PoseStamped), CONTACTS)
+        got = {(c, w.header.stamp.sec, w.header.stamp.nanosec): w.wrench
+               for c, ws in client.wrenches.items() for w in ws}
+    finally:
+        client.close()
+        assert proc.stop() == 0
+    assert len(want) == 4 * 21 and got.keys() == want.keys()
+    for key, w in want.items():
+        g = got[key]
+        assert (g.force.x, g.force.y, g.force.z, g.torque.z) == pytest.approx(
+            (w.force.x, w.force.y, w.force.z, w.torque.z), rel=1e-12, abs=1e-9), key

@@ -101,6 +101,19 @@ class WheelPatch:
     points_track: FloatArray
     frame_pose: Pose
 
+    def cloud_arrays(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Return ``points, normal, pressure`` of the patch cloud, rows along the frame's ``y``.
+
+        The contact frame's ``y = z x x`` (INTERFACE.md); on the right wheel
+        the side frame's lateral axis runs the other way, so its rows are
+        turned round: the node's patches all run like a rig's.
+        """
+        ey = np.cross(self.normal, self.points[0, -1] - self.points[0, 0])
+        rows = self.points[-1, 0] - self.points[0, 0] if self.points.shape[0] > 1 else ey
+        if float(np.dot(rows, ey)) < 0.0:
+            return self.points[::-1], self.normal, self.pressure[::-1]
+        return self.points, self.normal, self.pressure
+
     def in_frame(self, pose: Pose, nominal_radius: float) -> WheelPatch:
         """Return the patch with ``points`` and ``normal`` in the wheelset frame of ``pose``."""
         if pose == self.frame_pose:
