@@ -370,6 +370,7 @@ def flange_shift() -> tuple[Bag, dict[str, Any]]:
     from fastsim_ros.geometry.placement import Pose
     from fastsim_ros.pipeline import PipelineConfig
     from fastsim_ros.profile_pipeline import ProfilePipeline, contact_name
+    from msg_adapters.cdr import StampedTwist
 
     dur, v0, hold = 4.0, 20.0, 0.4
     names = ["left", "right", "left_flange", "right_flange"]
@@ -384,11 +385,9 @@ def flange_shift() -> tuple[Bag, dict[str, Any]]:
     holds = []
     for dy in FLANGE_SHIFTS:
         pipeline = ProfilePipeline(config, solve_roll=True)
-        from msg_adapters.cdr import StampedTwist
         wheel = StampedTwist(0, FRAME, twist[0], twist[1])
-        contact = pipeline.solve(Pose(dy), wheel, StampedTwist(0, "", (0.0, 0.0, 0.0),
-                                                                (0.0, 0.0, 0.0)),
-                                 0, loads=(2.0e4, 2.0e4))
+        rest = StampedTwist(0, "", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        contact = pipeline.solve(Pose(dy), wheel, rest, 0, loads=(2.0e4, 2.0e4))
         clouds: dict[str, np.ndarray] = {}
         for w in contact.wheels:
             for k, wp in enumerate(sorted(w.patches, key=lambda p: -p.region.reference[1])):

@@ -389,9 +389,10 @@ class Wheelset:
                 if abs(mismatch) <= ROLL_TOLERANCE:
                     break
                 tried.append((roll, mismatch))
-                roll = _next_roll(tried, half_track)
-                if roll is None:  # the bracket closed on a step of the mismatch
+                following = _next_roll(tried, half_track)
+                if following is None:  # the bracket closed on a step of the mismatch
                     break
+                roll = following
             if best is None or abs(best[0]) > 1e3 * ROLL_TOLERANCE:
                 raise BalanceError("the roll that levels both wheels was not found")
             _, left, right, p = best
