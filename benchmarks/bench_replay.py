@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Measure ``fastsim_replay``: throughput, --jobs scaling, and where the time goes.
+"""Measure ``fastsim_replay``: throughput against the batch solver, where the time goes, --jobs.
 
 Usage (from the package root)::
 
@@ -8,20 +8,25 @@ Usage (from the package root)::
 Prints, with the machine line:
 
 1. per bundled bag (its ``bags/<name>.params.yaml``), best of ``R`` replays
-   in this process: patch messages per second and the multiple of real time
-   (log duration / wall time) of a whole replay (open, read, solve, write,
-   close); beside it the batch solver's own rate on the same patches
-   (``MaeSolver.solve_batch``, one call per patch shape);
-2. the breakdown of one replay's wall time into reading (the reader's next
-   message: MCAP chunk decompression and record parsing), copying the input
-   message to the output, the pipeline (CDR decode, patch adaptation,
-   kinematics, solve), of which the solve alone (``solve_arrays`` re-timed
-   on the same patches and creepages), building and serializing the output
-   messages, writing them, and the rest (opening, connections, diagnostics,
-   closing), with per-message medians and p99;
-3. many bags (``K`` copies of each bag that uses the default contacts,
+   in this process, each a whole replay (open, read, solve, write, close):
+   patch messages per second and the multiple of real time (log duration /
+   wall time) of the replay (the chunked, batched path ``fastsim_replay``
+   takes) and, beside it, of the per-message reference path (rosbags'
+   reader and writer, one pipeline call per message: the replay before
+   issue 23); then the batch solver's own rate on the same patches in the
+   same run (``solve_batch`` of the bag's method, one call per patch shape,
+   best of 3) and the replay's share of it;
+2. where the batched replay's time goes (its best run): reading (chunk
+   reads, decompression, finding the records), copying the input's chunks,
+   decoding (twists and patches: layouts, the compiled scan and grid fit,
+   stamps, old stamps), kinematics (matching by stamp, creepages), solving,
+   state (frames, rig cycles, markers), encoding the outputs, writing them
+   (records, chunk compression, the summary, metadata.yaml), diagnostics,
+   and the rest (opening the input, the output directory, closing); shares
+   of the wall time and microseconds per input message;
+3. many bags: ``K`` copies of each bag that uses the default contacts,
    replayed through ``fastsim_replay.main`` with ``--jobs 1`` and
-   ``--jobs 2``): patches per second and the speed-up.
+   ``--jobs 2``: patches per second and the speed-up.
 
 Nothing is written outside a temporary directory.  Timings on a shared
 2-core VM drift between runs: quote the machine line and the load average.
@@ -36,6 +41,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from rosbags.rosbag2 import Reader
@@ -46,71 +52,73 @@ sys.path.insert(0, str(ROOT))
 from bench_fastsim import machine  # noqa: E402  (one machine line for every benchmark)
 from fastsim_ros import replay  # noqa: E402
 from fastsim_ros.contact import compiled  # noqa: E402
-from fastsim_ros.contact.compiled import MaeSolver  # noqa: E402
+from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
+from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
+from fastsim_ros.contact.friction import friction_law  # noqa: E402
 from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.replay import kernels  # noqa: E402
+from msg_adapters import patch as patch_adapter  # noqa: E402
 
 BAGS = ROOT / "bags"
 NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_inputs")
 #: bags whose params use the default contacts (left, right): one --params for all
 SAME_CONTACTS = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
-PHASES = ("read", "copy", "pipeline", "emit", "write")
+PHASES = ("read", "copy", "decode", "kinematics", "solve", "state", "encode", "write",
+          "diagnostics")
+SOLVERS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
+           "fastsim_ellipse": EquivalentEllipseSolver}
 
 
-def _us(values_ns) -> tuple[float, float]:
-    a = np.frombuffer(values_ns, dtype=np.int64) / 1e3 if len(values_ns) else np.zeros(1)
-    return float(np.median(a)), float(np.percentile(a, 99))
+def batch_rate(solves: list[tuple[Any, ...]], values: dict[str, Any],
+               repeats: int = 3) -> float:
+    """Return patch solves per second of the bag's method's ``solve_batch``.
 
-
-def _sum_s(values_ns) -> float:
-    return float(np.frombuffer(values_ns, dtype=np.int64).sum()) * 1e-9 if len(values_ns) \
-        else 0.0
-
-
-def solve_times(inputs, mu: float) -> np.ndarray:
-    """Return the wall time (s) of ``solve_arrays`` on each ``(patch, creepage)``."""
-    solver = MaeSolver(0.28, 8.0e10)
-    out = np.empty(len(inputs))
-    clock = time.perf_counter_ns
-    for k, (p, c) in enumerate(inputs):
-        t0 = clock()
-        solver.solve_arrays(p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi, c.eta, c.phi, mu)
-        out[k] = (clock() - t0) * 1e-9
-    return out
-
-
-def batch_rate(inputs, mu: float, repeats: int = 3) -> float:
-    """Return patch solves per second of ``MaeSolver.solve_batch`` on the same patches."""
-    solver = MaeSolver(0.28, 8.0e10)
-    groups: dict[tuple[int, int], list] = {}
-    for p, c in inputs:
-        groups.setdefault(p.pressure.shape, []).append((p, c))
+    On the same patches and creepages as the replay solved them, one call
+    per patch shape, best of ``repeats``.
+    """
+    solver = SOLVERS[values["method"]](values["poisson_ratio"], values["shear_modulus"])
+    mu = float(values["friction_coefficient"])
+    law = friction_law(values["friction_law"], mu,
+                       limit_ratio=float(values["friction_limit_ratio"]),
+                       decay=float(values["friction_decay"]))
+    groups: dict[tuple[int, int], list[tuple[Any, ...]]] = {}
+    for item in solves:
+        groups.setdefault(item[0].shape, []).append(item)
     batches = []
     for items in groups.values():
-        batches.append((np.stack([p.pressure for p, _ in items]),
-                        np.array([p.x0 for p, _ in items]), np.array([p.y0 for p, _ in items]),
-                        np.array([p.dx for p, _ in items]), np.array([p.dy for p, _ in items]),
-                        np.array([[c.xi, c.eta, c.phi] for _, c in items])))
+        batches.append((np.stack([i[0] for i in items]),
+                        *(np.array([i[k] for i in items]) for k in range(1, 5)),
+                        np.array([i[5:8] for i in items])))
     best = np.inf
     for _ in range(repeats):
         t0 = time.perf_counter()
         for ps, x0, y0, dx, dy, cr in batches:
-            solver.solve_batch(ps, x0, y0, dx, dy, cr, mu=mu)
+            solver.solve_batch(ps, x0, y0, dx, dy, cr, mu=mu, bound=values["traction_bound"],
+                               friction=law if law.slip_dependent else None,
+                               speed=np.full(len(cr), 20.0))
         best = min(best, time.perf_counter() - t0)
-    return len(inputs) / best
+    return len(solves) / best
 
 
-def one_bag(name: str, repeats: int, out: Path):
-    """Replay one bag ``repeats`` times; return the best result (profiled)."""
+def one_bag(name: str, repeats: int, out: Path, path: str,
+            tag: str = "") -> tuple[Any, dict[str, Any]]:
+    """Replay one bag ``repeats`` times on ``path``; return the fastest result (profiled)."""
     values = load_params_file(BAGS / f"{name}.params.yaml")
     best = None
     for k in range(repeats):
-        r = replay.replay_bag(BAGS / name, f"{name}_{k}", out, values, progress=False,
-                              profile=True)
+        r = replay.replay_bag(BAGS / name, f"{name}_{path}{tag}_{k}", out, values,
+                              progress=False, profile=True, path=path)
         if not r.ok:
             raise SystemExit(f"replay of {name} failed: {r.error}")
         if best is None or r.wall_s < best.wall_s:
             best = r
     return best, values
+
+
+def patches_of(name: str) -> int:
+    """Return the bag's patch messages."""
+    with Reader(BAGS / name) as reader:
+        return sum(c.msgcount for c in reader.connections if c.topic.endswith("/patch"))
 
 
 def many_bags(copies: int, jobs: int, out: Path) -> tuple[float, int, float]:
@@ -125,13 +133,12 @@ def many_bags(copies: int, jobs: int, out: Path) -> tuple[float, int, float]:
     log_s = 0.0
     for name in SAME_CONTACTS:
         with Reader(BAGS / name) as reader:
-            n = sum(c.msgcount for c in reader.connections if c.topic.endswith("/patch"))
             dur = reader.duration * 1e-9
         for k in range(copies):
             link = links / f"{name}_{k}"
             link.symlink_to(BAGS / name, target_is_directory=True)
             inputs.append(str(link))
-            patches += n
+            patches += patches_of(name)
             log_s += dur
     args = inputs + ["-o", str(out / f"out{jobs}"), "--jobs", str(jobs), "--no-progress",
                      "--params", str(BAGS / "hertz_ramp.params.yaml")]
@@ -147,64 +154,61 @@ def many_bags(copies: int, jobs: int, out: Path) -> tuple[float, int, float]:
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark and print its figures."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
-    ap.add_argument("--repeats", type=int, default=3, help="replays per bag (best is kept)")
+    ap.add_argument("--repeats", type=int, default=5, help="replays per bag (best is kept)")
     ap.add_argument("--copies", type=int, default=4,
                     help="copies of each default-contact bag in the many-bags run")
     ap.add_argument("--bags", nargs="+", default=list(NAMES), choices=NAMES)
     args = ap.parse_args(argv)
     print(f"machine: {machine()}")
     warm = compiled.warm_up()
+    patch_adapter.warm_up()
+    kernels.warm_up()
     source = "from the disk cache" if warm < 5.0 else "compiled: the cache was cold"
     print(f"kernels ready in {warm:.2f} s ({source})\n")
 
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
-        results = {name: one_bag(name, args.repeats, out) for name in args.bags}
+        for name in args.bags:  # one untimed replay each: first-call costs out of the figures
+            one_bag(name, 1, out, "auto", "_warm")
+        results = {name: one_bag(name, args.repeats, out, "auto") for name in args.bags}
+        reference = {name: one_bag(name, max(1, args.repeats // 2), out, "rosbags")[0]
+                     for name in args.bags}
 
         print(f"1. one bag at a time (best of {args.repeats}; whole replay: open to close)")
-        print(f"{'bag':20s} {'msgs':>5s} {'patches':>7s} {'wall s':>7s} {'patch/s':>8s} "
-              f"{'x real':>7s} {'batch solve/s':>13s}")
-        total_wall = total_log = 0.0
+        print(f"{'bag':20s} {'patches':>7s} {'wall ms':>8s} {'patch/s':>8s} {'x real':>7s} "
+              f"{'per-msg x real':>14s} {'batch solve/s':>13s} {'share':>6s}")
+        totals = {"wall": 0.0, "log": 0.0, "patches": 0, "solve_s": 0.0}
         for name, (r, values) in results.items():
-            p = r.profile
-            n_patch = len(p.pipeline)
-            mu = float(values["friction_coefficient"])
-            rate = batch_rate(p.solve_inputs, mu) if p.solve_inputs else float("nan")
-            total_wall += r.wall_s
-            total_log += r.duration_s
-            print(f"{name:20s} {r.messages_in:5d} {n_patch:7d} {r.wall_s:7.3f} "
-                  f"{n_patch / r.wall_s:8.0f} {r.speed:7.1f} {rate:13.0f}")
-        print(f"{'all five, in turn':20s} {'':5s} {'':7s} {total_wall:7.3f} {'':8s} "
-              f"{total_log / total_wall:7.1f}\n")
+            n_patch = patches_of(name)
+            solves = r.profile.solves
+            rate = batch_rate(solves, values) if solves else float("nan")
+            totals["wall"] += r.wall_s
+            totals["log"] += r.duration_s
+            totals["patches"] += n_patch
+            totals["solve_s"] += n_patch / rate
+            print(f"{name:20s} {n_patch:7d} {r.wall_s * 1e3:8.1f} {n_patch / r.wall_s:8.0f} "
+                  f"{r.speed:7.1f} {reference[name].speed:14.1f} {rate:13.0f} "
+                  f"{100 * n_patch / r.wall_s / rate:5.1f}%")
+        all_rate = totals["patches"] / totals["wall"]
+        solver_rate = totals["patches"] / totals["solve_s"]
+        print(f"{'all, in turn':20s} {totals['patches']:7d} {totals['wall'] * 1e3:8.1f} "
+              f"{all_rate:8.0f} {totals['log'] / totals['wall']:7.1f} {'':14s} "
+              f"{solver_rate:13.0f} {100 * all_rate / solver_rate:5.1f}%\n")
 
-        print("2. where the time goes (the best replay of each bag): share of wall time; "
-              "per message median / p99 (us)")
-        header = "".join(f" {k:>15s}" for k in PHASES + ("solve", "rest"))
-        print(f"{'bag':20s}{header}   overhead/msg")
-        for name, (r, values) in results.items():
-            p = r.profile
-            solves = solve_times(p.solve_inputs, float(values["friction_coefficient"]))
-            sums = {k: _sum_s(getattr(p, k)) for k in PHASES}
-            sums["pipeline"] += _sum_s(p.twist)
-            solve_s = float(solves.sum())
-            rest = r.wall_s - sum(sums.values())
-            shares = {k: v / r.wall_s for k, v in sums.items()}
-            cells = []
-            for k in PHASES:
-                share = shares[k] - (solve_s / r.wall_s if k == "pipeline" else 0.0)
-                cells.append(f" {100 * share:14.0f}%")
-            cells.append(f" {100 * solve_s / r.wall_s:14.0f}%")
-            cells.append(f" {100 * rest / r.wall_s:14.0f}%")
-            overhead = (r.wall_s - solve_s) / r.messages_in * 1e6
-            print(f"{name:20s}{''.join(cells)}   {overhead:8.1f} us")
-            per = [_us(getattr(p, k)) for k in PHASES]
-            s50, s99 = (float(np.median(solves)) * 1e6, float(np.percentile(solves, 99)) * 1e6) \
-                if solves.size else (float("nan"), float("nan"))
-            print(f"{'  per msg us':20s}" + "".join(f" {a:7.1f} / {b:5.0f}" for a, b in per)
-                  + f" {s50:7.1f} / {s99:5.0f}")
-        print("  (pipeline = pipeline calls of patches and twists minus the solve; per msg of"
-              " pipeline, emit, write: per patch; read, copy: per input message;\n"
-              "   overhead/msg = (wall - solve) / input messages, everything but the solve)\n")
+        print("2. where the batched replay's time goes (its best run): share of wall time; "
+              "us per input message")
+        print(f"{'bag':20s}" + "".join(f" {k[:6]:>7s}" for k in PHASES + ("rest",)))
+        for name, (r, _) in results.items():
+            phases = r.profile.phases
+            known = [phases.get(k, 0.0) for k in PHASES]
+            rest = r.wall_s - sum(known) - phases.get("csv", 0.0)
+            shares = known + [rest]
+            print(f"{name:20s}" + "".join(f" {100 * v / r.wall_s:6.0f}%" for v in shares))
+            per = [v / r.messages_in * 1e6 for v in shares]
+            print(f"{'  us/msg':20s}" + "".join(f" {v:7.2f}" for v in per))
+        print("  (read: chunk reads, decompression, record scan; copy: the input's chunks as "
+              "they are;\n   decode: twists, patch layouts, compiled scan and fit; write: "
+              "records, compression, summary, metadata)\n")
 
         print(f"3. many bags: {args.copies} copies each of {', '.join(SAME_CONTACTS)} "
               f"(one --params), fastsim_replay --jobs N")

@@ -286,6 +286,10 @@ class Pipeline:
                 raise parameters.ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config)
 
+    def outputs(self) -> dict[str, str]:
+        """Return every topic the pipeline publishes (relative, but /diagnostics) with its type."""
+        return output_topics(self.config.contacts)
+
     def inputs(self) -> tuple[InputTopic, ...]:
         """Return every input topic the pipeline takes, with its handler, in this order.
 

@@ -45,7 +45,7 @@ from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Whee
                                            WheelsetContact)
 from fastsim_ros.params import PROFILE_CONTACTS, SPECS, ParameterError
 from fastsim_ros.pipeline import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic, Outcome,
-                                  Pipeline, PipelineConfig, patch_topic)
+                                  Pipeline, PipelineConfig, output_topics, patch_topic)
 from msg_adapters.cdr import Cloud, StampedTwist
 from msg_adapters.errors import MalformedMessageError, RejectedInput
 from msg_adapters.patch import MIN_CONTACT_CELLS, patch_from_cloud
@@ -161,6 +161,10 @@ class ProfilePipeline:
         counts = tuple((f"poses/{k}", str(v)) for k, v in self.pose_counts.items())
         merged = {c: tuple((extra or {}).get(c, ())) + counts for c in self.config.contacts}
         return self.pipeline.diagnostics(stamp_ns, merged)
+
+    def outputs(self) -> dict[str, str]:
+        """Return every topic profiles mode publishes: the pipeline's and the patches."""
+        return output_topics(self.config.contacts, patches=True)
 
     def inputs(self) -> tuple[InputTopic, ...]:
         """Return the input topics of profiles mode: the twists, the pose and the load."""
@@ -359,7 +363,11 @@ class ProfilePipeline:
         return ProfileCycle(stamp, (), outcomes, None, None)
 
 
-def make_pipeline(config: PipelineConfig) -> Pipeline | ProfilePipeline:
+#: either pipeline: what the node and the replay drive (inputs, outputs, messages, counts)
+AnyPipeline = Pipeline | ProfilePipeline
+
+
+def make_pipeline(config: PipelineConfig) -> AnyPipeline:
     """Return the pipeline of the configured patch source (the node's and the replay's)."""
     if config["patch_source"] == "profiles":
         return ProfilePipeline(config)

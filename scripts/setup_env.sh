@@ -44,4 +44,5 @@ done
 # of the node reaches its first wrench quickly.  No-op when cached.
 (cd / && "$venv/bin/python" -c \
     'from fastsim_ros.contact import compiled; compiled.warm_up()
-from msg_adapters import patch; patch.warm_up()')
+from msg_adapters import patch; patch.warm_up()
+from fastsim_ros.replay import batch; batch.warm_up()')

@@ -36,6 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from fastsim_ros import replay  # noqa: E402
+from fastsim_ros.replay import batch  # noqa: E402
 from fastsim_ros.contact.compiled import MaeSolver  # noqa: E402
 from fastsim_ros.contact.normal import hertz_ellipse  # noqa: E402
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
@@ -613,21 +614,30 @@ def test_truncated_bag_from_the_console_script(tmp_path):
     assert list(out.iterdir()) == []
 
 
-def test_interrupt_leaves_nothing(tmp_path, monkeypatch, capsys):
+@pytest.mark.parametrize("where", ["batch", "message"])
+def test_interrupt_leaves_nothing(tmp_path, monkeypatch, capsys, where):
+    # Ctrl-C in the middle of the first bag: in a batched run of messages, or in one
+    # message's pipeline call (the per-message path: traction clouds on)
     calls = {"n": 0}
-    original = replay.Pipeline.on_patch
+    owner, name, at = ((batch.Batch, "run", 3) if where == "batch"
+                       else (replay.Pipeline, "on_patch", 300))
+    original = getattr(owner, name)
 
-    def on_patch(self, contact, raw):
+    def interrupted(*args):
         calls["n"] += 1
-        if calls["n"] == 300:
+        if calls["n"] == at:
             raise KeyboardInterrupt
-        return original(self, contact, raw)
+        return original(*args)
 
-    monkeypatch.setattr(replay.Pipeline, "on_patch", on_patch)
+    monkeypatch.setattr(owner, name, interrupted)
+    params = tmp_path / "params.yaml"
+    params.write_text("fastsim:\n  ros__parameters:\n    publish_traction: "
+                      f"{'false' if where == 'batch' else 'true'}\n")
     out = tmp_path / "out"
     status, _, err = run([BAGS / "hertz_ramp", BAGS / "semi_ellipses_spin", "-o", out, "--csv",
-                          "--plot"], capsys)
+                          "--plot", "--params", params], capsys)
     assert status == 130 and "interrupted" in err
+    assert calls["n"] == at
     assert list(out.iterdir()) == []
 
 

@@ -131,9 +131,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     executor: Executor | None = None
     try:
         from fastsim_ros.contact import compiled
+        from fastsim_ros.replay import batch
         from msg_adapters import patch as patch_adapter
         compiled.warm_up()  # load the kernels once (forked workers inherit them)
         patch_adapter.warm_up()
+        batch.warm_up()
         executor = InProcess() if jobs == 1 else LocalPool(jobs)
         for r in executor.results(tasks):
             for w in r.warnings:

@@ -42,17 +42,19 @@ class Series:
             self.stride *= 2
 
 
-def record(outcome: Outcome, t_ns: int, rows: Any, series: Series, method: str,
+def record(outcome: Outcome, t_ns: int, rows: Any, series: Series | None, method: str,
            law: str) -> None:
-    """Add a wrench's CSV row (when ``rows`` is a csv writer) and plot sample."""
+    """Add a wrench's CSV row (when ``rows`` is a csv writer) and plot sample (to ``series``)."""
     f, cr = outcome.forces, outcome.creepage
     if f is None or cr is None:  # no contact: a zero wrench, creepages undefined
         if rows is not None:
             rows.writerow((outcome.stamp_ns, outcome.contact, "", "", "", "", 0.0, 0.0, 0.0,
                            0.0, "", method, law))
-        series.add(t_ns * 1e-9, math.nan, math.nan, math.nan, 0.0, 0.0, 0.0)
+        if series is not None:
+            series.add(t_ns * 1e-9, math.nan, math.nan, math.nan, 0.0, 0.0, 0.0)
         return
     if rows is not None:
         rows.writerow((outcome.stamp_ns, outcome.contact, cr.xi, cr.eta, cr.phi, cr.speed,
                        f.n, f.fx, f.fy, f.mz, f.slip_fraction, method, law))
-    series.add(t_ns * 1e-9, cr.xi, cr.eta, cr.phi, f.fx, f.fy, f.n)
+    if series is not None:
+        series.add(t_ns * 1e-9, cr.xi, cr.eta, cr.phi, f.fx, f.fy, f.n)

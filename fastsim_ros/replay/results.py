@@ -18,8 +18,10 @@ class Profile:
     ``copy``: writing the input message, ``pipeline``: the pipeline call
     (decode, adapt, kinematics, solve) of patches, ``twist``: of twists,
     ``emit``: building and serializing the output messages of a patch,
-    ``write``: writing them.  ``solve_inputs``: ``(patch, creepage)`` of
-    every solved patch, to time the solver alone on the same inputs.
+    ``write``: writing them (the per-message path).  ``phases``: the
+    totals (s) of the chunked path's phases.  ``solves``: ``(pressure, x0,
+    y0, dx, dy, xi, eta, phi)`` of every solve as it was solved, to time
+    the solver alone on the same inputs.
     """
 
     read: array = field(default_factory=lambda: array("q"))
@@ -28,7 +30,8 @@ class Profile:
     twist: array = field(default_factory=lambda: array("q"))
     emit: array = field(default_factory=lambda: array("q"))
     write: array = field(default_factory=lambda: array("q"))
-    solve_inputs: list[tuple[Any, Any]] = field(default_factory=list)
+    phases: dict[str, float] = field(default_factory=dict)
+    solves: list[tuple[Any, ...]] = field(default_factory=list)
 
 
 @dataclass

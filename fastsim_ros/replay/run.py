@@ -29,9 +29,9 @@ from typing import Any
 from rclpy.serialization import serialize_message
 
 from fastsim_ros.params import SPECS, ParameterError
-from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig, output_topics
-from fastsim_ros.profile_pipeline import make_pipeline
-from fastsim_ros.replay import bagio
+from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig
+from fastsim_ros.profile_pipeline import AnyPipeline, make_pipeline
+from fastsim_ros.replay import bagio, bulk
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
 from fastsim_ros.replay.records import CSV_HEADER, Series, record
@@ -54,7 +54,11 @@ class Task:
     ``contacts_from_bag``: take the contacts from the bag's patch topics
     instead of ``values`` (no ``--params``); ``namespace``: the node's
     (absolute); ``tag``: this run's mark on temporary names (so the main
-    process can clean up after an interrupt).
+    process can clean up after an interrupt).  ``path``: ``"auto"`` (an
+    indexed MCAP input by the chunk, batched where the batch applies),
+    ``"messages"`` (by the chunk, every message through the pipeline's
+    handlers) or ``"rosbags"`` (rosbags' reader and writer, message by
+    message: the reference the others are tested against).
     """
 
     source: Path
@@ -67,6 +71,7 @@ class Task:
     namespace: str = "/"
     tag: str = ""
     progress: bool = False
+    path: str = "auto"
 
 
 def targets(out: Path, name: str, plot: bool, write_csv: bool) -> list[Path]:
@@ -82,10 +87,10 @@ def targets(out: Path, name: str, plot: bool, write_csv: bool) -> list[Path]:
 def replay_bag(source: Path, name: str, out: Path, values: dict[str, Any], *,
                plot: bool = False, write_csv: bool = False, contacts_from_bag: bool = False,
                namespace: str = "/", tag: str = "", progress: bool = True,
-               profile: bool = False) -> Result:
+               profile: bool = False, path: str = "auto") -> Result:
     """Replay one input into ``out``: :func:`run_task` of the :class:`Task` of these options."""
     return run_task(Task(source, name, out, values, plot, write_csv, contacts_from_bag,
-                         namespace, tag, progress), profile=profile)
+                         namespace, tag, progress, path), profile=profile)
 
 
 def run_task(task: Task, *, profile: bool = False) -> Result:
@@ -181,9 +186,9 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
     source, name, namespace = task.source, task.name, task.namespace
     prof = Profile() if profile else None
     result.profile = prof
-    clock = time.perf_counter_ns
 
     reader = bagio.open_reader(source)
+    csv_file = None
     try:
         if reader.message_count == 0:
             raise BadInput(f"{source}: empty bag (no messages)")
@@ -199,8 +204,6 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
         result.contacts = contacts
         result.contacts_found = found
         result.namespace = namespace
-        absolute = {resolve(t, namespace): msgtype for t, msgtype in output_topics(
-            contacts, patches=config["patch_source"] == "profiles").items()}
         inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
         if not any(resolve(conn.topic) in inputs
                    and inputs[resolve(conn.topic)].kind not in _KINEMATICS
@@ -212,88 +215,28 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
                    if task.contacts_from_bag else
                    f"of the configured contacts ({', '.join(contacts)})")
                 + "; nothing solved (are --params and --namespace right?)")
-        writer = bagio.open_writer(staging / name, {
-            PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
-            "fastsim.input": str(source), "fastsim.replay": PROG})
-        qos_out = bagio.qos(config["output_reliability"], int(config["qos_depth"]))
-        csv_file = None
+        custom = {PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
+                  "fastsim.input": str(source), "fastsim.replay": PROG}
         rows = None
         if task.write_csv:
             csv_file = open(staging / f"{name}.csv", "w", newline="", encoding="utf-8")
             rows = csv.writer(csv_file, lineterminator="\n")
             rows.writerow(CSV_HEADER)
-        series = {c: Series() for c in contacts}
-        method, law = str(config["method"]), str(config["friction_law"])
+        series = {c: Series() for c in contacts} if task.plot else None
+        out = _Outputs(pipeline, rows, series, str(config["method"]),
+                       str(config["friction_law"]))
         bar = _progress(name, reader.message_count, task.progress)
-        with writer:
-            copies = bagio.copy_connections(reader, writer, set(absolute))
-            conns: dict[str, Any] = {}
-
-            def put(topic: str, log_ns: int, data: Any) -> None:
-                conn = conns.get(topic)
-                if conn is None:
-                    conn = conns[topic] = writer.add_connection(
-                        topic, absolute[topic], typestore=bagio.TYPESTORE,
-                        offered_qos_profiles=qos_out)
-                writer.write(conn, log_ns, data)
-                result.messages_out += 1
-
-            diagnostics = resolve(DIAGNOSTICS_TOPIC, namespace)
-            first: int | None = None
-            last: int | None = None
-            next_diag = 0
-            t_read = clock()
-            for conn, log_ns, raw in bagio.messages(reader, str(source)):
-                if prof is not None:
-                    now = clock()
-                    prof.read.append(now - t_read)
-                if first is None:
-                    first = log_ns
-                    next_diag = first + 1_000_000_000
-                last = log_ns
-                result.messages_in += 1
-                if bar is not None and result.messages_in % _PROGRESS_EVERY == 0:
-                    bar.update(_PROGRESS_EVERY)
-                if log_ns >= next_diag:
-                    put(diagnostics, log_ns, serialize_message(
-                        pipeline.diagnostics(log_ns)))
-                    next_diag += ((log_ns - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
-                copy = copies.get(conn.id)
-                if copy is not None:
-                    t0 = clock()
-                    writer.write(copy, log_ns, raw)
-                    result.messages_out += 1
-                    if prof is not None:
-                        prof.copy.append(clock() - t0)
-                source_topic = inputs.get(resolve(conn.topic))
-                if source_topic is not None:
-                    t0 = clock()
-                    outcomes = source_topic.take(raw)
-                    t1 = clock()
-                    if prof is not None:
-                        (prof.twist if source_topic.kind in _KINEMATICS
-                         else prof.pipeline).append(t1 - t0)
-                    for outcome in outcomes:
-                        msgs = pipeline.messages(outcome)
-                        data = [(t, m if isinstance(m, (bytes, bytearray, memoryview))
-                                 else serialize_message(m)) for t, m in msgs]
-                        t2 = clock()
-                        for rel, payload in data:
-                            put(resolve(rel, namespace), log_ns, payload)
-                        if prof is not None:
-                            prof.emit.append(t2 - t1)
-                            prof.write.append(clock() - t2)
-                            if outcome.status == "solved":
-                                prof.solve_inputs.append((outcome.patch, outcome.creepage))
-                        if outcome.has_wrench:
-                            record(outcome, log_ns - first, rows, series[outcome.contact],
-                                   method, law)
-                        t1 = clock()
-                t_read = clock()
-            if first is None or last is None:
-                raise BadInput(f"{source}: empty bag (no messages)")
-            put(diagnostics, last, serialize_message(pipeline.diagnostics(last)))
-            result.duration_s = (last - first) * 1e-9
+        indexed = bulk.open_indexed(source, reader) if task.path != "rosbags" else None
+        if indexed is not None:
+            try:
+                first, last = _replay_indexed(task, indexed, reader, staging, pipeline, custom,
+                                              out, bar, prof, result)
+            finally:
+                indexed.close()
+        else:
+            first, last = _replay_messages(task, reader, staging, pipeline, custom, out, bar,
+                                           prof, result)
+        result.duration_s = (last - first) * 1e-9
         if bar is not None:
             bar.close()
         for c in contacts:
@@ -302,11 +245,147 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
         result.kinematics = dict(pipeline.kinematics_counts)
         if csv_file is not None:
             csv_file.close()
-        if task.plot:
+        if task.plot and series is not None:
             plot_start = time.perf_counter()
             write_plot(staging / f"{name}.png", name, contacts, series,
                        float(config["friction_coefficient"]))
             result.plot_s = time.perf_counter() - plot_start
     finally:
+        if csv_file is not None:
+            csv_file.close()
         reader.close()
     result.wall_s = time.perf_counter() - start_wall
+
+
+@dataclass
+class _Outputs:
+    """Where a wrench's CSV row and plot sample go (either may be off)."""
+
+    pipeline: AnyPipeline
+    rows: Any
+    series: dict[str, Series] | None
+    method: str
+    law: str
+    first: int = 0
+
+    def outcome(self, outcome: Any, log_ns: int) -> None:
+        """Record one outcome's wrench (the per-message paths)."""
+        if outcome.has_wrench:
+            record(outcome, log_ns - self.first, self.rows,
+                   None if self.series is None else self.series[outcome.contact],
+                   self.method, self.law)
+
+
+def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeline: AnyPipeline,
+                    custom: dict[str, str], out: _Outputs, bar: Any, prof: Profile | None,
+                    result: Result) -> tuple[int, int]:
+    """Replay an indexed MCAP input by the chunk (:mod:`~fastsim_ros.replay.bulk`)."""
+    replay = bulk.IndexedReplay(task.source, indexed, reader, staging / task.name, pipeline,
+                                task.namespace, custom, result,
+                                keep_inputs=prof is not None,
+                                batched=task.path != "messages")
+    try:
+        first, last = replay.run(out, None if bar is None else bar.update)
+        replay.close()
+    except BaseException:
+        replay.abort()
+        raise
+    if prof is not None:
+        prof.phases = dict(replay.phases)
+        if replay.batch is not None:
+            t = replay.batch.timing
+            prof.phases.update(decode=t.decode, kinematics=t.kinematics, solve=t.solve,
+                               state=t.state)
+            prof.solves = t.inputs or []
+    return first, last
+
+
+def _replay_messages(task: Task, reader: Any, staging: Path, pipeline: AnyPipeline,
+                     custom: dict[str, str], out: _Outputs, bar: Any, prof: Profile | None,
+                     result: Result) -> tuple[int, int]:
+    """Replay any input message by message with rosbags (the reference path)."""
+    source, namespace, config = task.source, task.namespace, pipeline.config
+    clock = time.perf_counter_ns
+    absolute = {resolve(t, namespace): msgtype for t, msgtype in pipeline.outputs().items()}
+    inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
+    writer = bagio.open_writer(staging / task.name, custom)
+    qos_out = bagio.qos(config["output_reliability"], int(config["qos_depth"]))
+    with writer:
+        copies = bagio.copy_connections(reader, writer, set(absolute))
+        conns: dict[str, Any] = {}
+
+        def put(topic: str, log_ns: int, data: Any) -> None:
+            conn = conns.get(topic)
+            if conn is None:
+                conn = conns[topic] = writer.add_connection(
+                    topic, absolute[topic], typestore=bagio.TYPESTORE,
+                    offered_qos_profiles=qos_out)
+            writer.write(conn, log_ns, data)
+            result.messages_out += 1
+
+        diagnostics = resolve(DIAGNOSTICS_TOPIC, namespace)
+        first: int | None = None
+        last: int | None = None
+        next_diag = 0
+        t_read = clock()
+        for conn, log_ns, raw in bagio.messages(reader, str(source)):
+            if prof is not None:
+                now = clock()
+                prof.read.append(now - t_read)
+            if first is None:
+                first = out.first = log_ns
+                next_diag = first + 1_000_000_000
+            last = log_ns
+            result.messages_in += 1
+            if bar is not None and result.messages_in % _PROGRESS_EVERY == 0:
+                bar.update(_PROGRESS_EVERY)
+            if log_ns >= next_diag:
+                put(diagnostics, log_ns, serialize_message(pipeline.diagnostics(log_ns)))
+                next_diag += ((log_ns - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
+            copy = copies.get(conn.id)
+            if copy is not None:
+                t0 = clock()
+                writer.write(copy, log_ns, raw)
+                result.messages_out += 1
+                if prof is not None:
+                    prof.copy.append(clock() - t0)
+            source_topic = inputs.get(resolve(conn.topic))
+            if source_topic is not None:
+                t0 = clock()
+                outcomes = source_topic.take(raw)
+                t1 = clock()
+                if prof is not None:
+                    (prof.twist if source_topic.kind in _KINEMATICS
+                     else prof.pipeline).append(t1 - t0)
+                for outcome in outcomes:
+                    msgs = pipeline.messages(outcome)
+                    data = [(t, m if isinstance(m, (bytes, bytearray, memoryview))
+                             else serialize_message(m)) for t, m in msgs]
+                    t2 = clock()
+                    for rel, payload in data:
+                        put(resolve(rel, namespace), log_ns, payload)
+                    if prof is not None:
+                        prof.emit.append(t2 - t1)
+                        prof.write.append(clock() - t2)
+                        if outcome.status == "solved" and outcome.patch is not None \
+                                and outcome.creepage is not None:
+                            prof.solves.append(_solve_input(outcome))
+                    out.outcome(outcome, log_ns)
+                    t1 = clock()
+            t_read = clock()
+        if first is None or last is None:
+            raise BadInput(f"{source}: empty bag (no messages)")
+        put(diagnostics, last, serialize_message(pipeline.diagnostics(last)))
+    return first, last
+
+
+def _solve_input(outcome: Any) -> tuple[Any, ...]:
+    """Return ``(pressure, x0, y0, dx, dy, xi, eta, phi)`` of a solved patch as it was solved."""
+    patch, creep = outcome.patch, outcome.creepage
+    p, x0, y0, phi = patch.pressure, patch.x0, patch.y0, creep.phi
+    if creep.speed < 0.0:  # turned by 180 degrees, as the pipeline solves it
+        p = p[::-1, ::-1]
+        x0 = -(x0 + (p.shape[1] - 1) * patch.dx)
+        y0 = -(y0 + (p.shape[0] - 1) * patch.dy)
+        phi = -phi
+    return (p, x0, y0, patch.dx, patch.dy, creep.xi, creep.eta, phi)

@@ -1,0 +1,394 @@
+"""The replay of an indexed MCAP bag, by the chunk: the path ``fastsim_replay`` takes.
+
+The input is read chunk by chunk (:func:`~fastsim_ros.replay.mcap.windows`:
+log-time order, memory bounded by the chunks that overlap in time); its
+chunks are copied to the output as they are (the input's messages, with
+their channels, schemas and message indexes: no second compression), except
+a chunk holding messages on one of the node's output topics, whose other
+messages are copied one by one.  Between two diagnostics the messages go,
+as a run, through :class:`~fastsim_ros.replay.batch.Batch` (the pipeline's
+rules in bulk) and their outputs are encoded and written in bulk; where the
+batch does not apply (inputs it does not know, traction clouds) each
+message goes through the pipeline's own handler
+(:meth:`~fastsim_ros.pipeline.Pipeline.inputs`).  Either way the messages,
+their order and their values are those of the per-message replay.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from rclpy.serialization import serialize_message
+from rosbags.rosbag2.metadata import dump_qos_v9
+
+from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
+                                  Outcome, Pipeline)
+from fastsim_ros.profile_pipeline import AnyPipeline
+from fastsim_ros.replay import bagio, batch, encode, kernels, mcap
+from fastsim_ros.replay.errors import BadInput
+from fastsim_ros.replay.results import Result
+
+Ints = NDArray[np.int64]
+#: messages per window read at a time (each window's chunks stay in memory)
+WINDOW = 8192
+#: order of a patch's outputs (Pipeline.messages), the diagnostics before them
+_DIAG, _WRENCH, _CREEPAGE, _FRAME, _MARKER, _WHEELSET = -1, 0, 1, 2, 4, 5
+
+
+def resolve(topic: str, namespace: str = "/") -> str:
+    """Return the absolute name of ``topic`` in ``namespace`` (see :func:`run.resolve`)."""
+    if topic.startswith("/"):
+        return topic
+    return f"{namespace.rstrip('/')}/{topic}"
+
+
+def open_indexed(source: Path, reader: Any) -> mcap.IndexedMcap | None:
+    """Return the input's one MCAP file opened by its index, or ``None``.
+
+    ``None`` (rosbags reads it) for several files, per-message or file
+    compression, no summary or no message indexes.
+    """
+    storage = reader.storage
+    files: list[Any] = getattr(storage, "storages", [storage])
+    if len(files) != 1 or not isinstance(files[0], mcap_reader_type()):
+        return None
+    if getattr(reader, "compression_mode", None):
+        return None
+    try:
+        indexed = mcap.open_indexed(Path(getattr(files[0], "path")))
+    except (mcap.McapError, OSError) as e:
+        raise BadInput(f"{source}: unreadable: {e}") from None
+    if indexed is not None and not all(c.index_offsets for c in indexed.chunks):
+        indexed.close()  # rosbags reads no chunk without message indexes: read it likewise
+        return None
+    return indexed
+
+
+def mcap_reader_type() -> type:
+    """Return rosbags' MCAP storage reader class."""
+    from rosbags.rosbag2.storage_mcap import McapReader
+    return McapReader
+
+
+class IndexedReplay:
+    """One indexed input replayed into one output bag (see the module docstring)."""
+
+    def __init__(self, source: Path, indexed: mcap.IndexedMcap, reader: Any, out_dir: Path,
+                 pipeline: AnyPipeline, namespace: str, custom_data: dict[str, str],
+                 result: Result, *, keep_inputs: bool = False, batched: bool = True) -> None:
+        self.source = source
+        self.mcap = indexed
+        self.pipeline = pipeline
+        self.config = pipeline.config
+        self.namespace = namespace
+        self.result = result
+        self.custom_data = custom_data
+        contacts = self.config.contacts
+        self.output_types = {resolve(t, namespace): m for t, m in pipeline.outputs().items()}
+        self.frame_id = str(self.config["wheelset_frame"])
+        out_dir.mkdir()
+        self.out_dir = out_dir
+        self.writer = mcap.McapWriter(out_dir / f"{out_dir.name}.mcap")
+        self.phases: dict[str, float] = {"read": 0.0, "copy": 0.0, "encode": 0.0,
+                                         "write": 0.0, "diagnostics": 0.0, "csv": 0.0}
+        # the input's channels: copied with their ids and schemas, but those on output topics
+        self.skip = {cid for cid, ch in indexed.channels.items()
+                     if resolve(ch.topic) in self.output_types}
+        self.meta: list[tuple[mcap.Channel, str, list[Any], str]] = []
+        connections = {(c.topic, c.msgtype): c for c in reader.connections}
+        used_schemas = {ch.schema_id for cid, ch in indexed.channels.items()
+                        if cid not in self.skip}
+        for sid in sorted(used_schemas):
+            if sid in indexed.schemas:
+                self.writer.add_schema(indexed.schemas[sid])
+        for cid, ch in sorted(indexed.channels.items()):
+            if cid in self.skip:
+                continue
+            self.writer.add_channel(ch)
+            schema = indexed.schemas.get(ch.schema_id)
+            msgtype = schema.name if schema is not None else ""
+            conn = connections.get((ch.topic, msgtype))
+            qos = dump_qos_v9(list(getattr(conn.ext, "offered_qos_profiles", ())) if conn
+                              else [])
+            digest = bagio.definition(conn)[1] if conn is not None else ""
+            self.meta.append((ch, msgtype, qos, digest))
+        self.next_schema = max(indexed.schemas, default=0) + 1
+        self.next_channel = max(indexed.channels, default=0) + 1
+        self.out_schemas: dict[str, int] = {}
+        self.out_channels: dict[str, int] = {}
+        self.qos_out = bagio.qos(self.config["output_reliability"], int(self.config["qos_depth"]))
+        # the inputs the pipeline takes, by channel
+        inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
+        self.handlers = {cid: inputs[resolve(ch.topic)] for cid, ch in indexed.channels.items()
+                         if resolve(ch.topic) in inputs}
+        self.batch: batch.Batch | None = None
+        if batched and isinstance(pipeline, Pipeline) and batch.supported(pipeline):
+            self.batch = batch.Batch(pipeline, {
+                cid: (i.kind, contacts.index(i.contact) if i.contact is not None else 0)
+                for cid, i in self.handlers.items()}, keep_inputs=keep_inputs)
+            scale = float(self.config["marker_scale"])
+            self.encoders = {c: (encode.Stamped(f"{c}_contact", 6),
+                                 encode.Stamped(f"{c}_contact", 3),
+                                 encode.Stamped(self.frame_id, 7),
+                                 encode.Markers(self.frame_id, k, c, scale))
+                             for k, c in enumerate(contacts)}
+            self.wheelset_encoder = encode.Stamped(self.frame_id, 6)
+
+    # ---------------------------------------------------------------- channels
+
+    def channel(self, topic: str) -> int:
+        """Return the output channel of an output topic, declared on first use."""
+        cid = self.out_channels.get(topic)
+        if cid is not None:
+            return cid
+        msgtype = self.output_types[topic]
+        sid = self.out_schemas.get(msgtype)
+        if sid is None:
+            sid = self.out_schemas[msgtype] = self.next_schema
+            self.next_schema += 1
+            text, _ = bagio.TYPESTORE.generate_msgdef(msgtype, ros_version=2)
+            self.writer.add_schema(mcap.Schema(sid, msgtype, "ros2msg", text.encode("utf-8")))
+        cid = self.out_channels[topic] = self.next_channel
+        self.next_channel += 1
+        qos = dump_qos_v9(self.qos_out)
+        channel = mcap.Channel(cid, sid, topic, "cdr", mcap.metadata_map(
+            {"offered_qos_profiles": mcap.dump_yaml(qos).strip()}))
+        self.writer.add_channel(channel)
+        self.meta.append((channel, msgtype, qos, bagio.TYPESTORE.hash_rihs01(msgtype)))
+        return cid
+
+    # ---------------------------------------------------------------- copies
+
+    def _copy(self, k: int, raw: bytes, records: bytes, arrays: mcap.Arrays) -> None:
+        t0 = time.perf_counter()
+        channel, log_time, start, size = arrays
+        chunk = self.mcap.chunks[k]
+        if not np.isin(channel, list(self.skip)).any():
+            counts = np.bincount(channel, minlength=1)
+            self.writer.copy_chunk(chunk, raw, {c: int(counts[c]) for c in
+                                                np.flatnonzero(counts).tolist()})
+            self.result.messages_out += int(channel.size)
+        else:  # messages on an output topic are not copied: the others one by one
+            for c, t, s, n in zip(channel.tolist(), log_time.tolist(), start.tolist(),
+                                  size.tolist()):
+                if c not in self.skip and c in self.writer.channels:
+                    self.writer.write(c, t, records[s:s + n])
+                    self.result.messages_out += 1
+        self.phases["copy"] += time.perf_counter() - t0
+
+    # ---------------------------------------------------------------- the replay
+
+    def run(self, out: Any, progress: Callable[[int], None] | None) -> tuple[int, int]:
+        """Replay every message; return the first and last log times (ns).
+
+        ``out``: where each wrench's CSV row and plot sample go (``rows``, a
+        csv writer or None; ``series``, per contact, or None; ``method``,
+        ``law``; ``first`` is set; ``outcome(outcome, log_ns)`` records one).
+        """
+        first: int | None = None
+        last = 0
+        next_diag = 0
+        base = 0
+        self.out = out
+        diagnostics = resolve(DIAGNOSTICS_TOPIC, self.namespace)
+        t_read = time.perf_counter()
+        try:
+            for w in mcap.windows(self.mcap, self._copy, WINDOW):
+                self.phases["read"] += time.perf_counter() - t_read
+                log = w.log_time
+                n = len(w)
+                if first is None:
+                    first = out.first = int(log[0])
+                    next_diag = first + 1_000_000_000
+                lo = 0
+                while lo < n:
+                    j = lo + int(np.searchsorted(log[lo:], next_diag, "left"))
+                    if j > lo:
+                        self._messages(w, lo, j, base)
+                    if j < n:
+                        t0 = time.perf_counter()
+                        stamp = int(log[j])
+                        if self.batch is not None:
+                            self.batch.store()
+                        msg = self.pipeline.diagnostics(stamp)
+                        if self.batch is not None:
+                            self.batch.reported()
+                        self.writer.write(self.channel(diagnostics), stamp,
+                                          serialize_message(msg))
+                        self.result.messages_out += 1
+                        next_diag += ((stamp - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
+                        self.phases["diagnostics"] += time.perf_counter() - t0
+                    lo = j
+                base += n
+                last = int(log[-1])
+                self.result.messages_in += n
+                if progress is not None:
+                    progress(n)
+                t_read = time.perf_counter()
+        except mcap.McapError as e:
+            raise BadInput(f"{self.source}: unreadable: {e}") from None
+        if first is None:
+            raise BadInput(f"{self.source}: empty bag (no messages)")
+        t0 = time.perf_counter()
+        if self.batch is not None:
+            self.batch.store()
+        self.writer.write(self.channel(diagnostics), last,
+                          serialize_message(self.pipeline.diagnostics(last)))
+        self.result.messages_out += 1
+        self.phases["diagnostics"] += time.perf_counter() - t0
+        return first, last
+
+    def close(self) -> None:
+        """Finish the output bag: the MCAP summary, then ``metadata.yaml``."""
+        t0 = time.perf_counter()
+        w = self.writer
+        info = mcap.bag_metadata(w.path.name, self.meta, w.counts, w.start, w.end,
+                                 self.custom_data)
+        w.close(mcap.dump_yaml(info["rosbag2_bagfile_information"]).strip())
+        path = self.out_dir / "metadata.yaml"
+        tmp = path.with_suffix(".yaml.tmp")
+        tmp.write_text(mcap.dump_yaml(info), encoding="utf-8")
+        tmp.replace(path)
+        self.phases["write"] += time.perf_counter() - t0
+
+    def abort(self) -> None:
+        """Close the output file as it is (the caller removes the staging directory)."""
+        self.writer.abort()
+
+    # ---------------------------------------------------------------- messages
+
+    def _messages(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
+        if self.batch is not None:
+            self._batch(w, lo, hi, base)
+            return
+        for i in range(lo, hi):  # the pipeline's own handlers, one message at a time
+            handler = self.handlers.get(int(w.channel[i]))
+            if handler is None:
+                continue
+            log_ns = int(w.log_time[i])
+            for outcome in handler.take(w.data(i)):
+                self._emit(outcome, log_ns)
+
+    def _emit(self, outcome: Outcome, log_ns: int) -> None:
+        for rel, m in self.pipeline.messages(outcome):
+            data = bytes(m) if isinstance(m, (bytearray, memoryview)) else \
+                m if isinstance(m, bytes) else serialize_message(m)
+            self.writer.write(self.channel(resolve(rel, self.namespace)), log_ns, data)
+            self.result.messages_out += 1
+        self.out.outcome(outcome, log_ns)
+
+    def _batch(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
+        assert self.batch is not None
+        p = self.batch.run(w, lo, hi, base)
+        t0 = time.perf_counter()
+        solved = p.status == 0
+        wrench = solved | (p.status == 1)
+        parts: list[tuple[Ints, Ints, NDArray[np.uint8], int]] = []  # keys, rows, bytes, channel
+        log = w.log_time[p.index]
+        for k, c in enumerate(self.config.contacts):
+            mine = p.contact == k
+            force_enc, creep_enc, pose_enc, marker_enc = self.encoders[c]
+            base_topic = resolve(f"contact/{c}/", self.namespace)
+            rows = np.flatnonzero(mine & wrench)
+            if rows.size:
+                values = np.zeros((rows.size, 6))
+                values[:, 0] = p.force[rows, 0]
+                values[:, 1] = p.force[rows, 1]
+                values[:, 2] = p.force[rows, 2]
+                values[:, 5] = p.force[rows, 3]
+                values[~solved[rows]] = 0.0
+                parts.append((rows * 8 + _WRENCH, rows,
+                              force_enc.encode(p.stamp[rows], values),
+                              self.channel(base_topic + "wrench")))
+            rows = np.flatnonzero(mine & solved)
+            if rows.size:
+                parts.append((rows * 8 + _CREEPAGE, rows,
+                              creep_enc.encode(p.stamp[rows], p.creep[rows, :3]),
+                              self.channel(base_topic + "creepage")))
+            rows = np.flatnonzero(mine & solved & p.changed)
+            if rows.size:
+                pose = np.concatenate((p.frame[rows, :3], encode.quaternions(p.frame[rows])),
+                                      axis=1)
+                parts.append((rows * 8 + _FRAME, rows,
+                              pose_enc.encode(p.stamp[rows], pose),
+                              self.channel(base_topic + "frame")))
+            rows = np.flatnonzero(mine & solved & p.marker)
+            markers = resolve(MARKERS_TOPIC, self.namespace)
+            if rows.size:
+                parts.append((rows * 8 + _MARKER, rows,
+                              marker_enc.arrows(p.stamp[rows], p.frame[rows], p.force[rows, 0],
+                                                p.force[rows, 1]), self.channel(markers)))
+            rows = np.flatnonzero(mine & ~solved & wrench & p.marker)
+            if rows.size:
+                parts.append((rows * 8 + _MARKER, rows, marker_enc.deletions(p.stamp[rows]),
+                              self.channel(markers)))
+        rows = np.flatnonzero(p.cycle)
+        if rows.size:
+            parts.append((rows * 8 + _WHEELSET, rows,
+                          self.wheelset_encoder.encode(p.cycle_stamp[rows],
+                                                       p.cycle_wrench[rows]),
+                          self.channel(resolve(WHEELSET_WRENCH_TOPIC, self.namespace))))
+        t1 = time.perf_counter()
+        self.phases["encode"] += t1 - t0
+        if parts:
+            self._write(parts, log)
+        self.phases["write"] += time.perf_counter() - t1
+        if self.out.rows is not None or self.out.series is not None:
+            t2 = time.perf_counter()
+            self._records(p, wrench, log)
+            self.phases["csv"] += time.perf_counter() - t2
+
+    def _records(self, p: batch.Patches, wrench: NDArray[np.bool_], log: Ints) -> None:
+        """Add the CSV row and plot sample of each wrench, in order (records.record's)."""
+        out = self.out
+        idx = np.flatnonzero(wrench)
+        if idx.size == 0:
+            return
+        contacts = self.config.contacts
+        solved = (p.status[idx] == 0).tolist()
+        stamp = p.stamp[idx].tolist()
+        name = [contacts[c] for c in p.contact[idx].tolist()]
+        cr = p.creep[idx].tolist()
+        f = p.force[idx].tolist()
+        slip = p.slip[idx].tolist()
+        method, law = out.method, out.law
+        if out.rows is not None:
+            out.rows.writerows(
+                (s, c, q[0], q[1], q[2], q[3], g[2], g[0], g[1], g[3], sl, method, law) if ok
+                else (s, c, "", "", "", "", 0.0, 0.0, 0.0, 0.0, "", method, law)
+                for ok, s, c, q, g, sl in zip(solved, stamp, name, cr, f, slip))
+        if out.series is not None:
+            t = ((log[idx] - out.first) * 1e-9).tolist()
+            nan = float("nan")
+            for ok, c, tt, q, g in zip(solved, name, t, cr, f):
+                if ok:
+                    out.series[c].add(tt, q[0], q[1], q[2], g[0], g[1], g[2])
+                else:
+                    out.series[c].add(tt, nan, nan, nan, 0.0, 0.0, 0.0)
+
+    def _write(self, parts: list[Any], log: Ints) -> None:
+        keys = np.concatenate([k for k, _, _, _ in parts])
+        order = np.argsort(keys, kind="stable")
+        sizes = np.concatenate([np.full(r.shape[0], r.shape[1] + 31, dtype=np.int64)
+                                for _, _, r, _ in parts])
+        offsets = np.zeros(keys.size, dtype=np.int64)
+        offsets[order] = np.concatenate(([0], np.cumsum(sizes[order])[:-1]))
+        out = np.empty(int(sizes.sum()), dtype=np.uint8)
+        channels = np.empty(keys.size, dtype=np.int64)
+        times = np.empty(keys.size, dtype=np.int64)
+        at = 0
+        for _, rows, payloads, cid in parts:
+            k = rows.size
+            ch = np.full(k, cid, dtype=np.int64)
+            records = mcap.message_records(ch, log[rows], payloads)
+            kernels.scatter_rows(out, records, offsets[at:at + k])
+            channels[at:at + k] = ch
+            times[at:at + k] = log[rows]
+            at += k
+        self.writer.write_records(out.tobytes(), channels[order], times[order], offsets[order])
+        self.result.messages_out += int(keys.size)
