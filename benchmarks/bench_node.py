@@ -198,6 +198,8 @@ def startup(trials: int) -> None:
           f"({', '.join(f'{t:.2f}' for t in times)})")
 
 
+#: ["--native"]: py-spy samples C and C++ frames too (pausing the process at each sample)
+NATIVE: list[str] = []
 FLOOR = Path(__file__).resolve().parent / "dds_floor.py"
 
 
@@ -262,8 +264,10 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
     spy = None
     if py_spy:
         duration_s = soak * 60.0 if soak else seconds
+        # native frames need the process paused at each sample (no --nonblocking)
+        sampling = NATIVE or ["--nonblocking"]
         spy = subprocess.Popen([str(Path(sys.executable).parent / "py-spy"), "record",
-                                "--pid", str(proc.pid), "--rate", "250", "--nonblocking",
+                                "--pid", str(proc.pid), "--rate", "250", *sampling,
                                 "--format", "raw", "--duration", str(int(duration_s)),
                                 "--output", py_spy],
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -369,8 +373,10 @@ def main() -> None:
                         help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
                         help="first time the per-message path in-process")
+    parser.add_argument("--target", choices=("node", "floor"), default="node",
+                        help="what the single runs drive: the node or the DDS floor")
     parser.add_argument("--py-spy", default=None, metavar="FILE",
-                        help="record the node with py-spy (collapsed stacks to FILE)")
+                        help="record the target with py-spy (collapsed stacks to FILE)")
     parser.add_argument("--floor", type=int, default=0, metavar="ROUNDS",
                         help="drive the node and the DDS floor (dds_floor.py) alternately, "
                         "ROUNDS times each, and print node/floor ratios of the medians")
@@ -389,7 +395,7 @@ def main() -> None:
                               shlex.split(args.node_args))
             else:
                 run(n, args.rate, args.seconds, args.soak, executor,
-                    shlex.split(args.node_args), py_spy=args.py_spy)
+                    shlex.split(args.node_args), args.target, args.py_spy)
 
 
 if __name__ == "__main__":

@@ -63,9 +63,9 @@ MAX_PATCH_CELLS = MAX_CELLS * MAX_CELLS
 #: the most cells along ``x`` for the exact solver (each strip's own operator
 #: block is dense: strips x cells^2 doubles)
 MAX_STRIP_CELLS = MAX_CELLS
-#: the most cells in contact for ``forces --method exact`` (its Coulomb solver
-#: holds the dense operator, (2 n)^2 doubles: 0.5 GB at 4,000 cells)
-MAX_EXACT_FORCE_CELLS = 4000
+#: the most cells in contact for ``forces --method exact`` (its FFT Coulomb solver:
+#: memory proportional to the cells, under 300 MB at 15,000)
+MAX_EXACT_FORCE_CELLS = 20_000
 #: the largest patch file read (bytes): far more than MAX_PATCH_CELLS rows need
 MAX_PATCH_BYTES = 64 * 2**20
 #: accepted ranges (SI): (smallest, largest) magnitude
@@ -308,8 +308,8 @@ def _check_exact_grid(area: areas.GridArea, *, forces: bool) -> None:
     n = int(np.count_nonzero(area.mask))
     if forces and n > MAX_EXACT_FORCE_CELLS:
         raise InvalidInputError(
-            f"forces --method exact takes at most {MAX_EXACT_FORCE_CELLS:,} cells in contact "
-            f"(its dense operator), got {n:,}: use fewer --cells or a coarser patch")
+            f"forces --method exact takes at most {MAX_EXACT_FORCE_CELLS:,} cells in contact, "
+            f"got {n:,}: use fewer --cells or a coarser patch")
 
 
 def _finite_result(result: dict[str, Any], keys: Sequence[str]) -> None:

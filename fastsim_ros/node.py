@@ -34,6 +34,7 @@ from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedE
 from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
 from rclpy.node import Node
+from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.parameter import Parameter
 from rclpy.publisher import Publisher
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -118,19 +119,21 @@ class FastsimNode(Node):
         # peers each has matched (publishers of an input, subscribers of an output)
         self._pubs: dict[str, Publisher] = {}
         self._subs: dict[str, Subscription] = {}
-        for c in config.contacts:
-            for kind, msgtype in _MESSAGE_TYPES.items():
-                topic = f"contact/{c}/{kind}"
-                self._pubs[topic] = self.create_publisher(msgtype, topic, qos_out)
-        self._pubs[WHEELSET_WRENCH_TOPIC] = self.create_publisher(
-            WrenchStamped, WHEELSET_WRENCH_TOPIC, qos_out)
-        self._pubs[MARKERS_TOPIC] = self.create_publisher(MarkerArray, MARKERS_TOPIC, qos_out)
+        # the outputs somebody subscribes to, kept by DDS's matched events: only
+        # those are encoded and published (a message to nobody is work for nothing)
+        self._wanted: set[str] = set()
+        outputs = {f"contact/{c}/{kind}": msgtype for c in config.contacts
+                   for kind, msgtype in _MESSAGE_TYPES.items()}
+        outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
+        outputs[MARKERS_TOPIC] = MarkerArray
         if isinstance(self.pipeline, ProfilePipeline):
             # profiles mode computes the patches and publishes them, so that a recording
             # replays in either mode (INTERFACE.md)
-            for c in config.contacts:
-                self._pubs[patch_topic(c)] = self.create_publisher(PointCloud2, patch_topic(c),
-                                                                   qos_out)
+            outputs.update({patch_topic(c): PointCloud2 for c in config.contacts})
+        for topic, msgtype in outputs.items():
+            self._pubs[topic] = self.create_publisher(
+                msgtype, topic, qos_out,
+                event_callbacks=PublisherEventCallbacks(matched=self._matched(topic)))
         self._diagnostics = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
         # the pipeline's one table of inputs: each topic raw to its handler
         for entry in self.pipeline.inputs():
@@ -171,6 +174,15 @@ class FastsimNode(Node):
             out[c] += shared
         return out
 
+    def _matched(self, topic: str) -> Callable[[Any], None]:
+        """Return the matched-event callback of an output topic's publisher."""
+        def matched(status: Any) -> None:
+            if status.current_count > 0:
+                self._wanted.add(topic)
+            else:
+                self._wanted.discard(topic)
+        return matched
+
     def _input_callback(self, spec: InputTopic) -> Callable[[bytes], None]:
         """Return the subscription callback of an input: its handler, then the outputs."""
         if spec.kind in ("wheel_twist", "rail_twist"):
@@ -198,7 +210,7 @@ class FastsimNode(Node):
                                       f"{outcome.detail}", throttle_duration_sec=1.0)
             return
         pubs = self._pubs
-        for topic, data in self.pipeline.messages(outcome):
+        for topic, data in self.pipeline.messages(outcome, self._wanted):
             pubs[topic].publish(data)
 
     def _publish_diagnostics(self) -> None:

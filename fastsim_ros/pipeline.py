@@ -21,7 +21,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Container, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -214,6 +214,27 @@ class _ContactState:
         self.stats = ContactStats()
 
 
+class _ContactTopics:
+    """A contact's output topics (relative names), built once."""
+
+    __slots__ = ("wrench", "creepage", "frame", "traction")
+
+    def __init__(self, contact: str) -> None:
+        base = f"contact/{contact}/"
+        self.wrench, self.creepage = base + "wrench", base + "creepage"
+        self.frame, self.traction = base + "frame", base + "traction"
+
+
+class _Every:
+    """Every topic: what :meth:`Pipeline.messages` encodes when not told otherwise."""
+
+    def __contains__(self, topic: object) -> bool:
+        return True
+
+
+_EVERY = _Every()
+
+
 def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
     if a is None:
         return True
@@ -252,6 +273,7 @@ class Pipeline:
         self._wheel: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
         self._rail: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
         self._contacts = {name: _ContactState() for name in config.contacts}
+        self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
         self._apply(config)
@@ -497,7 +519,8 @@ class Pipeline:
                 grid = (-(gx0 + (n_x - 1) * gdx), -(gy0 + (n_y - 1) * gdy), gdx, gdy)
             f = ContactForces(-f.fx, -f.fy, f.mz, f.n, f.slip_fraction, tau_x, tau_y, slip,
                               grid)
-        if not all(math.isfinite(v) for v in (f.fx, f.fy, f.mz, f.n)):
+        isfinite = math.isfinite
+        if not (isfinite(f.fx) and isfinite(f.fy) and isfinite(f.mz) and isfinite(f.n)):
             raise RejectedInput("nonfinite", "the solve gave a non-finite force")
         return f
 
@@ -531,40 +554,50 @@ class Pipeline:
 
     # ---------------------------------------------------------------- messages
 
-    def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
+    def messages(self, outcome: Outcome,
+                 wanted: Container[str] | None = None) -> list[tuple[str, Any]]:
         """Return the ``(topic, message)`` pairs to publish for an outcome, in order.
 
         Each as CDR bytes (INTERFACE.md "Outputs"): the contact's wrench and
         creepage, its frame when it moved, its traction cloud when asked
         for, its marker when due, and the wheelset wrench when the rig cycle
-        is complete.
+        is complete.  ``wanted``: if given, only these topics are encoded
+        (the node's topics that have subscribers).
         """
         if not outcome.has_wrench:
             return []
         c, stamp, frame_id = outcome.contact, outcome.stamp_ns, self._frame_id
-        base = f"contact/{c}/"
+        topics = self._topics[c]
         f = outcome.forces
         msgs: list[tuple[str, Any]] = []
+        if wanted is None:
+            wanted = _EVERY
+        topic = topics.wrench
         if f is None or outcome.frame is None or outcome.creepage is None:
-            msgs.append((base + "wrench", out.contact_wrench_cdr(stamp, c, 0.0, 0.0, 0.0, 0.0)))
+            if topic in wanted:
+                msgs.append((topic, out.contact_wrench_cdr(stamp, c, 0.0, 0.0, 0.0, 0.0)))
         else:
-            msgs.append((base + "wrench", out.contact_wrench_cdr(stamp, c, f.fx, f.fy, f.n,
-                                                                 f.mz)))
-            msgs.append((base + "creepage", out.creepage_cdr(stamp, c, outcome.creepage)))
-            if outcome.frame_changed:
-                msgs.append((base + "frame", out.pose_cdr(stamp, frame_id, outcome.frame)))
+            if topic in wanted:
+                msgs.append((topic, out.contact_wrench_cdr(stamp, c, f.fx, f.fy, f.n, f.mz)))
+            topic = topics.creepage
+            if topic in wanted:
+                msgs.append((topic, out.creepage_cdr(stamp, c, outcome.creepage)))
+            topic = topics.frame
+            if outcome.frame_changed and topic in wanted:
+                msgs.append((topic, out.pose_cdr(stamp, frame_id, outcome.frame)))
+            topic = topics.traction
             if (f.tau_x is not None and f.tau_y is not None and f.slip is not None
-                    and f.grid is not None):
-                msgs.append((base + "traction", out.traction_cloud_cdr(
+                    and f.grid is not None and topic in wanted):
+                msgs.append((topic, out.traction_cloud_cdr(
                     stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid)))
-        if outcome.markers:
+        if outcome.markers and MARKERS_TOPIC in wanted:
             index = self.config.contacts.index(c)
             fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)
             msgs.append((MARKERS_TOPIC, out.force_marker_cdr(
                 stamp, frame_id, index, c, outcome.frame, fx, fy,
                 float(self.config["marker_scale"]))))
         w = outcome.wheelset
-        if w is not None:
+        if w is not None and WHEELSET_WRENCH_TOPIC in wanted:
             msgs.append((WHEELSET_WRENCH_TOPIC, out.wrench_cdr(w.stamp_ns, frame_id, w.force,
                                                                w.torque)))
         return msgs

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Container, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -186,18 +186,21 @@ class ProfilePipeline:
                            kinematics(self.on_load)),
                 InputTopic(POSE_TOPIC, "geometry_msgs/msg/PoseStamped", "pose", None, pose))
 
-    def messages(self, outcome: Outcome) -> list[tuple[str, Any]]:
+    def messages(self, outcome: Outcome,
+                 wanted: Container[str] | None = None) -> list[tuple[str, Any]]:
         """Return the ``(topic, message)`` pairs of an outcome: its patch, then the pipeline's.
 
         The patch (CDR bytes) goes out with every outcome of the pose it
         came from, solved or refused by the solver; a pose dropped whole has
-        no patches.
+        no patches.  ``wanted``: if given, only these topics are encoded.
         """
         cloud = self._clouds.get(outcome.contact)
         head: list[tuple[str, Any]] = []
-        if cloud is not None and cloud.stamp_ns == outcome.stamp_ns:
-            head.append((patch_topic(outcome.contact), cloud_cdr(cloud)))
-        return head + self.pipeline.messages(outcome)
+        topic = patch_topic(outcome.contact)
+        if (cloud is not None and cloud.stamp_ns == outcome.stamp_ns
+                and (wanted is None or topic in wanted)):
+            head.append((topic, cloud_cdr(cloud)))
+        return head + self.pipeline.messages(outcome, wanted)
 
     def update(self, changes: dict[str, Any]) -> None:
         """Apply changes of parameters that may change while running (the rest are refused)."""

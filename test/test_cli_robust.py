@@ -136,7 +136,7 @@ def test_help_is_an_answer(capsys):
     (["--b", "1e200"], "--b must lie"),
     (["--a", "-6e-3"], "--a must lie"),
     (["--method", "exact", "--bound", "parabolic"], "--bound given"),
-    (["--method", "exact", "--cells", "100"], "cells in contact"),
+    (["--method", "exact", "--cells", "170"], "at most 20,000 cells in contact, got 22,"),
 ])
 def test_numbers_out_of_range_are_named(capsys, extra, match):
     base = dict(zip(ELLIPSE[::2], ELLIPSE[1::2]))

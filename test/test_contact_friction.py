@@ -318,17 +318,19 @@ def test_solvers_refuse_bad_friction_arguments(flange):
 # ---------------------------------------------------------------- the exact solver
 
 
-@pytest.fixture(scope="module")
-def exact_setup():
+@pytest.fixture(scope="module", params=["fft", "dense"])
+def exact_setup(request):
+    """Return the area, its operator and the Coulomb solver (both pass every test)."""
     from fastsim_ros.contact.exact import SteadyRollingOperator
     area = ellipse(A_AX, B_AX, nx=20, ny=20, load=LOAD)
-    return area, SteadyRollingOperator.of(area, nu=NU, shear_modulus=G)
+    return area, SteadyRollingOperator.of(area, nu=NU, shear_modulus=G), request.param
 
 
 def exact(setup, xi, eta, phi, **kw):
     from fastsim_ros.contact.exact import coulomb
-    area, op = setup
-    return coulomb(area, xi, eta, phi, nu=NU, shear_modulus=G, operator=op, **kw)
+    area, op, solver = setup
+    return coulomb(area, xi, eta, phi, nu=NU, shear_modulus=G, operator=op, solver=solver,
+                   **kw)
 
 
 @pytest.mark.parametrize("law", [ExponentialFriction(MU, 1.0, 0.8),
@@ -344,7 +346,7 @@ def test_exact_constant_limits_give_todays_numbers(law, exact_setup):
 def test_exact_slipping_cells_satisfy_the_law(exact_setup):
     """|tau| = mu(V |s|) p on the slip area, s = w - du/dx the exact slip; s = 0 elsewhere."""
     from fastsim_ros.contact.traction import rigid_slip
-    area, op = exact_setup
+    area, op, _ = exact_setup
     res = exact(exact_setup, 3e-3, 1e-3, 0.0, friction=FALLING, speed=V)
     mask = area.mask
     wx, wy = rigid_slip(area, 3e-3, 1e-3, 0.0, (0.0, 0.0))
@@ -362,7 +364,7 @@ def test_exact_slipping_cells_satisfy_the_law(exact_setup):
 
 
 def test_exact_full_slip_and_peak(exact_setup):
-    area, _ = exact_setup
+    area, _, _ = exact_setup
     xi = 0.5
     full = exact(exact_setup, xi, 0.0, 0.0, friction=FALLING, speed=V)
     assert -full.fx == pytest.approx(float(FALLING.mu(V * xi)) * area.load, rel=2e-3)

@@ -38,8 +38,11 @@ ALLOWED = {
     "kernels": {"numpy", "numba", "rules"},
     "compiled": {"numpy", "kernels", "area", "checks", "errors", "friction", "rules", "tables",
                  "pairs", "mae", "equivalent"},
+    "rolling": {"numpy", "scipy", "area", "checks", "errors", "influence"},
+    "partial_slip": {"numpy", "threadpoolctl", "area", "errors", "friction", "rolling",
+                     "traction"},
     "exact": {"numpy", "scipy", "area", "checks", "coefficients", "errors", "friction",
-              "influence", "traction"},
+              "partial_slip", "rolling", "traction"},
     "normal": {"numpy", "scipy", "area", "checks", "errors", "influence"},
     "samples": {"numpy", "area", "errors", "normal"},
 }

@@ -276,6 +276,25 @@ def test_messages_of_a_solve():
     assert "contact/left/frame" not in dict(pipe.messages(again))
 
 
+def test_messages_only_for_the_topics_wanted():
+    # the node encodes only what somebody subscribes to; without a choice, everything
+    pipe = make(contacts=["left", "right"])
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    left = solve(pipe, egg(), stamp=T0 + 7 * MS)
+    right = solve(pipe, egg().mirrored_y(), contact="right", stamp=T0 + 8 * MS,
+                  origin=(0.0, -0.75, -R))
+    every = [t for t, _ in pipe.messages(right)]
+    assert every == ["contact/right/wrench", "contact/right/creepage", "contact/right/frame",
+                     "contact/markers", "wheelset/wrench"]
+    wanted = {"contact/right/creepage", "wheelset/wrench", "contact/left/wrench"}
+    assert [t for t, _ in pipe.messages(right, wanted)] == ["contact/right/creepage",
+                                                            "wheelset/wrench"]
+    assert dict(pipe.messages(right, wanted))["wheelset/wrench"] == \
+        dict(pipe.messages(right))["wheelset/wrench"]
+    assert [t for t, _ in pipe.messages(left, wanted)] == ["contact/left/wrench"]
+    assert pipe.messages(left, set()) == []
+
+
 def test_wheelset_wrench_sums_the_contacts_once_per_cycle():
     pipe = make(contacts=["left", "right"])
     pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))

@@ -14,17 +14,24 @@ point may lie outside the area, where the displacement is still the elastic
 field of the tractions inside.  With that difference the coefficient of
 ``eta`` in ``Mz`` equals ``C23`` on every grid (METHOD.md section 5).
 
-Tractions ``tau`` are those of the rail on the wheel.  Full adhesion
-(``s = 0`` everywhere) is one linear system ``B tau = w``; ``B`` is a
-convolution on the regular grid, so products go through FFTs and GMRES solves
-fine meshes in seconds.  A dense direct solve is kept as the reference.
+Tractions ``tau`` are those of the rail on the wheel.  ``tau -> du/dx`` is
+the :class:`~fastsim_ros.contact.rolling.SteadyRollingOperator`, a
+convolution on the regular grid: products go through FFTs, never through a
+matrix.  Full adhesion (``s = 0`` everywhere) is one linear system ``B tau =
+w``, solved by GMRES (a dense direct solve is kept as the reference).
 Coulomb friction (``|tau| <= mu p``; ``s = 0`` where ``|tau| < mu p``; ``s``
-opposite to ``tau`` where ``|tau| = mu p``) is solved by block Gauss-Seidel
-over the lateral strips, each strip's own nonlinear problem solved exactly by
+opposite to ``tau`` where ``|tau| = mu p``) is solved by semismooth Newton on
+the whole area with FFT products (:mod:`~fastsim_ros.contact.partial_slip`,
+the default, up to :data:`MAX_COULOMB_CELLS` cells in contact); the
+reference, for small grids, is block Gauss-Seidel over the lateral strips
+with the dense operator, each strip's own nonlinear problem solved exactly by
 semismooth Newton.  With a slip-dependent law
 (:mod:`~fastsim_ros.contact.friction`) the bound is ``mu(v) p`` with ``v =
 |V| |s|`` the cell's own slip velocity: the projection's radius depends on
-the unknowns, and the strip's Newton carries that dependence in its Jacobian.
+the unknowns, and both Newtons carry that dependence in their Jacobians.
+
+``SteadyRollingOperator`` and ``StripBlock`` are :mod:`~fastsim_ros.contact.rolling`'s,
+taken from here as before.
 """
 
 from __future__ import annotations
@@ -32,10 +39,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal, NamedTuple
+from typing import Literal
 
 import numpy as np
-import scipy.fft
 import scipy.linalg
 import scipy.sparse.linalg
 from numpy.typing import NDArray
@@ -45,147 +51,21 @@ from fastsim_ros.contact.checks import (check_creepages, check_friction, check_m
                                         check_poisson_ratio)
 from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions)
-from fastsim_ros.contact.errors import ConvergenceError, InvalidInputError
+from fastsim_ros.contact.errors import (ConvergenceError, GridTooLargeError,
+                                        InvalidInputError)
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, resolve
-from fastsim_ros.contact.influence import influence_kernel
+from fastsim_ros.contact.partial_slip import on_one_blas_thread, solve_area
+from fastsim_ros.contact.rolling import SteadyRollingOperator, StripBlock
 from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
+
+__all__ = ["SteadyRollingOperator", "StripBlock", "TractionSolution", "full_adhesion",
+           "coulomb", "unit_solutions", "creep_coefficients", "extrapolation_grids",
+           "extrapolated_coefficients", "EXTRAPOLATION_GRIDS", "MAX_COULOMB_CELLS",
+           "MAX_DENSE_COULOMB_CELLS"]
 
 FloatArray = NDArray[np.float64]
 SolverKind = Literal["fft", "dense"]
 ShapeName = Literal["ellipse", "semi-ellipses"]
-
-
-@dataclass(frozen=True, eq=False)
-class SteadyRollingOperator:
-    """The discrete operator ``tau -> du/dx`` (upstream difference) of a grid.
-
-    ``kernel_*[dj, di]`` hold ``(K(d + e_x) - K(d))/dx`` for offsets
-    ``di in [-(nx-1), nx-1]``, ``dj in [-(ny-1), ny-1]`` (field minus source),
-    ``K`` the rectangle influence coefficients.  Units 1/Pa.
-    """
-
-    area: GridArea
-    nu: float
-    shear_modulus: float
-    kernel_xx: FloatArray
-    kernel_yy: FloatArray
-    kernel_xy: FloatArray
-
-    @classmethod
-    def of(cls, area: GridArea, *, nu: float, shear_modulus: float) -> SteadyRollingOperator:
-        """Build the operator of ``area``'s grid; ``shear_modulus``: combined ``G`` (Pa)."""
-        check_material(nu, shear_modulus)
-        nx, ny = area.nx, area.ny
-        k = influence_kernel(area.dx, area.dy, nx, ny - 1, shear_modulus=shear_modulus, nu=nu)
-
-        def diff(c: FloatArray) -> FloatArray:
-            # columns are di = -nx..nx; d + e_x for di in [-(nx-1), nx-1] is columns 2..2nx
-            return (c[:, 2:] - c[:, 1:-1]) / area.dx
-
-        return cls(area, nu, shear_modulus, diff(k.xx), diff(k.yy), diff(k.xy))
-
-    @property
-    def diagonal(self) -> tuple[float, float]:
-        """``(D_x, D_y)``: minus the self-coefficients, ``> 0`` (1/Pa)."""
-        cy, cx = self.area.ny - 1, self.area.nx - 1
-        return -float(self.kernel_xx[cy, cx]), -float(self.kernel_yy[cy, cx])
-
-    def dense(self) -> FloatArray:
-        """Return the operator restricted to the contact cells, ``[[Bxx, Bxy], [Bxy, Byy]]``."""
-        jj, ii = np.nonzero(self.area.mask)
-        dj = jj[:, None] - jj[None, :] + self.area.ny - 1
-        di = ii[:, None] - ii[None, :] + self.area.nx - 1
-        bxx = self.kernel_xx[dj, di]
-        byy = self.kernel_yy[dj, di]
-        bxy = self.kernel_xy[dj, di]
-        return np.block([[bxx, bxy], [bxy, byy]])
-
-    def strip_blocks(self) -> list[StripBlock]:
-        """Return each lateral strip's own block of the operator, strip by strip.
-
-        Per strip with cells in contact (:class:`StripBlock`): their indices
-        among the contact cells (row-major, as :meth:`dense` orders them), the
-        ``xx`` and ``yy`` blocks between them (``K_xy`` vanishes within a
-        strip, ``dj = 0``), and the strip's pattern of cells (bytes), which
-        strips of one pattern share along with their block arrays.
-        """
-        mask = self.area.mask
-        flat = np.cumsum(mask.ravel()).reshape(mask.shape) - 1
-        row_x = self.kernel_xx[self.area.ny - 1]
-        row_y = self.kernel_yy[self.area.ny - 1]
-        cache: dict[bytes, tuple[FloatArray, FloatArray]] = {}
-        blocks = []
-        for j in range(self.area.ny):
-            cols = np.flatnonzero(mask[j])
-            if cols.size == 0:
-                continue
-            key = (cols - cols[0]).tobytes()
-            if key not in cache:
-                d = cols[:, None] - cols[None, :] + self.area.nx - 1
-                cache[key] = (row_x[d], row_y[d])
-            blocks.append(StripBlock(flat[j, cols], *cache[key], key))
-        return blocks
-
-    def check_matches(self, area: GridArea, nu: float, shear_modulus: float) -> None:
-        """Refuse to serve ``area`` and the material if this operator was built for others."""
-        mine = self.area
-        if mine is not area and not (
-                (mine.nx, mine.ny, mine.dx, mine.dy) == (area.nx, area.ny, area.dx, area.dy)
-                and np.array_equal(mine.mask, area.mask)):
-            raise InvalidInputError("the operator was built for another grid or set of cells "
-                                    "in contact than the area's")
-        if (self.nu, self.shear_modulus) != (nu, shear_modulus):
-            raise InvalidInputError(f"the operator was built for nu = {self.nu}, G = "
-                                    f"{self.shear_modulus} Pa, not nu = {nu}, G = "
-                                    f"{shear_modulus} Pa")
-
-    def fft_product(self) -> _FFTProduct:
-        """FFT-based product with tractions on the whole grid."""
-        return _FFTProduct(self)
-
-
-class StripBlock(NamedTuple):
-    """One lateral strip's own block of the operator (:meth:`SteadyRollingOperator.strip_blocks`).
-
-    ``idx``: the strip's cells among the contact cells; ``xx``, ``yy``: the
-    blocks (1/Pa); ``pattern``: the strip's cells relative to its first (the
-    key under which strips of one pattern share ``xx`` and ``yy``).
-    """
-
-    idx: NDArray[np.int_]
-    xx: FloatArray
-    yy: FloatArray
-    pattern: bytes
-
-
-class _FFTProduct:
-    """Circular embedding of the Toeplitz operator on a ``2ny`` x ``2nx`` grid."""
-
-    def __init__(self, op: SteadyRollingOperator) -> None:
-        ny, nx = op.area.ny, op.area.nx
-        self.shape = (2 * ny, 2 * nx)
-        self.ny, self.nx = ny, nx
-        self.fxx = self._spectrum(op.kernel_xx)
-        self.fyy = self._spectrum(op.kernel_yy)
-        self.fxy = self._spectrum(op.kernel_xy)
-
-    def _spectrum(self, kernel: FloatArray) -> NDArray[np.complex128]:
-        c = np.zeros(self.shape)
-        ny, nx = self.ny, self.nx
-        # offset d lives at index d mod (2n): the product of the padded arrays is a
-        # linear (not circular) convolution on the first ny x nx entries.
-        rows = np.r_[np.arange(ny), np.arange(ny + 1, 2 * ny)]
-        cols = np.r_[np.arange(nx), np.arange(nx + 1, 2 * nx)]
-        c[np.ix_(rows, cols)] = np.roll(np.roll(kernel, -(ny - 1), axis=0), -(nx - 1), axis=1)
-        return scipy.fft.rfft2(c, workers=-1)
-
-    def __call__(self, tx: FloatArray, ty: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """``(du_x/dx, du_y/dx)`` on the grid for tractions ``tx``, ``ty`` (ny, nx)."""
-        fx = scipy.fft.rfft2(tx, s=self.shape, workers=-1)
-        fy = scipy.fft.rfft2(ty, s=self.shape, workers=-1)
-        gx = scipy.fft.irfft2(self.fxx * fx + self.fxy * fy, s=self.shape, workers=-1)
-        gy = scipy.fft.irfft2(self.fxy * fx + self.fyy * fy, s=self.shape, workers=-1)
-        return gx[: self.ny, : self.nx], gy[: self.ny, : self.nx]
 
 
 class _StripPreconditioner:
@@ -225,11 +105,16 @@ class TractionSolution(Tractions):
     """Tractions of one exact solve (:class:`Tractions`), its area and solver iterations.
 
     ``slip`` is all false in full adhesion; ``iterations``: GMRES iterations
-    (full adhesion) or Gauss-Seidel sweeps (Coulomb).
+    (full adhesion), Newton iterations (Coulomb, the FFT solver, on the
+    finest grid) or Gauss-Seidel sweeps (Coulomb, the dense reference);
+    ``krylov``: the FFT Coulomb solver's GMRES iterations in all (finest
+    grid); ``products``: its FFT products with the operator (finest grid).
     """
 
     area: GridArea
     iterations: int
+    krylov: int = 0
+    products: int = 0
 
 
 def _operator(operator: SteadyRollingOperator | None, area: GridArea, nu: float,
@@ -242,6 +127,7 @@ def _operator(operator: SteadyRollingOperator | None, area: GridArea, nu: float,
     return operator
 
 
+@on_one_blas_thread
 def full_adhesion(area: GridArea, xi: float, eta: float, phi: float, *, nu: float,
                   shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                   solver: SolverKind = "fft", rtol: float = 1e-10,
@@ -390,11 +276,12 @@ def _strip_coulomb(q: FloatArray, bp: FloatArray, bound: FloatArray, c: float,
     return _project(z, radius)[0] if fnorm <= tol else tau, out
 
 
+@on_one_blas_thread
 def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | None = None,
             nu: float, shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
             tol: float = 1e-9, max_sweeps: int = 500,
             operator: SteadyRollingOperator | None = None, friction: FrictionLaw | None = None,
-            speed: float | None = None) -> TractionSolution:
+            speed: float | None = None, solver: SolverKind = "fft") -> TractionSolution:
     """Tractions with Coulomb friction ``|tau| <= mu p``, ``p`` the area's pressure (Pa).
 
     ``friction``: a law (default ``ConstantFriction(mu)``; ``mu``, if given
@@ -403,21 +290,53 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
     slip-dependent law), ``s`` the slip per unit rolling distance.
 
     Creepages about ``reference`` (``phi`` in 1/m); ``shear_modulus`` the
-    combined ``G`` (Pa).  Block Gauss-Seidel over the lateral strips, each
-    strip's nonlinear problem solved exactly (:func:`_strip_coulomb`); the
-    strips' mutual influence is weak enough for the sweep to contract (a
-    march along ``x`` instead, cell by cell, diverges: the far upstream
-    terms of the difference kernel amplify).  Stops when the largest traction
-    change of a sweep is below ``tol * mu * max(p)``.
+    combined ``G`` (Pa).  ``operator``: the area's
+    :class:`SteadyRollingOperator` for this material, if already built: a
+    sweep of creepages on one area should pass it (the FFT solver keeps its
+    spectra, strip blocks and coarse grids on it); without it the FFT solver
+    builds one for the smallest grid holding the cells in contact
+    (:meth:`GridArea.cropped`: a potential-contact grid's empty margin costs
+    nothing), the results on ``area``'s grid all the same.
+
+    ``solver="fft"`` (default): semismooth Newton on the whole area, GMRES
+    with FFT products and strip-block preconditioning, started from the
+    grid of twice the cell size (:mod:`~fastsim_ros.contact.partial_slip`);
+    memory proportional to the cells, at most :data:`MAX_COULOMB_CELLS` cells
+    in contact.  ``"dense"``: the reference, block Gauss-Seidel over the
+    lateral strips with the dense operator (at most
+    :data:`MAX_DENSE_COULOMB_CELLS` cells), each strip's nonlinear problem
+    solved exactly (:func:`_strip_coulomb`); the strips' mutual influence is
+    weak enough for the sweep to contract (a march along ``x`` instead, cell
+    by cell, diverges: the far upstream terms of the difference kernel
+    amplify); at most ``max_sweeps`` sweeps.  Both solve the same discrete
+    problem and stop when the largest traction error (the Newton residual
+    ``|tau - P(tau - c s)|``; the Gauss-Seidel sweep's largest change) is
+    below ``tol * mu * max(p)``.  The cell count is checked before anything
+    of the solver is allocated (:class:`GridTooLargeError`).  Both run with
+    one BLAS thread (:func:`~fastsim_ros.contact.partial_slip.one_blas_thread`),
+    as does :func:`full_adhesion`.
     """
     law = resolve(mu, friction)
     mu = check_friction(law.mu_s)
     slip_law = law if law.slip_dependent else None
     v_roll = check_speed(speed) if slip_law is not None else 0.0
     check_creepages(xi, eta, phi)
-    op = _operator(operator, area, nu, shear_modulus)
     mask = area.mask
     n = int(np.count_nonzero(mask))
+    if solver == "fft":
+        _check_cells(n, MAX_COULOMB_CELLS, "the FFT Coulomb solver")
+        # the FFTs span the grid: without an operator, solve on the smallest grid that holds
+        # the cells in contact (their order, row by row, is the same on both grids)
+        op = _operator(operator, area if operator is not None else area.cropped(), nu,
+                       shear_modulus)
+        res = solve_area(op, (xi, eta, phi), reference, mu_s=mu, tol=tol, law=slip_law,
+                         speed=v_roll)
+        return _solution(area, res.tau, res.slip, reference, res.newton, res.krylov,
+                         res.products)
+    if solver != "dense":
+        raise InvalidInputError(f"unknown solver {solver!r}: fft or dense")
+    _check_cells(n, MAX_DENSE_COULOMB_CELLS, "the dense Coulomb solver")
+    op = _operator(operator, area, nu, shear_modulus)
     # rows of B's transpose are contiguous: the update of all slips by one
     # strip's traction change reads them.
     bt = np.ascontiguousarray(op.dense().T)
@@ -456,6 +375,25 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
             break
     else:
         raise ConvergenceError(f"Coulomb solver did not converge in {max_sweeps} sweeps")
+    return _solution(area, tau, slip, reference, sweep)
+
+
+#: the most cells in contact of the FFT Coulomb solver (CONTACT's default limit is 20,000)
+MAX_COULOMB_CELLS = 20_000
+#: the most cells in contact of the dense reference (its operator: 8 (2n)^2 bytes, 0.5 GB)
+MAX_DENSE_COULOMB_CELLS = 4_000
+
+
+def _check_cells(n: int, limit: int, what: str) -> None:
+    if n > limit:
+        raise GridTooLargeError(f"{what} takes at most {limit:,} cells in contact, got {n:,}")
+
+
+def _solution(area: GridArea, tau: FloatArray, slip: NDArray[np.bool_],
+              reference: tuple[float, float], iterations: int, krylov: int = 0,
+              products: int = 0) -> TractionSolution:
+    """Return the solution on the grid from the cells' tractions ``tau`` (m, 2)."""
+    mask = area.mask
     tau_x = np.zeros(mask.shape)
     tau_y = np.zeros(mask.shape)
     slip_map = np.zeros(mask.shape, dtype=bool)
@@ -463,7 +401,8 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
     tau_y[mask] = tau[:, 1]
     slip_map[mask] = slip
     fx, fy, mz = resultants(area, tau_x, tau_y, reference)
-    return TractionSolution(tau_x, tau_y, slip_map, fx, fy, mz, area, sweep)
+    return TractionSolution(tau_x, tau_y, slip_map, fx, fy, mz, area, iterations, krylov,
+                            products)
 
 
 def unit_solutions(area: GridArea, *, nu: float, reference: tuple[float, float] = (0.0, 0.0),
