@@ -4,6 +4,7 @@
 Usage (from the package root)::
 
     .venv/bin/python benchmarks/bench_replay.py [--repeats R] [--copies K] [--bags NAME ...]
+    .venv/bin/python benchmarks/bench_replay.py --scheduler [--small N]
 
 Prints, with the machine line:
 
@@ -27,6 +28,14 @@ Prints, with the machine line:
 3. many bags: ``K`` copies of each bag that uses the default contacts,
    replayed through ``fastsim_replay.main`` with ``--jobs 1`` and
    ``--jobs 2``: patches per second and the speed-up.
+
+With ``--scheduler``, instead: ``N`` small bags (generated: the first
+0.5 s of ``hertz_ramp``, 200 by default) replayed by two local worker
+processes of a Dask cluster started here (a scheduler and two workers, as
+``fastsim_replay --scheduler`` uses them) and by ``--jobs 2`` (the local fork
+pool), each after one untimed run: wall time, bags per second, the ratio,
+and each executor's overhead per bag, ``(2 x wall - sum of the tasks' own
+replay times) / N`` (submitting, moving the task and its result, waiting).
 
 Nothing is written outside a temporary directory.  Timings on a shared
 2-core VM drift between runs: quote the machine line and the load average.
@@ -56,7 +65,7 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
 from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from fastsim_ros.contact.friction import friction_law  # noqa: E402
 from fastsim_ros.params import load_params_file  # noqa: E402
-from fastsim_ros.replay import kernels  # noqa: E402
+from fastsim_ros.replay import batch  # noqa: E402
 from msg_adapters import patch as patch_adapter  # noqa: E402
 
 BAGS = ROOT / "bags"
@@ -158,11 +167,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--copies", type=int, default=4,
                     help="copies of each default-contact bag in the many-bags run")
     ap.add_argument("--bags", nargs="+", default=list(NAMES), choices=NAMES)
+    ap.add_argument("--scheduler", action="store_true",
+                    help="small bags on a local Dask cluster (two workers) against --jobs 2")
+    ap.add_argument("--small", type=int, default=200, help="small bags for --scheduler")
     args = ap.parse_args(argv)
+    if args.scheduler:
+        return cluster_main(args.small)
     print(f"machine: {machine()}")
     warm = compiled.warm_up()
     patch_adapter.warm_up()
-    kernels.warm_up()
+    batch.warm_up()
     source = "from the disk cache" if warm < 5.0 else "compiled: the cache was cold"
     print(f"kernels ready in {warm:.2f} s ({source})\n")
 
@@ -219,6 +233,86 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  --jobs {jobs}: {3 * args.copies} bags, {patches} patches in {wall:.2f} s: "
                   f"{patches / wall:.0f} patches/s, {log_s / wall:.1f}x real time")
         print(f"  speed-up --jobs 2 / --jobs 1: {walls[1] / walls[2]:.2f}x")
+    print(f"\nmachine: {machine()}")
+    return 0
+
+
+def small_bag(path: Path, seconds: float = 0.5) -> None:
+    """Write the first ``seconds`` of hertz_ramp as a bag (MCAP, zstd chunks)."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode, StoragePlugin
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    with Reader(BAGS / "hertz_ramp") as reader, writer:
+        conns = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data,
+                                             rihs01=c.digest,
+                                             offered_qos_profiles=c.ext.offered_qos_profiles)
+                 for c in reader.connections}
+        end = reader.start_time + round(seconds * 1e9)
+        for conn, t, raw in reader.messages(stop=end):
+            writer.write(conns[conn.id], t, raw)
+
+
+def timed(executor: Any, tasks: list[Any]) -> tuple[float, float]:
+    """Run the tasks; return the wall time and the sum of the tasks' own replay times (s)."""
+    t0 = time.perf_counter()
+    results = list(executor.results(tasks))
+    wall = time.perf_counter() - t0
+    bad = [r.error for r in results if not r.ok]
+    if bad:
+        raise SystemExit(f"replay failed: {bad[0]}")
+    return wall, sum(r.wall_s for r in results)
+
+
+def cluster_main(count: int) -> int:
+    """Run the ``--scheduler`` benchmark: a local cluster of two workers against ``--jobs 2``."""
+    import os
+
+    from fastsim_ros.replay.cluster import Cluster, LocalProcesses, warm_worker
+    from fastsim_ros.replay.executors import LocalPool
+    from fastsim_ros.replay.run import Task
+    print(f"machine: {machine()}")
+    warm_worker()
+    values = load_params_file(BAGS / "hertz_ramp.params.yaml")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp)
+        small_bag(out / "small")
+        (out / "in").mkdir()
+        for k in range(count):
+            (out / "in" / f"b{k:04d}").symlink_to(out / "small", target_is_directory=True)
+        with Reader(out / "small") as reader:
+            log_s = reader.duration * 1e-9
+            messages = reader.message_count
+
+        def tasks(run: str) -> list[Any]:
+            target = out / run
+            target.mkdir()
+            return [Task(out / "in" / f"b{k:04d}", f"b{k:04d}", target, values, tag=run)
+                    for k in range(count)]
+
+        print(f"{count} bags of {log_s:.3f} s, {messages} messages each\n")
+        cluster = LocalProcesses(out, 2, env=env, cwd=ROOT)
+        try:
+            figures = {}
+            for label, make in (("--jobs 2", lambda: LocalPool(2)),
+                                ("--scheduler, 2 workers",
+                                 lambda: Cluster(cluster.address))):
+                for run in ("warm", "timed"):
+                    executor = make()
+                    try:
+                        wall, inside = timed(executor, tasks(f"{label[2:6]}-{run}"))
+                    finally:
+                        executor.close()
+                figures[label] = (wall, inside)
+                print(f"{label:24s} {wall:6.2f} s: {count / wall:6.1f} bags/s, "
+                      f"{count * log_s / wall:7.1f}x real time; overhead per bag "
+                      f"{(2 * wall - inside) / count * 1e3:6.2f} ms "
+                      f"(the tasks themselves {inside / count * 1e3:.2f} ms each)")
+        finally:
+            cluster.close()
+        jobs, dask = figures["--jobs 2"][0], figures["--scheduler, 2 workers"][0]
+        print(f"\ntwo Dask workers / --jobs 2 throughput: {jobs / dask:.2f}x")
     print(f"\nmachine: {machine()}")
     return 0
 

@@ -3,7 +3,7 @@
 Usage (INTERFACE.md, "The offline replay fastsim_replay")::
 
     fastsim_replay IN [IN ...] -o OUT [--params FILE] [--namespace NS] [--plot] [--csv]
-                   [--jobs N]
+                   [--jobs N | --scheduler ADDRESS]
 
 Each ``IN`` (a rosbag2 directory, or a single ``.mcap``) named ``NAME`` (the
 directory's name, or the file's without ``.mcap``) gives:
@@ -49,12 +49,24 @@ truncated or empty input (the others are still done); 1 an output that could
 not be written or an internal error; 130 interrupted.  Every problem is one
 line on stderr naming the file.
 
+``--jobs N`` replays N inputs at a time on this machine (a fork pool);
+``--scheduler ADDRESS`` each input as a task on a Dask distributed cluster
+(:mod:`~fastsim_ros.replay.cluster`).  IN and OUT may be fsspec URLs
+(:mod:`~fastsim_ros.replay.storage`).
+
 The package, each module one concern (dependencies point down):
 
 - :mod:`~fastsim_ros.replay.cli`: flags, checks before any work, the summary;
-- :mod:`~fastsim_ros.replay.executors`: where tasks run (this process, a
-  local pool): the one seam between the command line and one input's replay;
-- :mod:`~fastsim_ros.replay.run`: one input, replayed and committed atomically;
+- :mod:`~fastsim_ros.replay.executors` (this process, a local pool) and
+  :mod:`~fastsim_ros.replay.cluster` (Dask): where tasks run, the one seam
+  between the command line and one input's replay;
+- :mod:`~fastsim_ros.replay.run`: one input, replayed and committed
+  atomically (:mod:`~fastsim_ros.replay.storage` for URLs);
+- :mod:`~fastsim_ros.replay.bulk`: an indexed MCAP input by the chunk,
+  :mod:`~fastsim_ros.replay.batch` (the pipeline's rules over runs of
+  messages), :mod:`~fastsim_ros.replay.encode` (outputs in bulk),
+  :mod:`~fastsim_ros.replay.mcap` (MCAP by the chunk),
+  :mod:`~fastsim_ros.replay.kernels` (their compiled loops);
 - :mod:`~fastsim_ros.replay.records` (CSV rows, plot samples),
   :mod:`~fastsim_ros.replay.plot`, :mod:`~fastsim_ros.replay.results`
   (:class:`Result`, its summary), :mod:`~fastsim_ros.replay.bagio`

@@ -9,6 +9,7 @@ compression) and the node's publisher QoS of the output connections.
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -75,8 +76,12 @@ def fast_yaml() -> Iterator[None]:
 
 # ------------------------------------------------------------------------ inputs
 
-def input_name(path: Path) -> str:
+def input_name(path: Path | str) -> str:
     """Return the NAME of an input: the directory's name, or the file's without ``.mcap``."""
+    if isinstance(path, str) and "://" in path:  # an fsspec URL
+        base = path.rstrip("/").rsplit("/", 1)[-1]
+        return base[:-len(".mcap")] if base.endswith(".mcap") and not path.endswith("/") \
+            else base
     p = Path(os.path.abspath(path))
     return p.stem if p.suffix == ".mcap" and not p.is_dir() else p.name
 
@@ -108,14 +113,20 @@ def messages(reader: Reader, source: str) -> Iterator[tuple[Any, int, bytes]]:
         yield item
 
 
+@functools.lru_cache(maxsize=256)
+def standard_definition(msgtype: str) -> tuple[str, str]:
+    """Return ``(msgdef, rihs01)`` of a ROS 2 Jazzy message type (computed once per type)."""
+    text, _ = TYPESTORE.generate_msgdef(msgtype, ros_version=2)
+    return text, TYPESTORE.hash_rihs01(msgtype)
+
+
 def definition(conn: Any) -> tuple[str, str]:
     """Return ``(msgdef, rihs01)`` of an input connection, to copy it as it is."""
     msgdef, digest = conn.msgdef.data, conn.digest
     if msgdef and digest:
         return msgdef, digest
     if conn.msgtype in TYPESTORE.fielddefs:
-        text, _ = TYPESTORE.generate_msgdef(conn.msgtype, ros_version=2)
-        return text, TYPESTORE.hash_rihs01(conn.msgtype)
+        return standard_definition(conn.msgtype)
     try:  # a type of its own: hash the definition the bag carries
         store = get_typestore(Stores.EMPTY)
         store.register(get_types_from_msg(msgdef, conn.msgtype))

@@ -696,7 +696,9 @@ class Batch:
         items: list[tuple[Ints, Floats]] = []
         for g in groups:
             take = where[g.rows]
-            if take.any():
+            if take.all():
+                items.append((g.rows, g.pressure))
+            elif take.any():
                 items.append((g.rows[take], g.pressure[take]))
         for i, patch in singles.items():
             if where[i]:

@@ -122,6 +122,8 @@ class IndexedReplay:
         self.out_schemas: dict[str, int] = {}
         self.out_channels: dict[str, int] = {}
         self.qos_out = bagio.qos(self.config["output_reliability"], int(self.config["qos_depth"]))
+        self.qos_text: str | None = None
+        self.qos_dicts: list[Any] = []
         # the inputs the pipeline takes, by channel
         inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
         self.handlers = {cid: inputs[resolve(ch.topic)] for cid, ch in indexed.channels.items()
@@ -151,15 +153,18 @@ class IndexedReplay:
         if sid is None:
             sid = self.out_schemas[msgtype] = self.next_schema
             self.next_schema += 1
-            text, _ = bagio.TYPESTORE.generate_msgdef(msgtype, ros_version=2)
+            text, _ = bagio.standard_definition(msgtype)
             self.writer.add_schema(mcap.Schema(sid, msgtype, "ros2msg", text.encode("utf-8")))
         cid = self.out_channels[topic] = self.next_channel
         self.next_channel += 1
-        qos = dump_qos_v9(self.qos_out)
+        if self.qos_text is None:
+            self.qos_dicts = dump_qos_v9(self.qos_out)
+            self.qos_text = mcap.dump_yaml(self.qos_dicts).strip()
         channel = mcap.Channel(cid, sid, topic, "cdr", mcap.metadata_map(
-            {"offered_qos_profiles": mcap.dump_yaml(qos).strip()}))
+            {"offered_qos_profiles": self.qos_text}))
         self.writer.add_channel(channel)
-        self.meta.append((channel, msgtype, qos, bagio.TYPESTORE.hash_rihs01(msgtype)))
+        self.meta.append((channel, msgtype, self.qos_dicts,
+                          bagio.standard_definition(msgtype)[1]))
         return cid
 
     # ---------------------------------------------------------------- copies
@@ -249,10 +254,13 @@ class IndexedReplay:
         w = self.writer
         info = mcap.bag_metadata(w.path.name, self.meta, w.counts, w.start, w.end,
                                  self.custom_data)
-        w.close(mcap.dump_yaml(info["rosbag2_bagfile_information"]).strip())
+        inner = mcap.dump_yaml(info["rosbag2_bagfile_information"])
+        w.close(inner.strip())
         path = self.out_dir / "metadata.yaml"
         tmp = path.with_suffix(".yaml.tmp")
-        tmp.write_text(mcap.dump_yaml(info), encoding="utf-8")
+        tmp.write_text("rosbag2_bagfile_information:\n"
+                       + "".join("  " + line + "\n" for line in inner.splitlines()),
+                       encoding="utf-8")
         tmp.replace(path)
         self.phases["write"] += time.perf_counter() - t0
 

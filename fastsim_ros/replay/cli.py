@@ -15,7 +15,10 @@ from typing import Any
 from fastsim_ros.params import ParameterError, defaults, load_params_file
 from fastsim_ros.replay.bagio import input_name
 from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
-from fastsim_ros.replay.run import PROG, Task, targets
+from fastsim_ros.replay import storage
+from fastsim_ros.replay.cluster import ClusterError
+from fastsim_ros.replay.errors import problem
+from fastsim_ros.replay.run import PROG, STAGING, Task, targets
 
 
 class _Parser(argparse.ArgumentParser):
@@ -28,10 +31,10 @@ def parser() -> argparse.ArgumentParser:
     p = _Parser(prog=PROG, allow_abbrev=False,
                 description="Replay rosbag2 bags (directories or .mcap files) through the "
                             "fastsim node's pipeline; write bags with the creep forces.")
-    p.add_argument("inputs", nargs="+", metavar="IN", type=Path,
-                   help="a rosbag2 directory or a single .mcap file")
-    p.add_argument("-o", "--output", required=True, type=Path, metavar="OUT",
-                   help="output directory (made if missing)")
+    p.add_argument("inputs", nargs="+", metavar="IN", type=_location,
+                   help="a rosbag2 directory or a single .mcap file (a path or an fsspec URL)")
+    p.add_argument("-o", "--output", required=True, type=_location, metavar="OUT",
+                   help="output directory, made if missing (a path or an fsspec URL)")
     p.add_argument("--params", type=Path, metavar="FILE",
                    help="the node's ROS 2 parameter file (default: every default, and the "
                         "contacts those with a patch topic in the bag)")
@@ -42,6 +45,9 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", action="store_true", help="write OUT/NAME.csv, one row per wrench")
     p.add_argument("--jobs", type=_jobs, default=1, metavar="N",
                    help="replay the inputs on N worker processes (default 1)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="replay each input as a task on the Dask distributed cluster of this "
+                        "scheduler (e.g. tcp://10.0.0.5:8786) instead of on this machine")
     p.add_argument("--no-progress", action="store_true",
                    help="no progress bar (it shows only on a terminal anyway)")
     return p
@@ -67,6 +73,11 @@ def namespace(text: str) -> str:
     return name
 
 
+def _location(text: str) -> Path | str:
+    """Return a local path as a Path, an fsspec URL (``protocol://...``) as it is."""
+    return text if storage.is_url(text) else Path(text)
+
+
 def _jobs(text: str) -> int:
     try:
         n = int(text)
@@ -89,14 +100,16 @@ def _terminate(signum: int, frame: Any) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the replay; return the exit status (see the package docstring)."""
     args = parser().parse_args(argv)
-    out: Path = args.output
+    out: Path | str = args.output
     values = defaults()
     if args.params is not None:
         try:
             values = load_params_file(args.params)
         except ParameterError as e:
             return _fail(str(e))
-    names: dict[str, Path] = {}
+    if args.scheduler is not None and args.jobs != 1:
+        return _fail("--jobs is for this machine, --scheduler for a cluster: give one")
+    names: dict[str, Path | str] = {}
     for src in args.inputs:
         name = input_name(src)
         if not name or name.startswith("."):
@@ -104,35 +117,35 @@ def main(argv: Sequence[str] | None = None) -> int:
         if name in names:
             return _fail(f"{src}: same name {name!r} as {names[name]}; outputs would clash")
         names[name] = src
-    if os.path.lexists(out) and not out.is_dir():
-        return _fail(f"{out}: exists and is not a directory")
-    for name in names:
-        for target in targets(out, name, args.plot, args.csv):
-            if os.path.lexists(target):
-                return _fail(f"{target}: exists already; not overwritten")
     try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        print(f"{PROG}: {out}: cannot make the output directory: {e.strerror or e}",
+        if not storage.is_url(out) and os.path.lexists(out) and not Path(out).is_dir():
+            return _fail(f"{out}: exists and is not a directory")
+        for name in names:
+            for target in targets(out, name, args.plot, args.csv):
+                if storage.exists(target):
+                    return _fail(f"{target}: exists already; not overwritten")
+        storage.makedirs(out)
+    except (OSError, ValueError, ImportError) as e:
+        print(f"{PROG}: {out}: cannot make the output directory: {problem(e)}",
               file=sys.stderr)
         return 1
     tag = f"{os.getpid()}"
     jobs = min(args.jobs, len(names))
     tasks = [Task(src, name, out, values, plot=args.plot, write_csv=args.csv,
                   contacts_from_bag=args.params is None, namespace=args.namespace, tag=tag,
-                  progress=not args.no_progress and jobs == 1)
+                  progress=not args.no_progress and jobs == 1 and args.scheduler is None)
              for name, src in names.items()]
     previous = signal.signal(signal.SIGTERM, _terminate)
     status = 0
     executor: Executor | None = None
     try:
-        from fastsim_ros.contact import compiled
-        from fastsim_ros.replay import batch
-        from msg_adapters import patch as patch_adapter
-        compiled.warm_up()  # load the kernels once (forked workers inherit them)
-        patch_adapter.warm_up()
-        batch.warm_up()
-        executor = InProcess() if jobs == 1 else LocalPool(jobs)
+        if args.scheduler is not None:
+            from fastsim_ros.replay.cluster import Cluster
+            executor = Cluster(args.scheduler, progress=not args.no_progress)
+        else:
+            from fastsim_ros.replay.cluster import warm_worker
+            warm_worker()  # load the kernels once (forked workers inherit them)
+            executor = InProcess() if jobs == 1 else LocalPool(jobs)
         for r in executor.results(tasks):
             for w in r.warnings:
                 print(f"{PROG}: warning: {w}", file=sys.stderr)
@@ -148,6 +161,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         _clean(out, tag)
         print(f"{PROG}: interrupted; nothing left of the unfinished inputs", file=sys.stderr)
         return 130
+    except ClusterError as e:
+        executor = None  # nothing to close: the scheduler is gone
+        print(f"{PROG}: {e}; the outputs already written stay", file=sys.stderr, flush=True)
+        return 1
     finally:
         if executor is not None:
             executor.close()
@@ -155,12 +172,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     return status
 
 
-def _clean(out: Path, tag: str) -> None:
+def _clean(out: Path | str, tag: str) -> None:
     """Remove this run's temporary directories from OUT."""
-    try:
-        entries = list(out.iterdir())
-    except OSError:
-        return
-    for p in entries:
-        if p.name.startswith(".") and p.name.endswith(f".{tag}.replay-tmp"):
-            shutil.rmtree(p, ignore_errors=True)
+    for name in storage.listing(out):
+        if name.startswith(".") and f".{tag}." in name and name.endswith(STAGING):
+            if storage.is_url(out):
+                storage.remove(str(out), name)
+            else:
+                shutil.rmtree(Path(out) / name, ignore_errors=True)

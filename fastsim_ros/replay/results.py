@@ -56,6 +56,7 @@ class Result:
     solve_us: dict[str, tuple[float, float]] = field(default_factory=dict)
     kinematics: dict[str, int] = field(default_factory=dict)
     written: list[str] = field(default_factory=list)
+    attempts: int = 1
     profile: Profile | None = None
 
     @property
@@ -99,5 +100,8 @@ class Result:
                         if dropped else ""))
         lines.append(f"  replay: {self.wall_s - self.plot_s:.2f} s, {self.speed:.1f}x real time"
                      + (f"; plot {self.plot_s:.2f} s" if self.plot_s else ""))
+        if self.attempts > 1:
+            lines.append(f"  retried: replayed {self.attempts} times (a worker died while "
+                         "replaying it; what it left was removed)")
         lines += [f"  wrote {p}" for p in self.written[1:]]
         return "\n".join(lines)

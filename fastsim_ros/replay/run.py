@@ -21,8 +21,10 @@ import json
 import os
 import shutil
 import sys
+import tempfile
 import time
-from dataclasses import dataclass
+import uuid
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +33,7 @@ from rclpy.serialization import serialize_message
 from fastsim_ros.params import SPECS, ParameterError
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, Pipeline, PipelineConfig,
                                   output_topics)
-from fastsim_ros.replay import bagio, bulk
+from fastsim_ros.replay import bagio, bulk, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
 from fastsim_ros.replay.records import CSV_HEADER, Series, record
@@ -43,13 +45,16 @@ PARAMETERS_KEY = "fastsim.parameters"
 #: messages between two progress-bar updates
 _PROGRESS_EVERY = 256
 _KINEMATICS = ("wheel_twist", "rail_twist")
+#: how staging directories end
+STAGING = ".replay-tmp"
 
 
 @dataclass(frozen=True)
 class Task:
     """One input to replay (picklable: executors send it to their workers).
 
-    ``source``: the bag; ``name``: its NAME; ``out``: the output directory;
+    ``source``: the bag; ``name``: its NAME; ``out``: the output directory
+    (either a local path or an fsspec URL: :mod:`~fastsim_ros.replay.storage`);
     ``values``: the parameters (checked again by the pipeline);
     ``contacts_from_bag``: take the contacts from the bag's patch topics
     instead of ``values`` (no ``--params``); ``namespace``: the node's
@@ -61,9 +66,9 @@ class Task:
     message: the reference the others are tested against).
     """
 
-    source: Path
+    source: Path | str
     name: str
-    out: Path
+    out: Path | str
     values: dict[str, Any]
     plot: bool = False
     write_csv: bool = False
@@ -74,14 +79,10 @@ class Task:
     path: str = "auto"
 
 
-def targets(out: Path, name: str, plot: bool, write_csv: bool) -> list[Path]:
-    """Return the paths an input NAME writes into OUT."""
-    paths = [out / name]
-    if write_csv:
-        paths.append(out / f"{name}.csv")
-    if plot:
-        paths.append(out / f"{name}.png")
-    return paths
+def targets(out: Any, name: str, plot: bool, write_csv: bool) -> list[Any]:
+    """Return the paths (or URLs) an input NAME writes into OUT."""
+    names = [name] + ([f"{name}.csv"] if write_csv else []) + ([f"{name}.png"] if plot else [])
+    return [storage.join(out, n) for n in names]
 
 
 def replay_bag(source: Path, name: str, out: Path, values: dict[str, Any], *,
@@ -102,10 +103,36 @@ def run_task(task: Task, *, profile: bool = False) -> Result:
     KeyboardInterrupt and SystemExit propagate, after the temporary files
     are removed.  ``profile``: time each phase
     (:class:`~fastsim_ros.replay.results.Profile`, for the benchmark).
+
+    Each attempt stages under a name of its own (``.NAME.TAG.ID.replay-tmp``
+    in OUT); what an earlier attempt of the same run left there (a worker
+    that died while replaying it) is removed first and counted in
+    ``Result.attempts``.
     """
-    source, name, out = task.source, task.name, task.out
+    if storage.is_url(task.source) or storage.is_url(task.out):
+        return _run_fetched(task, profile)
+    return _run_local(task, profile)
+
+
+def staging_prefix(name: str, tag: str) -> str:
+    """Return how the staging directories of an input's attempts in a run begin."""
+    return f".{name}.{tag}."
+
+
+def _earlier_attempts(out: Path | str, name: str, tag: str) -> list[str]:
+    prefix = staging_prefix(name, tag)
+    return [n for n in storage.listing(out) if n.startswith(prefix) and n.endswith(STAGING)]
+
+
+def _run_local(task: Task, profile: bool) -> Result:
+    source, name, out = task.source, task.name, Path(task.out)
     result = Result(str(source), name)
-    staging = out / f".{name}.{task.tag or os.getpid()}.replay-tmp"
+    tag = task.tag or str(os.getpid())
+    earlier = _earlier_attempts(out, name, tag)
+    for leftover in earlier:  # a worker that died while replaying this input
+        shutil.rmtree(out / leftover, ignore_errors=True)
+    result.attempts = 1 + len(earlier)
+    staging = out / f"{staging_prefix(name, tag)}{uuid.uuid4().hex[:12]}{STAGING}"
     done = False
     try:
         staging.mkdir()
@@ -135,6 +162,46 @@ def run_task(task: Task, *, profile: bool = False) -> Result:
                     Path(p).unlink(missing_ok=True)
             result.written = []
     return result
+
+
+def _run_fetched(task: Task, profile: bool) -> Result:
+    """Replay an input or into an output that is a URL, through local copies."""
+    tag = task.tag or str(os.getpid())
+    with tempfile.TemporaryDirectory(prefix="fastsim-replay-") as tmp:
+        local = Path(tmp)
+        source: Path | str = task.source
+        if storage.is_url(task.source):
+            try:
+                source = storage.fetch(str(task.source), local / "in")
+            except Exception as e:
+                result = Result(str(task.source), task.name, status=2)
+                result.error = f"{task.source}: cannot fetch: {problem(e)}"
+                return result
+        if not storage.is_url(task.out):
+            result = _run_local(replace(task, source=source), profile)
+            result.source = str(task.source)
+            result.error = result.error.replace(str(source), str(task.source))
+            return result
+        out = str(task.out)
+        earlier = _earlier_attempts(out, task.name, tag)
+        for leftover in earlier:
+            storage.remove(out, leftover)
+        staged = local / "out"
+        staged.mkdir()
+        result = _run_local(replace(task, source=source, out=staged), profile)
+        result.source = str(task.source)
+        result.error = result.error.replace(str(source), str(task.source))
+        result.attempts = 1 + len(earlier)
+        if result.ok:
+            name = f"{staging_prefix(task.name, tag)}{uuid.uuid4().hex[:12]}{STAGING}"
+            try:
+                result.written = storage.commit(staged, [Path(p).name for p in result.written],
+                                                out, name)
+            except OSError as e:
+                storage.remove(out, name)
+                result.ok, result.status, result.written = False, 1, []
+                result.error = f"{out}: cannot write: {problem(e)}"
+        return result
 
 
 def _progress(name: str, total: int, enabled: bool) -> Any:
@@ -183,7 +250,7 @@ def bag_contacts(topics: list[str], namespace: str) -> tuple[str, ...]:
 
 def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
     start_wall = time.perf_counter()
-    source, name, namespace = task.source, task.name, task.namespace
+    source, name, namespace = Path(task.source), task.name, task.namespace
     prof = Profile() if profile else None
     result.profile = prof
 
@@ -280,7 +347,7 @@ def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeli
                     custom: dict[str, str], out: _Outputs, bar: Any, prof: Profile | None,
                     result: Result) -> tuple[int, int]:
     """Replay an indexed MCAP input by the chunk (:mod:`~fastsim_ros.replay.bulk`)."""
-    replay = bulk.IndexedReplay(task.source, indexed, reader, staging / task.name, pipeline,
+    replay = bulk.IndexedReplay(Path(task.source), indexed, reader, staging / task.name, pipeline,
                                 task.namespace, custom, result,
                                 keep_inputs=prof is not None,
                                 batched=task.path != "messages")

@@ -1,0 +1,186 @@
+"""The replay on a Dask distributed cluster: ``fastsim_replay ... --scheduler ADDRESS``.
+
+One more executor (:mod:`~fastsim_ros.replay.executors`): each input is one
+task, :func:`~fastsim_ros.replay.run.run_task` run on a worker (which must
+have this package installed and, for local paths, see the same files as the
+client: a shared file system, or fsspec URLs).  The task stages and commits
+its own outputs, so what the cluster adds is only where it runs:
+
+- a worker that dies mid-bag: the scheduler runs the task again on another
+  worker (Dask's own rescheduling of the tasks of a lost worker); the new
+  attempt removes what the dead one left in OUT and counts itself
+  (``Result.attempts``, in the summary);
+- a bad bag is a result with its one-line error, not a failed task: it is
+  reported once and never retried;
+- a task whose workers kept dying (Dask's ``allowed-failures``): reported
+  as a failed input;
+- the scheduler lost: :class:`ClusterError` (one line); outputs already
+  committed stay (each was renamed into place whole).
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import subprocess
+import sys
+import time
+from collections.abc import Iterator, Sequence
+from concurrent.futures import CancelledError
+from pathlib import Path
+from typing import Any
+
+from fastsim_ros.replay.errors import problem
+from fastsim_ros.replay.results import Result
+from fastsim_ros.replay.run import Task, run_task
+
+#: seconds to wait for the scheduler when connecting
+CONNECT_TIMEOUT = 10.0
+
+
+class ClusterError(Exception):
+    """The cluster cannot be reached, or was lost while replaying."""
+
+
+def warm_worker() -> str:
+    """Load the compiled kernels on a worker (numba's disk cache), once per worker process."""
+    from fastsim_ros.contact import compiled
+    from fastsim_ros.replay import batch
+    from msg_adapters import patch
+    compiled.warm_up()
+    patch.warm_up()
+    batch.warm_up()
+    return "ok"
+
+
+class Cluster:
+    """Tasks on the Dask distributed scheduler at ``address`` (``tcp://host:8786``, ...)."""
+
+    def __init__(self, address: str, *, progress: bool = False) -> None:
+        from distributed import Client
+        # the client's own reconnection attempts log tracebacks: a lost or unreachable
+        # scheduler is one line of ours instead
+        logging.getLogger("distributed").setLevel(logging.CRITICAL)
+        self.address = address
+        self.progress = progress
+        self.futures: list[Any] = []
+        try:
+            self.client = Client(address, timeout=f"{CONNECT_TIMEOUT}s", set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as e:
+            raise ClusterError(f"cannot reach the Dask scheduler at {address}: "
+                               f"{problem(e)}") from None
+
+    def results(self, tasks: Sequence[Task]) -> Iterator[Result]:
+        """Submit every task; yield the results in the tasks' order."""
+        from distributed import KilledWorker
+        from distributed.comm import CommClosedError
+        client = self.client
+        try:
+            client.run(warm_worker)
+        except Exception as e:
+            raise ClusterError(f"the workers of {self.address} cannot load the package: "
+                               f"{problem(e)}") from None
+        self.futures = [client.submit(run_task, t, key=f"fastsim-replay-{t.tag}-{t.name}",
+                                      pure=False) for t in tasks]
+        bar = self._bar(len(tasks))
+        for task, future in zip(tasks, self.futures):
+            try:
+                result = future.result()
+            except KilledWorker as e:   # its workers kept dying: give up on this input
+                result = Result(str(task.source), task.name, status=1,
+                                error=f"{task.source}: the workers replaying it died "
+                                      f"({problem(e)})")
+            except Exception as e:
+                lost = (CancelledError, OSError, CommClosedError)
+                if client.status != "running" or isinstance(e, lost):
+                    raise ClusterError(f"lost the Dask scheduler at {self.address} "
+                                       f"({type(e).__name__})") from None
+                result = Result(str(task.source), task.name, status=1,
+                                error=f"{task.source}: internal error on a worker: "
+                                      f"{problem(e)}")
+            if bar is not None:
+                bar.update(1)
+            yield result
+        if bar is not None:
+            bar.close()
+
+    def _bar(self, total: int) -> Any:
+        if not self.progress or not sys.stderr.isatty():
+            return None
+        from tqdm import tqdm  # type: ignore[import-untyped]
+        return tqdm(total=total, desc="bags", unit="bag", file=sys.stderr, leave=False,
+                    dynamic_ncols=True)
+
+    def stop(self) -> None:
+        """Cancel the tasks not done, then disconnect.
+
+        A task already running finishes or is dropped by its worker; the
+        command line removes its staging directory.
+        """
+        try:
+            self.client.cancel(self.futures, force=True)
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Disconnect from the scheduler."""
+        try:
+            self.client.close(timeout=5)
+        except Exception:
+            pass
+
+
+class LocalProcesses:
+    """A Dask scheduler and ``workers`` worker processes on this machine (tests, benchmarks).
+
+    Started with this interpreter and ``env`` (this package on their path),
+    logs in ``directory``; ``nanny=False``: a killed worker stays dead.
+    ``address`` once they are up; :meth:`close` ends them.
+    """
+
+    def __init__(self, directory: Path, workers: int = 2, *, env: dict[str, str] | None = None,
+                 cwd: Path | None = None, nanny: bool = False, timeout: float = 60.0) -> None:
+        self.directory = directory
+        self.env = env
+        self.cwd = cwd
+        self.procs: list[subprocess.Popen[bytes]] = []
+        self.workers: list[subprocess.Popen[bytes]] = []
+        file = directory / "scheduler.json"
+        try:
+            self.procs.append(self._start("distributed.cli.dask_scheduler", "--host",
+                                          "127.0.0.1", "--port", "0", "--no-dashboard",
+                                          "--scheduler-file", str(file)))
+            deadline = time.monotonic() + timeout
+            while not file.exists():
+                if time.monotonic() > deadline or self.procs[0].poll() is not None:
+                    raise ClusterError("the local Dask scheduler did not start")
+                time.sleep(0.05)
+            self.address: str = json.loads(file.read_text())["address"]
+            for k in range(workers):
+                self.workers.append(self._start(
+                    "distributed.cli.dask_worker", self.address, "--nthreads", "1",
+                    "--no-dashboard", "--name", f"w{k}", *(() if nanny else ("--no-nanny",))))
+            self.procs += self.workers
+            from distributed import Client
+            with Client(self.address, timeout=f"{timeout}s", set_as_default=False) as client:
+                client.wait_for_workers(workers, timeout=timeout)
+        except BaseException:
+            self.close()
+            raise
+
+    def _start(self, module: str, *args: str) -> subprocess.Popen[bytes]:
+        log = open(self.directory / f"{module.rsplit('.', 1)[-1]}-{len(self.procs)}.log", "wb")
+        return subprocess.Popen([sys.executable, "-m", module, *args], cwd=self.cwd,
+                                env=self.env, stdout=log, stderr=subprocess.STDOUT)
+
+    def close(self) -> None:
+        """End the workers, then the scheduler."""
+        for p in reversed(self.procs):
+            if p.poll() is None:
+                p.terminate()
+        for p in self.procs:
+            try:
+                p.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                p.kill()
+                p.wait(timeout=15)

@@ -1,0 +1,131 @@
+"""Inputs and outputs that are fsspec URLs (``s3://``, ``file://``): fetched, staged, committed.
+
+A task whose input is a URL replays a local copy of it (fetched into a
+temporary directory on the worker); a task whose output directory is a URL
+replays into a local temporary directory and then commits: each file is
+uploaded under a temporary name inside ``OUT`` and moved to its final name,
+the bag's ``metadata.yaml`` last (a rosbag2 bag is a bag only once that file
+is there), so a reader never sees a half-written output.  Anything else is
+a local path and stays one.
+"""
+
+from __future__ import annotations
+
+import os
+import posixpath
+from pathlib import Path
+from typing import Any
+
+#: the bag file that makes an output directory a bag: moved into place last
+METADATA = "metadata.yaml"
+
+
+def is_url(path: Any) -> bool:
+    """Tell whether ``path`` is an fsspec URL (``protocol://...``) rather than a local path."""
+    return isinstance(path, str) and "://" in path
+
+
+def filesystem(url: str) -> tuple[Any, str]:
+    """Return the fsspec filesystem of ``url`` and the path on it."""
+    from fsspec.core import url_to_fs  # type: ignore[import-untyped]
+    fs, path = url_to_fs(url)
+    return fs, path.rstrip("/") or path
+
+
+def join(base: str | Path, name: str) -> str | Path:
+    """Return ``base/name`` for a local path or a URL."""
+    if is_url(base):
+        return posixpath.join(str(base).rstrip("/"), name)
+    return Path(base) / name
+
+
+def basename(url: str) -> str:
+    """Return the last part of a URL's path (a trailing slash ignored)."""
+    return posixpath.basename(url.rstrip("/"))
+
+
+def exists(path: str | Path) -> bool:
+    """Tell whether there is anything at a local path or a URL (a broken symlink counts)."""
+    if is_url(path):
+        fs, p = filesystem(str(path))
+        return bool(fs.exists(p))
+    return os.path.lexists(path)
+
+
+def makedirs(directory: str | Path) -> None:
+    """Make a local directory or a directory URL (and its parents) if missing."""
+    if is_url(directory):
+        fs, p = filesystem(str(directory))
+        fs.makedirs(p, exist_ok=True)
+    else:
+        Path(directory).mkdir(parents=True, exist_ok=True)
+
+
+def fetch(url: str, into: Path) -> Path:
+    """Copy the input at ``url`` (a bag directory or an ``.mcap``) into ``into``; return it."""
+    fs, path = filesystem(url)
+    if not fs.exists(path):
+        raise FileNotFoundError(f"{url}: no such file or directory")
+    into.mkdir(parents=True, exist_ok=True)
+    local = into / basename(url)
+    if fs.isdir(path):
+        local.mkdir(parents=True)
+        for entry in fs.ls(path, detail=False):
+            if fs.isfile(entry):
+                fs.get(entry, str(local / posixpath.basename(entry)))
+    else:
+        fs.get(path, str(local))
+    return local
+
+
+def commit(local_out: Path, names: list[str], url: str, staging_name: str) -> list[str]:
+    """Upload ``names`` (files and bag directories in ``local_out``) to the directory ``url``.
+
+    Staged under ``url/staging_name/`` and moved into place file by file,
+    each bag's ``metadata.yaml`` last; return the final URLs.  Raises
+    ``OSError`` (the caller removes what was staged: :func:`remove`).
+    """
+    fs, root = filesystem(url)
+    staging = posixpath.join(root, staging_name)
+    moves: list[tuple[str, str]] = []
+    last: list[tuple[str, str]] = []
+    for name in names:
+        src = local_out / name
+        files = sorted(p for p in src.rglob("*") if p.is_file()) if src.is_dir() else [src]
+        for f in files:
+            rel = f.relative_to(local_out).as_posix()
+            tmp, final = posixpath.join(staging, rel), posixpath.join(root, rel)
+            fs.makedirs(posixpath.dirname(tmp), exist_ok=True)
+            fs.put_file(str(f), tmp)
+            (last if f.name == METADATA else moves).append((tmp, final))
+    for tmp, final in moves + last:
+        fs.makedirs(posixpath.dirname(final), exist_ok=True)
+        fs.mv(tmp, final)
+    remove(url, staging_name)
+    prefix = url.rstrip("/")
+    return [f"{prefix}/{name}" for name in names]
+
+
+def remove(url: str, name: str) -> None:
+    """Remove ``url/name`` (a staging directory or a committed output) if it is there."""
+    fs, root = filesystem(url)
+    path = posixpath.join(root, name)
+    try:
+        if fs.exists(path):
+            fs.rm(path, recursive=True)
+    except OSError:
+        pass
+
+
+def listing(directory: str | Path) -> list[str]:
+    """Return the names in a local directory or a directory URL (none if it is missing)."""
+    if is_url(directory):
+        fs, root = filesystem(str(directory))
+        try:
+            return [posixpath.basename(p.rstrip("/")) for p in fs.ls(root, detail=False)]
+        except (FileNotFoundError, NotADirectoryError):
+            return []
+    try:
+        return [p.name for p in Path(directory).iterdir()]
+    except OSError:
+        return []

@@ -1,0 +1,161 @@
+"""``fastsim_replay --scheduler``: the replay on a real Dask cluster on localhost.
+
+Each test's cluster is a scheduler and two worker processes started by the
+test (the venv's python, this checkout on their path) and torn down after.
+The outputs must equal a local ``--jobs 1`` run; a worker killed while it
+replays must leave every output present once and complete (its task run
+again, the summary saying so); a corrupt bag among good ones is reported
+once; fsspec URLs work for inputs and outputs; a scheduler that cannot be
+reached is one line.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from rosbags.rosbag2 import Reader
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from fastsim_ros.replay.cluster import LocalProcesses  # noqa: E402
+from test_replay import BAGS, bag_contents, decoded_without_timing  # noqa: E402
+
+ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(
+    [str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    """Start a scheduler and two workers without nannies (a killed worker stays dead)."""
+    c = LocalProcesses(tmp_path, 2, env=ENV, cwd=ROOT)
+    yield c
+    c.close()
+
+
+def replay(*args, timeout=300):
+    """Run ``fastsim_replay`` as users do; return the finished process."""
+    return subprocess.run([sys.executable, "-m", "fastsim_ros.replay", *map(str, args)],
+                          cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=timeout)
+
+
+def same_outputs(a: Path, b: Path, names) -> None:
+    for name in names:
+        assert (a / f"{name}.csv").read_text() == (b / f"{name}.csv").read_text()
+        assert decoded_without_timing(bag_contents(a / name)[0]) == \
+            decoded_without_timing(bag_contents(b / name)[0])
+
+
+def test_a_cluster_replays_as_jobs_1_and_reads_and_writes_urls(tmp_path, cluster):
+    names = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
+    params = BAGS / "hertz_ramp.params.yaml"
+    local = replay(*[BAGS / n for n in names], "-o", tmp_path / "local", "--csv",
+                   "--params", params)
+    assert local.returncode == 0, local.stderr
+    remote = replay(*[BAGS / n for n in names], "-o", tmp_path / "cluster", "--csv",
+                    "--params", params, "--scheduler", cluster.address)
+    assert remote.returncode == 0, remote.stderr
+    assert remote.stderr == ""
+    same_outputs(tmp_path / "local", tmp_path / "cluster", names)
+    # fsspec URLs: an input directory and a lone .mcap in, a directory URL out
+    urls = replay(f"file://{BAGS / 'hertz_ramp'}", f"file://{BAGS / 'bad_inputs'}",
+                  "-o", f"file://{tmp_path / 'urls'}", "--csv", "--params", params,
+                  "--scheduler", cluster.address)
+    assert urls.returncode == 0, urls.stderr
+    assert f"-> file://{tmp_path / 'urls'}/hertz_ramp" in urls.stdout
+    same_outputs(tmp_path / "local", tmp_path / "urls", ("hertz_ramp", "bad_inputs"))
+    assert sorted(p.name for p in (tmp_path / "urls").iterdir()) == [
+        "bad_inputs", "bad_inputs.csv", "hertz_ramp", "hertz_ramp.csv"]
+
+
+def test_a_corrupt_bag_among_good_ones_is_reported_once(tmp_path, cluster):
+    broken = tmp_path / "broken.mcap"
+    broken.write_bytes((BAGS / "roller_rig" / "roller_rig.mcap").read_bytes()[:30_000])
+    out = tmp_path / "out"
+    proc = replay(BAGS / "hertz_ramp", broken, BAGS / "roller_rig", "-o", out,
+                  "--scheduler", cluster.address)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"fastsim_replay: {broken}")
+    assert sorted(p.name for p in out.iterdir()) == ["hertz_ramp", "roller_rig"]
+    assert proc.stdout.count("messages in") == 2
+
+
+def test_a_killed_worker_leaves_every_output_once_and_whole(tmp_path, cluster):
+    src = tmp_path / "in"
+    src.mkdir()
+    for k in range(8):
+        (src / f"f{k}").symlink_to(BAGS / "flange_shift", target_is_directory=True)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "fastsim_ros.replay", *sorted(map(str, src.iterdir())), "-o",
+         str(out), "--csv", "--params", str(BAGS / "flange_shift.params.yaml"), "--scheduler",
+         cluster.address], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+    # both workers busy (two staging directories), then one dies at once (SIGKILL)
+    deadline = time.monotonic() + 120
+    while not (out.is_dir() and sum(p.name.endswith(".replay-tmp") for p in out.iterdir()) >= 2):
+        assert time.monotonic() < deadline and proc.poll() is None
+        time.sleep(0.005)
+    cluster.workers[0].send_signal(signal.SIGKILL)
+    stdout, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 0, stderr
+    assert "retried: replayed 2 times" in stdout
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted([f"f{k}" for k in range(8)] + [f"f{k}.csv" for k in range(8)])
+    for k in range(8):
+        with Reader(out / f"f{k}") as reader:
+            assert sum(1 for _ in reader.messages()) == reader.message_count > 4000
+        assert (out / f"f{k}.csv").read_text() == (out / "f0.csv").read_text()
+
+
+def test_a_lost_scheduler_is_one_line_and_the_written_outputs_stay(tmp_path, cluster):
+    src = tmp_path / "in"
+    src.mkdir()
+    for k in range(10):
+        (src / f"f{k}").symlink_to(BAGS / "flange_shift", target_is_directory=True)
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "fastsim_ros.replay", *sorted(map(str, src.iterdir())), "-o",
+         str(out), "--csv", "--scheduler", cluster.address], cwd=ROOT, env=ENV,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not (out.is_dir() and any(p.name.endswith(".csv") for p in out.iterdir())):
+        assert time.monotonic() < deadline and proc.poll() is None
+        time.sleep(0.005)
+    cluster.procs[0].send_signal(signal.SIGKILL)   # the scheduler
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == 1
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr
+    assert f"lost the Dask scheduler at {cluster.address}" in stderr
+    assert "the outputs already written stay" in stderr
+    # what was committed is whole (a worker still running may commit a bag after)
+    done = [p for p in out.iterdir() if not p.name.startswith(".") and p.is_dir()]
+    assert done
+    for bag in done:
+        if (out / f"{bag.name}.csv").exists():
+            with Reader(bag) as reader:
+                assert sum(1 for _ in reader.messages()) == reader.message_count > 4000
+
+
+def test_an_unreachable_scheduler_is_one_line(tmp_path):
+    proc = replay(BAGS / "hertz_ramp", "-o", tmp_path / "out", "--scheduler",
+                  "tcp://127.0.0.1:9", timeout=120)
+    assert proc.returncode == 1
+    assert proc.stderr.count("\n") == 1
+    assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_jobs_and_scheduler_together_are_refused(tmp_path):
+    proc = replay(BAGS / "hertz_ramp", "-o", tmp_path / "out", "--jobs", "2", "--scheduler",
+                  "tcp://127.0.0.1:9")
+    assert proc.returncode == 2 and "give one" in proc.stderr
+    assert not (tmp_path / "out").exists()
