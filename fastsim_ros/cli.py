@@ -1,7 +1,9 @@
 """``fastsim_contact``: one-off contact computations from the command line.
 
-Two commands (INTERFACE.md): ``coefficients`` prints an area's generalised
-creepage coefficients, ``forces`` the creep forces at given creepages.  SI
+Three commands (INTERFACE.md): ``coefficients`` prints an area's generalised
+creepage coefficients, ``forces`` the creep forces at given creepages,
+``wheelset`` a wheelset's patches and creep forces from wheel and rail profiles
+(:mod:`fastsim_ros.cli_wheelset`).  SI
 units throughout.  ``--json`` prints exactly one JSON object on stdout.  Bad
 input gives one line on stderr and exit status 2, never a traceback, and no
 non-finite number is ever printed as a result.
@@ -172,6 +174,8 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--bound", choices=BOUNDS, default="given",
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch)")
+    from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
+    cli_wheelset.add_parser(sub, _finite)
     return parser
 
 
@@ -536,6 +540,10 @@ def _check_load(load: float, unit: areas.GridArea) -> None:
 
 
 def _print_table(command: str, result: dict[str, Any]) -> None:
+    if command == "wheelset":
+        from fastsim_ros import cli_wheelset
+        cli_wheelset.print_table(result)
+        return
     if command == "coefficients":
         print(f"{result['area_description']}, nu = {result['nu']:g}, method {result['method']}"
               + (f", extrapolated from grids {result['cells']}" if result.get("extrapolated")
@@ -556,6 +564,9 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
 def _run(argv: Sequence[str] | None) -> tuple[argparse.Namespace, dict[str, Any]]:
     args = build_parser().parse_args(argv)
     with np.errstate(all="ignore"):
+        if args.command == "wheelset":
+            from fastsim_ros import cli_wheelset
+            return args, cli_wheelset.run(args)
         result = coefficients(args) if args.command == "coefficients" else forces(args)
     return args, result
 

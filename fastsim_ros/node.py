@@ -51,7 +51,8 @@ from fastsim_ros import params as parameters
 from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
-                                  InputTopic, Outcome, Pipeline, PipelineConfig)
+                                  InputTopic, Outcome, PipelineConfig, patch_topic)
+from fastsim_ros.profile_pipeline import ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
 _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
@@ -107,7 +108,10 @@ class FastsimNode(Node):
         start = time.perf_counter()
         patch_adapter.warm_up()
         warm += time.perf_counter() - start
-        self.pipeline = Pipeline(config)
+        try:  # profiles mode reads and places its profiles here
+            self.pipeline = make_pipeline(config)
+        except parameters.ParameterError as e:  # a profile file or placement: one line
+            raise StartupError(str(e)) from None
         depth = int(config["qos_depth"])
         qos_in = _qos(config["patch_reliability"], depth)
         qos_out = _qos(config["output_reliability"], depth)
@@ -122,6 +126,10 @@ class FastsimNode(Node):
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
         outputs[MARKERS_TOPIC] = MarkerArray
+        if isinstance(self.pipeline, ProfilePipeline):
+            # profiles mode computes the patches and publishes them, so that a recording
+            # replays in either mode (INTERFACE.md)
+            outputs.update({patch_topic(c): PointCloud2 for c in config.contacts})
         for topic, msgtype in outputs.items():
             self._pubs[topic] = self.create_publisher(
                 msgtype, topic, qos_out,
@@ -134,8 +142,12 @@ class FastsimNode(Node):
                 raw=True)
         self.create_timer(float(config["diagnostics_period"]), self._publish_diagnostics)
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        source = (f"patches from the profiles {config['wheel_profile']} on "
+                  f"{config['rail_profile']} at each wheelset/pose"
+                  if isinstance(self.pipeline, ProfilePipeline)
+                  else "patches from contact/<name>/patch")
         self.get_logger().info(
-            f"solving {', '.join(config.contacts)} with {config['method']} "
+            f"{source}; solving {', '.join(config.contacts)} with {config['method']} "
             f"(mu {config['friction_coefficient']:g}, bound {config['traction_bound']}); "
             f"kernels ready in {warm:.2f} s")
 

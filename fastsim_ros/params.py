@@ -24,6 +24,10 @@ METHODS = ("mae", "mae_calibrated", "fastsim_ellipse")
 #: friction laws (:mod:`fastsim_ros.contact.friction`): Coulomb, and the falling
 #: mu(v) = mu_s ((1 - A) exp(-B v) + A) of the local slip velocity v
 FRICTION_LAWS = ("constant", "exponential")
+#: patch sources: patch topics, or the profiles and the wheelset's pose
+PATCH_SOURCES = ("topics", "profiles")
+#: the contacts of profiles mode, fixed per wheel: the patch nearer the tread, then a second
+PROFILE_CONTACTS = ("left", "right", "left_flange", "right_flange")
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 
@@ -47,6 +51,7 @@ class ParameterSpec:
     high: float | None = None
     choices: tuple[str, ...] = ()
     dynamic: bool = False
+    empty_ok: bool = False
 
     def allowed(self) -> str:
         """Return the allowed values in words (for descriptors and error messages)."""
@@ -57,7 +62,7 @@ class ParameterSpec:
         if self.kind == "string_array":
             return "a non-empty list of distinct names ([A-Za-z][A-Za-z0-9_]*)"
         if self.kind == "string":
-            return "a non-empty name"
+            return "a string" if self.empty_ok else "a non-empty name"
         return f"a {self.kind}"
 
     def check(self, value: Any) -> Any:
@@ -77,7 +82,7 @@ class ParameterSpec:
             if not isinstance(value, bool):
                 raise bad
         elif self.kind == "string":
-            if not isinstance(value, str) or not value:
+            if not isinstance(value, str) or not (value or self.empty_ok):
                 raise bad
         elif self.kind == "string_array":
             if (not isinstance(value, (list, tuple)) or not value
@@ -165,6 +170,55 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "publisher", low=1, high=10000),
     ParameterSpec("diagnostics_period", "double", 1.0,
                   "seconds between /diagnostics messages", low=0.01, high=60.0),
+    # --- the patch source (INTERFACE.md "Patches from wheel and rail profiles")
+    ParameterSpec("patch_source", "string", "topics",
+                  "where patches come from: topics (contact/<name>/patch) or profiles "
+                  "(computed each cycle from wheelset/pose, wheelset/load and the profiles; "
+                  "the contacts are then left, right, left_flange, right_flange)",
+                  choices=PATCH_SOURCES),
+    ParameterSpec("track_frame", "string", "track",
+                  "frame id of wheelset/pose (profiles mode)"),
+    ParameterSpec("wheel_profile", "string", "package://fastsim_ros/data/profiles/"
+                  "MBench_S1002_v3.prw",
+                  "left wheel profile: SIMPACK .prw or two-column 'y z' file (profiles mode; "
+                  "package://fastsim_ros/... names a file shipped with the package)"),
+    ParameterSpec("rail_profile", "string", "package://fastsim_ros/data/profiles/"
+                  "MBench_UIC60_v3.prr",
+                  "left rail profile: SIMPACK .prr or two-column 'y z' file (profiles mode)"),
+    ParameterSpec("right_wheel_profile", "string", "",
+                  "right wheel profile (empty: the mirror image of the left)", empty_ok=True),
+    ParameterSpec("right_rail_profile", "string", "",
+                  "right rail profile (empty: the mirror image of the left)", empty_ok=True),
+    ParameterSpec("profile_smoothing", "double", 0.0,
+                  "smoothing wavelength L_filt of the profiles (m; 0: none)",
+                  low=0.0, high=0.05),
+    ParameterSpec("gauge_width", "double", 1.435,
+                  "track gauge between the rails' inner faces (m)", low=0.3, high=3.0),
+    ParameterSpec("gauge_height", "double", 0.014,
+                  "depth below the rail top at which the gauge is measured (m)",
+                  low=0.0, high=0.1),
+    ParameterSpec("cant", "double", 0.0,
+                  "rail inclination added to the profile's (rad, positive towards the track "
+                  "centre; 0 for profiles that carry theirs)", low=-0.2, high=0.2),
+    ParameterSpec("flange_back_distance", "double", 1.360,
+                  "distance between the wheels' flange backs (m)", low=0.2, high=3.0),
+    ParameterSpec("flange_back_position", "double", -0.070,
+                  "flange back's lateral position in the wheel profile's coordinates (m)",
+                  low=-0.5, high=0.5),
+    ParameterSpec("nominal_radius", "double", 0.460,
+                  "wheel radius at the wheel profile's origin (m)", low=0.05, high=2.0),
+    ParameterSpec("cell_size", "double", 2.0e-4,
+                  "cell size of the potential contact grids computed from profiles (m)",
+                  low=2.0e-5, high=5.0e-3),
+    ParameterSpec("separation_distance", "double", 8.0e-3,
+                  "interpenetration regions of one wheel further apart than this (m) are "
+                  "separate patches (CONTACT's D_SEP)", low=0.0, high=0.1),
+    ParameterSpec("combination_distance", "double", 4.0e-3,
+                  "regions within this (m) are combined first (CONTACT's D_COMB; at most "
+                  "separation_distance)", low=0.0, high=0.1),
+    ParameterSpec("wheel_load", "double", 0.0,
+                  "vertical load per wheel (N) when no wheelset/load arrived; 0: the pose's "
+                  "vertical position is used as given", low=0.0, high=1.0e7, dynamic=True),
 )
 
 SPECS: dict[str, ParameterSpec] = {spec.name: spec for spec in PARAMETERS}
@@ -183,6 +237,11 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
         if spec is None:
             raise ParameterError(f"unknown parameter {name!r}")
         out[name] = spec.check(value)
+    if out["patch_source"] == "profiles":
+        if "contacts" in values and tuple(out["contacts"]) != PROFILE_CONTACTS:
+            raise ParameterError("parameter 'contacts': in profiles mode the contacts are "
+                                 "fixed: " + ", ".join(PROFILE_CONTACTS))
+        out["contacts"] = PROFILE_CONTACTS
     return out
 
 

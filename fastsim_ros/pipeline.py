@@ -64,10 +64,15 @@ CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "traction": "sensor_msgs/msg/PointCloud2"}
 
 
-def output_topics(contacts: tuple[str, ...]) -> dict[str, str]:
-    """Return every output topic (relative, but /diagnostics) with its message type."""
+def output_topics(contacts: tuple[str, ...], *, patches: bool = False) -> dict[str, str]:
+    """Return every output topic (relative, but /diagnostics) with its message type.
+
+    ``patches``: the patches are outputs too (profiles mode computes them).
+    """
     topics = {f"contact/{c}/{kind}": msgtype for c in contacts
               for kind, msgtype in CONTACT_OUTPUTS.items()}
+    if patches:
+        topics.update({patch_topic(c): "sensor_msgs/msg/PointCloud2" for c in contacts})
     topics[WHEELSET_WRENCH_TOPIC] = "geometry_msgs/msg/WrenchStamped"
     topics[MARKERS_TOPIC] = "visualization_msgs/msg/MarkerArray"
     topics[DIAGNOSTICS_TOPIC] = "diagnostic_msgs/msg/DiagnosticArray"
@@ -255,8 +260,11 @@ class Pipeline:
     :meth:`update` changes the parameters that may change while running.
     """
 
-    def __init__(self, config: PipelineConfig) -> None:
+    def __init__(self, config: PipelineConfig, *, solver: Any = None) -> None:
         self.config = config
+        # a solver with MaeSolver's solve_arrays, used instead of the method's (the
+        # command line's exact solver on patches from profiles)
+        self._override = solver
         nu, g = config["poisson_ratio"], config["shear_modulus"]
         # one solver per method of parameters.METHODS (CalibratedMaeSolver is a MaeSolver)
         self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver] = {
@@ -272,7 +280,7 @@ class Pipeline:
 
     def _apply(self, config: PipelineConfig) -> None:
         self.config = config
-        self._solver = self._solvers[config["method"]]
+        self._solver = self._override or self._solvers[config["method"]]
         self._mu = float(config["friction_coefficient"])
         # None: constant friction, the call of old (speed unused); else the law, run at |V|
         law = friction_law(str(config["friction_law"]), self._mu,
@@ -299,6 +307,10 @@ class Pipeline:
             if config[name] != self.config[name]:
                 raise parameters.ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config)
+
+    def outputs(self) -> dict[str, str]:
+        """Return every topic the pipeline publishes (relative, but /diagnostics) with its type."""
+        return output_topics(self.config.contacts)
 
     def inputs(self) -> tuple[InputTopic, ...]:
         """Return every input topic the pipeline takes, with its handler, in this order.
@@ -355,6 +367,13 @@ class Pipeline:
     def on_rail_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
         """Take a rail twist (roller, moving rail); return ``"ok"`` or why it was dropped."""
         return self._twist(self._rail, twist, "rail")
+
+    def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
+        """Return the wheel and rail twists a patch stamped ``stamp_ns`` is solved with.
+
+        Raises :class:`RejectedInput` (``no_kinematics``, ``stale_kinematics``).
+        """
+        return self._kinematics(stamp_ns)
 
     def _kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
         wheel = _newest_before(self._wheel, stamp_ns)
@@ -428,6 +447,39 @@ class Pipeline:
         wheelset = self._add_wrench(state, stamp, f_ws, torque)
         return Outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces, patch,
                        wheelset, self._markers_due(state, stamp))
+
+    def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
+                    rail: StampedTwist = REST, *,
+                    method: str | None = None) -> tuple[Creepage, ContactForces]:
+        """Return the creepages and creep forces of one converted patch under given twists.
+
+        The rules of :meth:`on_patch` (standstill, the solver's refusals as
+        :class:`RejectedInput`), without its stamps, counts or outputs: the
+        profiles patch source balances a wheel's vertical load with it.
+        ``method``: another of the pipeline's methods than the configured one.
+        """
+        creep = creepages(patch.frame, wheel, rail)
+        if not abs(creep.speed) >= self._min_speed:
+            raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
+        if method is None or method == self.config["method"]:
+            return creep, self._solve(patch, creep, ContactStats())
+        configured, self._solver = self._solver, self._solvers[method]
+        try:
+            return creep, self._solve(patch, creep, ContactStats())
+        finally:
+            self._solver = configured
+
+    def reject(self, contact: str, stamp_ns: int, reason: str, detail: str) -> Outcome:
+        """Count an input of ``contact`` dropped upstream of its patch (profiles mode)."""
+        stats = self._contacts[contact].stats
+        stats.window_inputs += 1
+        if stats.window_first_ns is None:
+            stats.window_first_ns = stamp_ns
+        stats.window_last_ns = stamp_ns
+        stats.counts[reason] += 1
+        stats.window_rejected += 1
+        stats.last_detail = f"{reason}: {detail}"
+        return Outcome(contact, stamp_ns, reason, detail)
 
     def _no_contact(self, contact: str, state: _ContactState, stamp: int) -> Outcome:
         state.stats.counts[NO_CONTACT] += 1

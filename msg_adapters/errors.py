@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
-#: every reason a patch can be dropped for (INTERFACE.md, "Outputs", /diagnostics)
+#: every reason a patch can be dropped for (INTERFACE.md, "Outputs", /diagnostics);
+#: ``derailment``: in profiles mode, a pose past the flange or off the rail head
 REJECTION_REASONS = (
     "nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",
     "old_stamp", "no_kinematics", "stale_kinematics", "standstill", "too_large",
-    "degenerate", "out_of_table",
+    "degenerate", "out_of_table", "derailment",
 )
 
 

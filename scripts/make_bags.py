@@ -31,6 +31,9 @@ sys.path.insert(0, str(ROOT))
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact.normal import hertz_ellipse, solve_normal  # noqa: E402
 from fastsim_ros.contact.samples import semi_ellipses_patch  # noqa: E402
+from fastsim_ros.geometry import benchmark  # noqa: E402
+from fastsim_ros.geometry.placement import rotation  # noqa: E402
+from msg_adapters.profile_msgs import quaternion  # noqa: E402
 from rosbags.interfaces import (  # noqa: E402
     Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime)
 from rosbags.rosbag2 import Reader, Writer  # noqa: E402
@@ -41,6 +44,8 @@ TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 T = TYPESTORE.types
 CLOUD = "sensor_msgs/msg/PointCloud2"
 TWIST = "geometry_msgs/msg/TwistStamped"
+POSE = "geometry_msgs/msg/PoseStamped"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
 
 #: first stamp of every bag (ns since the epoch): realistic, the same every run
 T0_NS = 1_700_000_000 * 10**9
@@ -55,7 +60,7 @@ PATCH_OFFSET = 0.0025  # patches lie between twists: no stamp ties, no boundary 
 FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure")
 REASONS = ("nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",
            "old_stamp", "no_kinematics", "stale_kinematics", "standstill", "too_large",
-           "degenerate", "out_of_table")
+           "degenerate", "out_of_table", "derailment")
 #: parameters of the node that the bad-input bag relies on
 MAX_PATCH_CELLS = 4096
 MAX_KINEMATICS_AGE = 0.05
@@ -88,6 +93,20 @@ def twist_msg(ns: int, linear: Any, angular: Any) -> Any:
     """Make a ``geometry_msgs/TwistStamped`` in the wheelset frame."""
     return T[TWIST](header=header(ns),
                     twist=T["geometry_msgs/msg/Twist"](linear=vec(linear), angular=vec(angular)))
+
+
+def pose_msg(ns: int, dy: float, dz: float, roll: float, yaw: float) -> Any:
+    """Make a ``geometry_msgs/PoseStamped`` of the wheelset in the track frame."""
+    qx, qy, qz, qw = quaternion(roll, yaw)
+    return T[POSE](header=header(ns, "track"), pose=T["geometry_msgs/msg/Pose"](
+        position=T["geometry_msgs/msg/Point"](x=0.0, y=float(dy), z=float(dz)),
+        orientation=T["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw)))
+
+
+def load_msg(ns: int, total: float, roll_moment: float = 0.0) -> Any:
+    """Make a ``wheelset/load``: the total vertical load (N) and its roll moment (N m)."""
+    return T[WRENCH](header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
+        force=vec((0.0, 0.0, total)), torque=vec((roll_moment, 0.0, 0.0))))
 
 
 def contact_axes(normal: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -326,57 +345,70 @@ def _side_gap(rx: float, ry_neg: float, ry_pos: float) -> Callable[..., np.ndarr
     return gap
 
 
-def flange_shift() -> tuple[Bag, dict[str, Any]]:
-    """Build (c): normal-solver patches, lateral shift tread -> flange root, two-point stretch.
+#: flange_shift's holds: the lateral shift to the left (m), tread -> two-point -> flange
+FLANGE_SHIFTS = (0.0, 2.0e-3, 4.0e-3, 4.75e-3, 4.85e-3, 4.95e-3, 5.05e-3, 6.0e-3, 6.4e-3,
+                 8.0e-3)
+#: its profiles-mode parameters (the geometry the patches were computed with)
+FLANGE_PROFILE_PARAMS: dict[str, Any] = {
+    "patch_source": "profiles", "cell_size": 4.0e-4, "separation_distance": 2.0e-3,
+    "combination_distance": 1.0e-3, "shear_modulus": G, "poisson_ratio": NU, "method": "mae"}
 
-    Ten shifts ``s = k/9`` held 0.4 s each.  Left tread: contact angle
-    0.03 -> 0.5 rad, rolling radius 0.46 -> 0.466 m, lateral radius on the
-    flange side (in-plane ``y < 0``) 0.3 -> 0.03 m.  Right tread: angle
-    0.03 -> 0.01 rad, radius 0.46 -> 0.458 m, field-side radius 0.45 -> 0.75 m.
-    From ``k = 7`` on the left flange (angle 1.1 rad, radius 0.475 m) carries
-    15, 30, 45 kN and the left tread the rest of 60 kN.  The axle spins at
-    ``v0 / mean(R_left, R_right)``: the wheels get opposite creepages.
+
+def flange_shift() -> tuple[Bag, dict[str, Any]]:
+    """Build (c): patches from the profiles, the wheelset shifted from the treads to the flange.
+
+    The shipped S1002 wheels on UIC60 rails (the Manchester benchmark's
+    placement), 20 kN per wheel, 20 m/s with the axle spinning at ``v0 /
+    R0``, no yaw; ten lateral shifts to the left (:data:`FLANGE_SHIFTS`) held
+    0.4 s each, each with the roll that levels both wheels under their loads.
+    The patches are the profile pipeline's (0.4 mm cells; regions more than 2
+    mm apart kept as separate patches): from 4.75 to 5.05 mm the left wheel
+    touches its rail on the tread and on the gauge corner (``left_flange``),
+    from 6.4 mm on its flange.  The bag has the pose, the load and the
+    twist too, so it replays in either mode; its parameters are topics mode.
     """
-    dur, v0, hold, nshift = 4.0, 20.0, 0.4, 10
-    bag = track_bag("flange_shift", ["left", "right", "left_flange"])
-    radii, clouds = [], []
-    fl_area = None
-    for k in range(nshift):
-        s = k / (nshift - 1)
-        d = 0.008 * s
-        g_l, r_l = 0.03 + 0.47 * s, 0.46 + 0.006 * s
-        g_r, r_r = 0.03 - 0.02 * s, 0.46 - 0.002 * s
-        flange_load = 15.0e3 * (k - 6) if k >= 7 else 0.0
-        left = normal_area(r_l / math.cos(g_l), 0.3 * 0.1**s, 0.3, 6.0e4 - flange_load, 24)
-        right = normal_area(r_r / math.cos(g_r), 0.3, 0.45 + 0.3 * s, 6.0e4, 24)
-        pl = (0.0, Y_WHEEL - d, -r_l)
-        pr = (0.0, -Y_WHEEL - d, -r_r)
-        c = {"left": cloud_points(left, pl, left_normal(g_l)),
-             "right": cloud_points(right, pr, right_normal(g_r))}
-        g_f, r_f = 1.1, 0.475
-        pf = (0.0, Y_WHEEL - d - 0.035, -r_f)
-        if flange_load > 0.0:
-            fl_area = normal_area(r_f / math.cos(g_f), 0.04, 0.08, flange_load, 24)
-            c["left_flange"] = cloud_points(fl_area, pf, left_normal(g_f))
-        clouds.append(c)
-        radii.append((r_l, r_r))
-    # no flange contact: empty patches on the first flange patch's grid
-    assert fl_area is not None
-    empty = cloud_points(fl_area.with_pressure(np.ones_like(fl_area.pressure)),
-                         (0.0, Y_WHEEL - 0.035, -0.475), left_normal(1.1))
-    empty[..., 6] = 0.0
+    from fastsim_ros.geometry.placement import Pose
+    from fastsim_ros.pipeline import PipelineConfig
+    from fastsim_ros.profile_pipeline import ProfilePipeline, contact_name
+    from msg_adapters.cdr import StampedTwist
+
+    dur, v0, hold = 4.0, 20.0, 0.4
+    names = ["left", "right", "left_flange", "right_flange"]
+    bag = Bag("flange_shift")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/load", WRENCH)
+    bag.topic("/wheelset/pose", POSE)
+    for c in names:
+        bag.topic(f"/contact/{c}/patch", CLOUD)
+    config = PipelineConfig.from_values({**FLANGE_PROFILE_PARAMS, "wheel_load": 2.0e4})
+    twist = (v0, 0.0, 0.0), (0.0, v0 / R, 0.0)
+    holds = []
+    for dy in FLANGE_SHIFTS:
+        pipeline = ProfilePipeline(config, solve_roll=True)
+        wheel = StampedTwist(0, FRAME, twist[0], twist[1])
+        rest = StampedTwist(0, "", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        contact = pipeline.solve(Pose(dy), wheel, rest, 0, loads=(2.0e4, 2.0e4))
+        clouds: dict[str, np.ndarray] = {}
+        for w in contact.wheels:
+            for k, wp in enumerate(sorted(w.patches, key=lambda p: -p.region.reference[1])):
+                points, normal, pressure = wp.cloud_arrays()
+                pts = np.empty(pressure.shape + (7,))
+                pts[..., 0:3] = points
+                pts[..., 3:6] = normal
+                pts[..., 6] = pressure
+                clouds[contact_name(w.side, k)] = pts
+        holds.append((contact.pose, clouds))
     for t in twist_times(dur):
-        k = min(int(t / hold), nshift - 1)
-        omega = v0 / (0.5 * (radii[k][0] + radii[k][1]))
-        bag.add("/wheelset/twist", stamp_ns(t), twist_msg(stamp_ns(t), (v0, 0, 0),
-                                                          (0, omega, 0)))
+        bag.add("/wheelset/twist", stamp_ns(t), twist_msg(stamp_ns(t), *twist))
+        bag.add("/wheelset/load", stamp_ns(t), load_msg(stamp_ns(t), 4.0e4))
+    empty = np.zeros((0, 0, 7))
     for t in patch_times(dur):
-        k = min(int(t / hold), nshift - 1)
+        pose, clouds = holds[min(int(t / hold), len(holds) - 1)]
         ns = stamp_ns(t)
-        for name in ("left", "right", "left_flange"):
-            pts = clouds[k].get(name, empty)
-            bag.add(f"/contact/{name}/patch", ns, cloud_msg(ns, pts))
-    return bag, {"contacts": ["left", "right", "left_flange"]}
+        bag.add("/wheelset/pose", ns, pose_msg(ns, pose.dy, pose.dz, pose.roll, pose.yaw))
+        for name in names:
+            bag.add(f"/contact/{name}/patch", ns, cloud_msg(ns, clouds.get(name, empty)))
+    return bag, {"contacts": names}
 
 
 def roller_rig() -> tuple[Bag, dict[str, Any]]:
@@ -586,6 +618,36 @@ def expected_counts(outcomes: list[tuple[str, str, int]]) -> dict[str, Any]:
     return res
 
 
+def mbench_a22() -> tuple[Bag, dict[str, Any]]:
+    """Build the Manchester benchmark A-2.2 as a recording of a rig with profiles.
+
+    The 21 poses of CONTACT's ``mbench_a22`` cases (shift 0..10 mm to the
+    right, yaw 0..24 mrad, their roll), one every 10 ms; the wheelset twist
+    at 200 Hz (2 m/s along the track, the case's axle spin, in the wheelset
+    frame of the case's roll and yaw); the load, 10 kN per wheel (20 kN, no
+    roll moment), with each twist.  No patches: the node or the replay in
+    profiles mode computes them (params: profiles mode, the benchmark's G).
+    """
+    bag = Bag("mbench_a22")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/load", WRENCH)
+    bag.topic("/wheelset/pose", POSE)
+    for k, case in enumerate(benchmark.a22("left")):
+        rot = rotation(case.roll, case.yaw)
+        v = rot.T @ np.array([case.forward_speed, 0.0, 0.0])
+        for t in (PATCH_DT * k, PATCH_DT * k + TWIST_DT):
+            ns = stamp_ns(t)
+            bag.add("/wheelset/twist", ns, twist_msg(ns, v, (0.0, case.axle_spin, 0.0)))
+            bag.add("/wheelset/load", ns, load_msg(ns, 2.0 * benchmark.LOAD))
+        ns = stamp_ns(PATCH_OFFSET + PATCH_DT * k)
+        bag.add("/wheelset/pose", ns, pose_msg(ns, case.dy, 0.0, case.roll, case.yaw))
+    return bag, {"contacts": ["left", "right", "left_flange", "right_flange"],
+                 "patch_source": "profiles", "shear_modulus": benchmark.SHEAR_MODULUS,
+                 "poisson_ratio": benchmark.POISSON, "friction_coefficient": benchmark.MU,
+                 "method": "mae_calibrated", "cell_size": benchmark.CELL,
+                 "wheel_load": 0.0}
+
+
 # ------------------------------------------------------------------ params, main
 
 SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
@@ -594,6 +656,7 @@ SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
     "flange_shift": flange_shift,
     "roller_rig": roller_rig,
     "bad_inputs": bad_inputs,
+    "mbench_a22": mbench_a22,
 }
 
 BASE_PARAMS: dict[str, Any] = {

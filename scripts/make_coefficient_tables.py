@@ -39,8 +39,12 @@ from fastsim_ros.contact.coefficients import coefficients_from_unit_solutions  #
 
 # Kalker's 19 published ratios, points in between (in log(a/b)), and a margin
 # beyond both ends: MAE's zones of real patches may measure a little outside 0.1..10.
-A_OVER_B = (0.05, 0.07, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1 / 0.9,
-            1 / 0.8, 1 / 0.7, 1 / 0.6, 2.0, 2.5, 1 / 0.3, 4.0, 5.0, 1 / 0.15, 10.0, 1 / 0.07, 20.0)
+# The ends beyond 0.05..20 (0.0125..80, added with --extend) serve the zones of flange
+# contacts: patches 16 mm long and under 1 mm wide (the Manchester benchmark's flange).
+A_OVER_B = (0.0125, 0.0175, 0.025, 0.035,
+            0.05, 0.07, 0.1, 0.15, 0.2, 0.25, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1 / 0.9,
+            1 / 0.8, 1 / 0.7, 1 / 0.6, 2.0, 2.5, 1 / 0.3, 4.0, 5.0, 1 / 0.15, 10.0, 1 / 0.07, 20.0,
+            1 / 0.035, 1 / 0.025, 1 / 0.0175, 1 / 0.0125)
 NUS = (0.0, 0.25, 0.5)
 GRIDS = (40, 60, 80, 100, 120, 160)
 MAIN_FIT = (60, 80, 100, 120, 160)
@@ -96,6 +100,9 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true",
                         help="three ratios and one nu only (a smoke run, writes under /tmp)")
+    parser.add_argument("--extend", action="store_true",
+                        help="solve only the ratios the shipped tables lack and merge their rows "
+                        "in (the shipped rows stay as they are)")
     parser.add_argument("--cell-shape-check", type=float, nargs="+", metavar="A_OVER_B",
                         help="instead of the tables: extrapolate C11, C22, C23 at these a/b on "
                         "square-box cells and on cells with 4x the cell count along x per y "
@@ -105,6 +112,12 @@ def main() -> int:
         return cell_shape_check(args.cell_shape_check)
     ratios = (0.5, 1.0, 2.0) if args.quick else A_OVER_B
     nus = (0.25,) if args.quick else NUS
+    shipped: dict[str, list[list[str]]] = {}
+    if args.extend:
+        for name in ("kalker_coefficients.csv", "half_ellipse_coefficients.csv"):
+            shipped[name] = _rows(ROOT / "fastsim_ros" / "data" / name)
+        have = {float(r[0]) for r in shipped["half_ellipse_coefficients.csv"]}
+        ratios = tuple(g for g in ratios if not any(abs(g - h) <= 1e-9 * g for h in have))
     out_dir = Path("/tmp/fastsim_tables") if args.quick else ROOT / "fastsim_ros" / "data"
     raw_path = (out_dir if args.quick else ROOT / "docs" / "data") / "coefficient_grids.csv"
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -135,7 +148,13 @@ def main() -> int:
             print(f"nu={nu:g} a/b={g:.4g}: C11={full[2]} C22={full[4]} C23={full[6]} "
                   f"c13={half[6]}  ({time.time() - t_start:.0f} s)", flush=True)
 
+    if args.extend:
+        full_rows = _merged(shipped["kalker_coefficients.csv"], full_rows)
+        half_rows = _merged(shipped["half_ellipse_coefficients.csv"], half_rows)
     command = "python scripts/make_coefficient_tables.py" + (" --quick" if args.quick else "")
+    if args.extend:
+        command = ("python scripts/make_coefficient_tables.py, then --extend for a/b "
+                   "0.0125..0.035 and 28.57..80")
     provenance = [
         f"# Made by: {command} (fastsim_ros exact solver, fastsim_ros/contact/exact.py)",
         "# Ellipse a b = 1/pi, full adhesion, n x n cells over the bounding box for n in "
@@ -153,10 +172,12 @@ def main() -> int:
         "# Upper half (y > 0) of the ellipse (METHOD.md 3.4): Fx+ = -G ab c11 xi - G ab c12 eta"
         " + G (ab)^1.5 c13 phi; Fy+ = -G ab c21 xi - G ab c22 eta - G (ab)^1.5 c23 phi."],
         ["a_over_b", "nu"] + [s for k in HALF_KEYS for s in (k, k + "_err")], half_rows)
-    keys = list(raw_rows[0].keys())
-    with open(raw_path, "w", newline="") as f:
+    keys = list(raw_rows[0].keys()) if raw_rows else []
+    append = args.extend and raw_path.exists()
+    with open(raw_path, "a" if append else "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys)
-        w.writeheader()
+        if not append:
+            w.writeheader()
         w.writerows(raw_rows)
     print(f"done in {time.time() - t_start:.0f} s", flush=True)
     return 0
@@ -183,6 +204,17 @@ def cell_shape_check(ratios: list[float]) -> int:
         w.writeheader()
         w.writerows(rows)
     return 0
+
+
+def _rows(path: Path) -> list[list[str]]:
+    """Return the data rows of a shipped table (comments and the column line dropped)."""
+    lines = [line for line in path.read_text().splitlines() if not line.startswith("#")]
+    return [row for row in csv.reader(lines[1:])]
+
+
+def _merged(old: list[list[str]], new: list[list[str]]) -> list[list[str]]:
+    """Old and new rows, sorted by nu then a/b (the shipped tables' order)."""
+    return sorted(old + new, key=lambda r: (float(r[1]), float(r[0])))
 
 
 def _write(path: Path, header: list[str], columns: list[str], rows: list[list[str]]) -> None:

@@ -105,7 +105,8 @@ class Client:
     is pushed out of a history), so that :meth:`wait_connected` knows them all.
     """
 
-    def __init__(self, contacts: tuple[str, ...], name: str = "test_client") -> None:
+    def __init__(self, contacts: tuple[str, ...], name: str = "test_client", *,
+                 patches: bool = True) -> None:
         self.context = Context()
         rclpy.init(context=self.context)
         self.node = Node(name, context=self.context)
@@ -116,7 +117,9 @@ class Client:
         self._subscriptions: list[tuple[str, Any]] = []
         self.twist = self.publisher(TwistStamped, "wheelset/twist")
         self.rail = self.publisher(TwistStamped, "rail/twist")
-        self.patch = {c: self.publisher(PointCloud2, f"contact/{c}/patch") for c in contacts}
+        # patches: this client publishes them (topics mode); profiles mode computes them
+        self.patch = ({c: self.publisher(PointCloud2, f"contact/{c}/patch") for c in contacts}
+                      if patches else {})
         self.wrenches: dict[str, list[WrenchStamped]] = {
             c: self.subscribe(WrenchStamped, f"contact/{c}/wrench") for c in contacts}
         self.wheelset: list[WrenchStamped] = self.subscribe(WrenchStamped, "wheelset/wrench")
@@ -249,6 +252,32 @@ class Client:
                  if k.startswith("rejected/") and v > before.get(k, 0)]
         assert len(grown) == 1, f"{contact}: counts before {before}, after {after}"
         return grown[0]
+
+    def poses_handled(self) -> int:
+        """Return how many poses the node has counted (taken, or dropped by reason)."""
+        values = self.node_values()
+        return sum(int(values.get(f"poses/{k}", "0"))
+                   for k in ("pose", "malformed", "wrong_frame", "nonfinite", "old_stamp"))
+
+    def send_pose(self, publisher: Any, msg: Any, contacts: tuple[str, ...],
+                  timeout: float = 60.0) -> dict[str, list[WrenchStamped]]:
+        """Publish a pose (profiles mode); once the node counted it, return its wrenches.
+
+        Waits for the count, then for a wrench of the pose's stamp on every
+        contact of ``contacts`` that the node served (a pose dropped whole has none).
+        """
+        before = self.poses_handled()
+        publisher.publish(msg)
+        assert self.wait_for(lambda: self.poses_handled() > before, timeout), (
+            f"the node did not count the pose (it counted {self.poses_handled()})")
+        stamp = stamp_ns(msg)
+        # the diagnostics that counted the pose count its wrenches too: wait for them all
+        counted = {c: int(self.diagnostic_values(c).get("wrenches", "0")) for c in contacts}
+        assert self.wait_for(lambda: all(len(self.wrenches[c]) >= counted[c]
+                                         for c in contacts), timeout), (
+            f"wrenches counted {counted}, arrived "
+            f"{ {c: len(self.wrenches[c]) for c in contacts} }")
+        return {c: [w for w in self.wrenches[c] if stamp_ns(w) == stamp] for c in contacts}
 
     def call(self, client: Any, request: Any, timeout: float = 20.0) -> Any:
         """Call a service of the node (an idempotent one) and return the response.

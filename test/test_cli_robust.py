@@ -354,8 +354,8 @@ def test_forces_run_the_compiled_path(capsys, method, solver):
 
 
 def strip_patch(path):
-    """Write a strip 101 cells long and 2 wide: MAE zones of a/b about 50, beyond the tables."""
-    rows = [f"{(i - 50) * 1e-3!r},{(j - 0.5) * 1e-3!r},1e9" for j in range(2) for i in range(101)]
+    """Write a strip 401 cells long and 2 wide: MAE zones of a/b about 200, beyond the tables."""
+    rows = [f"{(i - 200) * 1e-3!r},{(j - 0.5) * 1e-3!r},1e9" for j in range(2) for i in range(401)]
     return write(path, ["x,y,pressure", *rows])
 
 

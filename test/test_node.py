@@ -193,8 +193,8 @@ def bad_inputs():
         p[5, 5:8] = 1e9
         return cloud_msg(area, stamp_ns=stamp, pressure=p)
 
-    def out_of_table(stamp):  # 2 x 101 cells: MAE zones of a/b about 50, beyond the tables
-        strip = areas.GridArea(-50e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 101)) * 1e9)
+    def out_of_table(stamp):  # 2 x 401 cells: MAE zones of a/b about 200, beyond the tables
+        strip = areas.GridArea(-200e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 401)) * 1e9)
         return cloud_msg(strip, stamp_ns=stamp)
 
     def tiny(stamp):

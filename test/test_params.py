@@ -57,8 +57,12 @@ def test_methods_and_the_default():
 
 @pytest.mark.parametrize("path", sorted((PACKAGE_ROOT / "bags").glob("*.params.yaml")))
 def test_bag_parameter_files_load(path):
-    # the bags' golden outputs are the paper's MAE's: their files name it explicitly
-    assert load_params_file(path)["method"] == "mae"
+    # the bags' golden outputs are their method's: each file names it explicitly (the
+    # paper's MAE, but mbench_a22: the default method of the benchmark's report)
+    load_params_file(path)
+    assert '    method: "mae"' in path.read_text() or (
+        path.name == "mbench_a22.params.yaml"
+        and '    method: "mae_calibrated"' in path.read_text())
 
 
 @pytest.mark.parametrize("name, value", [

@@ -227,8 +227,8 @@ def test_patch_rejections_then_the_next_good_patch_is_served():
 
 @pytest.mark.parametrize("method", ["mae", "mae_calibrated"])
 def test_out_of_table_patch(method):
-    # a strip 101 cells long and 2 wide: MAE zones of a/b about 50, beyond the tables' 20
-    area = areas.GridArea(-50e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 101)) * 1e9)
+    # a strip 401 cells long and 2 wide: MAE zones of a/b about 200, beyond the tables' 80
+    area = areas.GridArea(-200e-3, -0.5e-3, 1e-3, 1e-3, np.ones((2, 401)) * 1e9)
     pipe = make(method=method)
     pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
     out = solve(pipe, area)

@@ -91,7 +91,9 @@ def test_every_path_replays_a_bundled_bag_the_same(tmp_path, name):
     batched = replayed(BAGS / name, tmp_path / "auto", values, "auto")
     assert_same(by_chunk, reference)
     assert_same(batched, reference)
-    assert sum(reference[2].counts[c]["solved"] for c in reference[2].contacts) >= 400
+    # a recording of patches solves hundreds; mbench_a22 (profiles mode) its 21 poses' two treads
+    least = 42 if values.get("patch_source") == "profiles" else 400
+    assert sum(reference[2].counts[c]["solved"] for c in reference[2].contacts) >= least
 
 
 # ------------------------------------------------------------------------ a varied bag

@@ -13,9 +13,13 @@ as SciPy's ``CubicSpline``, computed here with numpy alone so that the fast
 path does not import SciPy; the coefficients are smooth in ``log(a/b)`` over
 two decades), and in ``nu`` by a quadratic through the three
 tabulated values of ``C (1 - nu)``, which removes the ``1/(1 - nu)`` of
-Kalker's asymptotic formulas.  The tables span ``0.05 <= a/b <= 20`` (a
-margin beyond Kalker's 0.1..10: MAE's zones of real patches may measure a
-little outside it) and ``0 <= nu <= 0.5``; outside, a look-up is refused
+Kalker's asymptotic formulas.  The core of the tables spans ``0.05 <= a/b
+<= 20`` (a margin beyond Kalker's 0.1..10: MAE's zones of real patches may
+measure a little outside it); the ends ``0.0125..0.05`` and ``20..80`` serve
+the zones of flange contacts (patches 16 mm long, under 1 mm wide) and are
+splines of their own, joined to the core's at 0.05 and 20 (the values
+continuous there), so that extending the tables left every number inside
+the core as it was.  ``0 <= nu <= 0.5``; outside, a look-up is refused
 (:class:`OutOfTableError`).
 
 Everything handed out is read-only (arrays not writeable, mappings
@@ -43,6 +47,8 @@ FULL_NAMES = ("C11", "C22", "C23", "C33")
 HALF_NAMES = ("c11", "c12", "c13", "c21", "c22", "c23")
 #: the half-ellipse coefficients that are halves of Kalker's
 HALF_FROM_FULL = {"c11": "C11", "c22": "C22", "c23": "C23"}
+#: the core range of a/b: one spline; beyond it each end has its own (see the module)
+CORE_RANGE = (0.05, 20.0)
 
 
 def _read(name: str) -> tuple[list[str], FloatArray]:
@@ -183,6 +189,18 @@ class CoefficientTable:
         return {n: self._at(n, t) for n in HALF_NAMES}
 
 
+def _pieces(a_over_b: FloatArray) -> list[tuple[int, int]]:
+    """Return the knot index ranges ``(first, last)`` of the splines: the ends, the core."""
+    lo = int(np.argmin(np.abs(a_over_b - CORE_RANGE[0])))
+    hi = int(np.argmin(np.abs(a_over_b - CORE_RANGE[1])))
+    pieces = [(lo, hi)]
+    if lo > 0:
+        pieces.insert(0, (0, lo))
+    if hi < a_over_b.size - 1:
+        pieces.append((hi, a_over_b.size - 1))
+    return pieces
+
+
 @lru_cache(maxsize=16)
 def coefficient_table(nu: float) -> CoefficientTable:
     """Return the tables interpolated to Poisson ratio ``nu`` (cached per ``nu``; read-only)."""
@@ -198,7 +216,12 @@ def coefficient_table(nu: float) -> CoefficientTable:
                                  for m in range(nodes.size) if m != k])
                         for k in range(nodes.size)])
     poly = {}
+    pieces = _pieces(data.a_over_b)
     for name, v in data.values.items():
-        at_nu = (weights @ (v * (1.0 - nodes)[:, None])) / (1.0 - nu)
-        poly[name] = np.ascontiguousarray(not_a_knot_spline(knots, at_nu))
+        splines = []
+        for a, b in pieces:  # each piece as its own table (the core's numbers unchanged)
+            part = v[:, a:b + 1]
+            at_nu = (weights @ (part * (1.0 - nodes)[:, None])) / (1.0 - nu)
+            splines.append(not_a_knot_spline(knots[a:b + 1], at_nu))
+        poly[name] = np.ascontiguousarray(np.concatenate(splines, axis=1))
     return CoefficientTable(float(nu), _frozen(knots), _frozen_map(poly))

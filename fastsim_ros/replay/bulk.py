@@ -27,7 +27,8 @@ from rclpy.serialization import serialize_message
 from rosbags.rosbag2.metadata import dump_qos_v9
 
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
-                                  Outcome, Pipeline, output_topics)
+                                  Outcome, Pipeline)
+from fastsim_ros.profile_pipeline import AnyPipeline
 from fastsim_ros.replay import bagio, batch, encode, kernels, mcap
 from fastsim_ros.replay.errors import BadInput
 from fastsim_ros.replay.results import Result
@@ -78,7 +79,7 @@ class IndexedReplay:
     """One indexed input replayed into one output bag (see the module docstring)."""
 
     def __init__(self, source: Path, indexed: mcap.IndexedMcap, reader: Any, out_dir: Path,
-                 pipeline: Pipeline, namespace: str, custom_data: dict[str, str],
+                 pipeline: AnyPipeline, namespace: str, custom_data: dict[str, str],
                  result: Result, *, keep_inputs: bool = False, batched: bool = True) -> None:
         self.source = source
         self.mcap = indexed
@@ -88,8 +89,7 @@ class IndexedReplay:
         self.result = result
         self.custom_data = custom_data
         contacts = self.config.contacts
-        self.output_types = {resolve(t, namespace): m
-                             for t, m in output_topics(contacts).items()}
+        self.output_types = {resolve(t, namespace): m for t, m in pipeline.outputs().items()}
         self.frame_id = str(self.config["wheelset_frame"])
         out_dir.mkdir()
         self.out_dir = out_dir
@@ -129,7 +129,7 @@ class IndexedReplay:
         self.handlers = {cid: inputs[resolve(ch.topic)] for cid, ch in indexed.channels.items()
                          if resolve(ch.topic) in inputs}
         self.batch: batch.Batch | None = None
-        if batched and batch.supported(pipeline):
+        if batched and isinstance(pipeline, Pipeline) and batch.supported(pipeline):
             self.batch = batch.Batch(pipeline, {
                 cid: (i.kind, contacts.index(i.contact) if i.contact is not None else 0)
                 for cid, i in self.handlers.items()}, keep_inputs=keep_inputs)

@@ -13,6 +13,8 @@ from pathlib import Path
 from typing import Any
 
 from fastsim_ros.params import ParameterError, defaults, load_params_file
+from fastsim_ros.pipeline import PipelineConfig
+from fastsim_ros.profile_pipeline import wheelset_of
 from fastsim_ros.replay.bagio import input_name
 from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
 from fastsim_ros.replay import storage
@@ -105,8 +107,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.params is not None:
         try:
             values = load_params_file(args.params)
+            if values["patch_source"] == "profiles":  # its profiles read before any work
+                wheelset_of(PipelineConfig.from_values(values))
         except ParameterError as e:
-            return _fail(str(e))
+            return _fail(f"{args.params}: {e}" if str(args.params) not in str(e) else str(e))
     if args.scheduler is not None and args.jobs != 1:
         return _fail("--jobs is for this machine, --scheduler for a cluster: give one")
     names: dict[str, Path | str] = {}

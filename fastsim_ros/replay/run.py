@@ -31,8 +31,8 @@ from typing import Any
 from rclpy.serialization import serialize_message
 
 from fastsim_ros.params import SPECS, ParameterError
-from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, Pipeline, PipelineConfig,
-                                  output_topics)
+from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig
+from fastsim_ros.profile_pipeline import AnyPipeline, make_pipeline
 from fastsim_ros.replay import bagio, bulk, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
@@ -266,7 +266,7 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
             if found:
                 values = dict(values, contacts=list(found))
         config = PipelineConfig.from_values(values)
-        pipeline = Pipeline(config)
+        pipeline = make_pipeline(config)
         contacts = config.contacts
         result.contacts = contacts
         result.contacts_found = found
@@ -328,7 +328,7 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
 class _Outputs:
     """Where a wrench's CSV row and plot sample go (either may be off)."""
 
-    pipeline: Pipeline
+    pipeline: AnyPipeline
     rows: Any
     series: dict[str, Series] | None
     method: str
@@ -343,7 +343,7 @@ class _Outputs:
                    self.method, self.law)
 
 
-def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeline: Pipeline,
+def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeline: AnyPipeline,
                     custom: dict[str, str], out: _Outputs, bar: Any, prof: Profile | None,
                     result: Result) -> tuple[int, int]:
     """Replay an indexed MCAP input by the chunk (:mod:`~fastsim_ros.replay.bulk`)."""
@@ -367,14 +367,13 @@ def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeli
     return first, last
 
 
-def _replay_messages(task: Task, reader: Any, staging: Path, pipeline: Pipeline,
+def _replay_messages(task: Task, reader: Any, staging: Path, pipeline: AnyPipeline,
                      custom: dict[str, str], out: _Outputs, bar: Any, prof: Profile | None,
                      result: Result) -> tuple[int, int]:
     """Replay any input message by message with rosbags (the reference path)."""
     source, namespace, config = task.source, task.namespace, pipeline.config
     clock = time.perf_counter_ns
-    absolute = {resolve(t, namespace): msgtype
-                for t, msgtype in output_topics(config.contacts).items()}
+    absolute = {resolve(t, namespace): msgtype for t, msgtype in pipeline.outputs().items()}
     inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
     writer = bagio.open_writer(staging / task.name, custom)
     qos_out = bagio.qos(config["output_reliability"], int(config["qos_depth"]))

@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""Speed of the profiles patch source: one wheelset pose, both wheels, and its parts.
+
+For a few poses of the Manchester benchmark (S1002 on UIC60, 10 kN per
+wheel, 0.2 mm cells unless ``--cell``) it times, interleaved in one run:
+
+- ``pose (loads)``: :meth:`ProfilePipeline.on_pose` with the wheel loads
+  given, what the node runs per cycle: contact search, planar grids, the
+  normal problem, the vertical balance with the creep forces (the default
+  method) and the four contacts' solves;
+- ``pose (height)``: the same with the vertical position given (one pass);
+- the parts of one pass: ``search`` (both wheels' contact locus and
+  regions), ``grids`` (planar grids and their undeformed gap), ``normal``
+  (the normal problem on each grid), ``tangential`` (the creep forces of
+  each patch, the default method).
+
+Prints medians and p99 (ms) with the machine.  Usage:
+``python benchmarks/bench_geometry.py [--repeat N] [--cell H]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from fastsim_ros.geometry import benchmark  # noqa: E402
+from fastsim_ros.geometry.placement import Pose  # noqa: E402
+from fastsim_ros.geometry.planar import planar_grid  # noqa: E402
+from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
+from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
+from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
+from msg_adapters.patch import patch_from_cloud  # noqa: E402
+from msg_adapters.profile_msgs import StampedPose, patch_cloud, quaternion  # noqa: E402
+
+#: A-2.2 poses: centred on the treads, 5 mm (the right gauge corner), 7 mm (the flange)
+POSES = (1, 11, 15)
+
+
+def machine() -> str:
+    cpu = "unknown CPU"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def timed(fn: Callable[[], object], repeat: int) -> np.ndarray:
+    out = np.empty(repeat)
+    for k in range(repeat):
+        t = time.perf_counter()
+        fn()
+        out[k] = time.perf_counter() - t
+    return out * 1e3
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=20)
+    parser.add_argument("--cell", type=float, default=2e-4)
+    args = parser.parse_args()
+    print(f"machine: {machine()}; cell {args.cell * 1e3:g} mm; {args.repeat} repeats, "
+          "interleaved; times in ms")
+    print(f"{'pose':>18s} {'what':>16s} {'median':>9s} {'p99':>9s}")
+    for number in POSES:
+        case = benchmark.a22("right")[number - 1]
+        values = {"patch_source": "profiles", "shear_modulus": benchmark.SHEAR_MODULUS,
+                  "poisson_ratio": benchmark.POISSON, "cell_size": args.cell}
+        loaded = ProfilePipeline(PipelineConfig.from_values({**values, "wheel_load": 1e4}))
+        height = ProfilePipeline(PipelineConfig.from_values({**values, "wheel_load": 0.0}))
+        pose = Pose(case.dy, case.dz, case.yaw, case.roll)
+        twist = wheel_twist(pose, case.forward_speed, case.axle_spin, 0.0, 0.0)
+        msg = StampedPose(0, "track", (0.0, pose.dy, pose.dz), quaternion(pose.roll, pose.yaw))
+        stamp = [0]
+
+        def cycle(p: ProfilePipeline) -> None:
+            stamp[0] += 1
+            p.on_wheel_twist(twist.__class__(stamp[0], twist.frame_id, twist.linear,
+                                             twist.angular))
+            out = p.on_pose(msg.__class__(stamp[0], msg.frame_id, msg.position,
+                                          msg.orientation))
+            assert out.contact is not None, out.outcomes[0].detail
+
+        cycle(loaded)  # warm: numba, caches
+        cycle(height)
+        ws = height.wheelset
+        regions = {s: ws.regions(s, pose) for s in ("left", "right")}
+        r0 = ws.placement.nominal_radius
+        grids = [planar_grid(r, ws.rails[s], ws.wheels[s], ws.side_pose(s, pose), r0, ws.cell)
+                 for s in ("left", "right") for r in regions[s]]
+        patches = [p for s in ("left", "right") for p in ws.patches(s, pose)]
+        clouds = [patch_cloud(0, "wheelset", p.points, p.normal, p.pressure) for p in patches]
+        converted = [patch_from_cloud(c, max_cells=100_000) for c in clouds]
+
+        parts: dict[str, Callable[[], object]] = {
+            "pose (loads)": lambda: cycle(loaded),
+            "pose (height)": lambda: cycle(height),
+            "search": lambda: [ws.regions(s, pose) for s in ("left", "right")],
+            "grids": lambda: [planar_grid(r, ws.rails[s], ws.wheels[s], ws.side_pose(s, pose),
+                                          r0, ws.cell)
+                              for s in ("left", "right") for r in regions[s]],
+            "normal": lambda: [ws._normal.solve(g.gap - g.gap.min(), -float(g.gap.min()),
+                                                g.dx, g.ds) for g in grids],
+            "tangential": lambda: [height.pipeline.solve_patch(c, twist) for c in converted
+                                   if c is not None],
+        }
+        samples: dict[str, list[np.ndarray]] = {k: [] for k in parts}
+        for _ in range(args.repeat):
+            for name, fn in parts.items():
+                samples[name].append(timed(fn, 1))
+        label = f"A-2.2 {number} ({-case.dy * 1e3:.1f} mm)"
+        for name, runs in samples.items():
+            t = np.concatenate(runs)
+            print(f"{label:>18s} {name:>16s} {np.median(t):9.2f} {np.percentile(t, 99):9.2f}")
+        cells = sum(g.gap.size for g in grids)
+        print(f"{label:>18s} {'grids':>16s} {len(grids)} grid(s), {cells} cells")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

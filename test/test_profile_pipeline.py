@@ -1,0 +1,185 @@
+"""The pipeline in profiles mode: poses and loads in, patches and wrenches out, bad poses."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros.geometry.placement import rotation
+from fastsim_ros.geometry.wheelset import LOAD_TOLERANCE
+from fastsim_ros.params import PROFILE_CONTACTS, ParameterError
+from fastsim_ros.pipeline import Pipeline, PipelineConfig
+from fastsim_ros.profile_pipeline import ProfilePipeline
+from msg_adapters.cdr import StampedTwist
+from msg_adapters.profile_msgs import StampedPose, quaternion
+
+MS = 1_000_000
+SPEED, R0 = 2.0, 0.46
+
+
+def _config(**over):
+    values = {"patch_source": "profiles", "wheel_load": 1e4, "shear_modulus": 82e9,
+              "poisson_ratio": 0.28, **over}
+    return PipelineConfig.from_values(values)
+
+
+def _twist(stamp, *, roll=0.0, yaw=0.0, speed=SPEED, spin=None):
+    rot = rotation(roll, yaw)
+    v = rot.T @ np.array([speed, 0.0, 0.0])
+    w = (0.0, speed / R0 if spin is None else spin, 0.0)
+    return StampedTwist(stamp, "wheelset", tuple(float(c) for c in v), w)
+
+
+def _pose(stamp, dy, yaw=0.0, roll=0.0, dz=0.0, frame="track"):
+    return StampedPose(stamp, frame, (0.0, dy, dz), quaternion(roll, yaw))
+
+
+def _vertical_force(outcome, pose_roll=0.0, pose_yaw=0.0):
+    f = outcome.forces
+    w = outcome.frame.to_wheelset((f.fx, f.fy, f.n))
+    return float((rotation(pose_roll, pose_yaw) @ np.asarray(w))[2])
+
+
+@pytest.fixture(scope="module")
+def served():
+    """One pose, 10 kN per wheel from the parameter, shifted 3 mm right and yawed."""
+    p = ProfilePipeline(_config())
+    p.on_wheel_twist(_twist(0, roll=-2e-4, yaw=-7.2e-3))
+    cycle = p.on_pose(_pose(1 * MS, -3e-3, yaw=-7.2e-3, roll=-2e-4))
+    return p, cycle
+
+
+def test_a_pose_gives_every_contact_a_wrench_and_the_loads_balance(served):
+    p, cycle = served
+    by = {o.contact: o for o in cycle.outcomes}
+    assert tuple(by) == PROFILE_CONTACTS
+    assert by["left"].status == by["right"].status == "solved"
+    # one patch per wheel here: the second names publish zero wrenches
+    assert by["left_flange"].status == by["right_flange"].status == "no_contact"
+    # the rig cycle is complete once: one wheelset wrench, from the last contact
+    wrenches = [o.wheelset for o in cycle.outcomes if o.wheelset is not None]
+    assert len(wrenches) == 1
+    # this roll is not the loads' equilibrium: each wheel carries its load at its own
+    # height (CONTACT's half wheelsets), micrometres apart, and both are expressed in the
+    # frame at their mean height; the loads hold to the creep force that difference makes
+    for side in ("left", "right"):
+        assert _vertical_force(by[side], -2e-4, -7.2e-3) == pytest.approx(1e4, rel=1e-4)
+
+
+def test_on_a_centred_pose_each_wheel_carries_its_load_exactly():
+    # symmetric: both wheels at one height, the balance holds to its tolerance
+    p = ProfilePipeline(_config())
+    p.on_wheel_twist(_twist(0))
+    cycle = p.on_pose(_pose(1 * MS, 0.0))
+    by = {o.contact: o for o in cycle.outcomes}
+    for side in ("left", "right"):
+        assert _vertical_force(by[side]) == pytest.approx(1e4, rel=10 * LOAD_TOLERANCE)
+    wrench = next(o.wheelset for o in cycle.outcomes if o.wheelset is not None)
+    assert wrench.force[2] == pytest.approx(2e4, rel=10 * LOAD_TOLERANCE)
+    # mirror symmetry: equal normal loads, lateral forces opposite
+    assert by["left"].forces.n == pytest.approx(by["right"].forces.n, rel=1e-9)
+    # the wheelset shifted right rides on the right flange's side: lateral force to the left
+    assert by["right"].frame.origin[1] < 0.0 < by["left"].frame.origin[1]
+
+
+def test_the_patches_replayed_as_topics_give_the_same_wrenches(served):
+    # what the node publishes on contact/<name>/patch, fed to a topics-mode pipeline
+    p, cycle = served
+    topics = Pipeline(PipelineConfig.from_values({
+        "contacts": list(PROFILE_CONTACTS), "shear_modulus": 82e9, "poisson_ratio": 0.28}))
+    topics.on_wheel_twist(_twist(0, roll=-2e-4, yaw=-7.2e-3))
+    for (name, cloud), outcome in zip(cycle.patches, cycle.outcomes):
+        again = topics.on_patch(name, cloud)
+        assert again.status == outcome.status
+        if outcome.forces is not None:
+            assert again.forces is not None
+            assert (again.forces.fx, again.forces.fy, again.forces.mz, again.forces.n) == \
+                (outcome.forces.fx, outcome.forces.fy, outcome.forces.mz, outcome.forces.n)
+            assert again.creepage == outcome.creepage
+
+
+def test_a_load_message_splits_by_its_roll_moment():
+    p = ProfilePipeline(_config(wheel_load=0.0))
+    b = p.wheelset.placement.wheel_offset
+    # 26 kN with a roll moment putting 16 kN on the left wheel, 10 kN on the right
+    assert p.on_load(StampedTwist(0, "wheelset", (0.0, 0.0, 26e3), (6e3 * b, 0.0, 0.0))) == "ok"
+    p.on_wheel_twist(_twist(0))
+    cycle = p.on_pose(_pose(1 * MS, 0.0))
+    by = {o.contact: o for o in cycle.outcomes}
+    assert cycle.loads == pytest.approx((16e3, 10e3))
+    assert _vertical_force(by["left"]) == pytest.approx(16e3, rel=10 * LOAD_TOLERANCE)
+    assert _vertical_force(by["right"]) == pytest.approx(10e3, rel=10 * LOAD_TOLERANCE)
+
+
+def test_a_load_all_on_one_wheel_lifts_the_other():
+    p = ProfilePipeline(_config(wheel_load=0.0))
+    b = p.wheelset.placement.wheel_offset
+    assert p.on_load(StampedTwist(0, "wheelset", (0.0, 0.0, 1e4), (1e4 * b, 0.0, 0.0))) == "ok"
+    p.on_wheel_twist(_twist(0))
+    by = {o.contact: o for o in p.on_pose(_pose(1 * MS, 0.0)).outcomes}
+    assert by["right"].status == "no_contact" and by["left"].status == "solved"
+    assert _vertical_force(by["left"]) == pytest.approx(1e4, rel=10 * LOAD_TOLERANCE)
+
+
+@pytest.mark.parametrize("load, why", [
+    (StampedTwist(0, "other", (0.0, 0.0, 2e4), (0.0, 0.0, 0.0)), "wrong_frame"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, -2e4), (0.0, 0.0, 0.0)), "nonfinite"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, 2e4), (2e5, 0.0, 0.0)), "nonfinite"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, math.nan), (0.0, 0.0, 0.0)), "nonfinite"),
+])
+def test_bad_loads_are_not_taken(load, why):
+    p = ProfilePipeline(_config(wheel_load=0.0))
+    assert p.on_load(load) == why
+    assert p.wheel_loads(1 * MS) is None
+
+
+def test_without_a_load_the_pose_height_is_used_and_a_lifted_pair_has_no_contact():
+    p = ProfilePipeline(_config(wheel_load=0.0))
+    p.on_wheel_twist(_twist(0))
+    cycle = p.on_pose(_pose(1 * MS, 0.0, dz=1e-3))  # 1 mm above the rails
+    assert [o.status for o in cycle.outcomes] == ["no_contact"] * 4
+    assert all(o.has_wrench for o in cycle.outcomes)
+    # lowered 20 um below touching: the interpenetration carries a load
+    cycle = p.on_pose(_pose(2 * MS, 0.0, dz=-0.218e-3))
+    by = {o.contact: o for o in cycle.outcomes}
+    assert by["left"].status == "solved" and 1e3 < by["left"].forces.n < 1e5
+
+
+def _reasons(cycle):
+    return {o.status for o in cycle.outcomes}
+
+
+def test_bad_poses_are_dropped_for_every_contact_and_the_next_one_served():
+    p = ProfilePipeline(_config())
+    assert _reasons(p.on_pose(_pose(1 * MS, 0.0))) == {"no_kinematics"}
+    p.on_wheel_twist(_twist(2 * MS))
+    assert _reasons(p.on_pose(_pose(3 * MS, 0.0, frame="map"))) == {"wrong_frame"}
+    assert _reasons(p.on_pose(StampedPose(4 * MS, "track", (0.0, math.nan, 0.0),
+                                          (0.0, 0.0, 0.0, 1.0)))) == {"nonfinite"}
+    assert _reasons(p.on_pose(_pose(200 * MS, 0.0))) == {"stale_kinematics"}
+    assert _reasons(p.on_pose(_pose(100 * MS, 0.0))) == {"old_stamp"}
+    p.on_wheel_twist(_twist(201 * MS))
+    # 45 mm to the right: the right flange has climbed its rail
+    assert _reasons(p.on_pose(_pose(202 * MS, -0.045))) == {"derailment"}
+    p.on_wheel_twist(_twist(203 * MS, speed=0.0, spin=0.0))
+    assert _reasons(p.on_pose(_pose(204 * MS, 0.0))) == {"standstill"}
+    p.on_wheel_twist(_twist(205 * MS))
+    good = p.on_pose(_pose(206 * MS, 0.0))
+    assert {o.contact: o.status for o in good.outcomes}["left"] == "solved"
+    report = dict(p.pipeline.report("left").values)
+    for reason in ("no_kinematics", "wrong_frame", "nonfinite", "stale_kinematics",
+                   "old_stamp", "derailment", "standstill"):
+        assert report[f"rejected/{reason}"] == "1", reason
+
+
+def test_a_missing_profile_is_a_parameter_error_naming_the_file(tmp_path):
+    with pytest.raises(ParameterError, match="nothere.prw: cannot read"):
+        ProfilePipeline(_config(wheel_profile=str(tmp_path / "nothere.prw")))
+
+
+def test_profiles_mode_fixes_the_contacts():
+    assert PipelineConfig.from_values({"patch_source": "profiles"}).contacts == PROFILE_CONTACTS
+    with pytest.raises(ParameterError, match="fixed"):
+        PipelineConfig.from_values({"patch_source": "profiles", "contacts": ["front"]})
