@@ -1,0 +1,726 @@
+"""A contact table: the wheelset's patches precomputed over lateral shift and yaw.
+
+The per-pose path (:class:`~fastsim_ros.geometry.wheelset.Wheelset`) solves
+the contact search and the non-Hertzian normal problem for every pose: 20 to
+200 ms, far beyond a 1 kHz loop (TARGETS.md: a pose at most 1 ms median).
+A rig's wheelset moves over a few millimetres and milliradians, so the
+patches are solved once on a grid of nodes ``(dy, yaw)`` and interpolated:
+what multibody codes do with their contact tables (CONTACT's own module 1
+solves each case afresh; the table trades that for speed, and
+``docs/validation_table.md`` measures the price against both).
+
+Assumptions, each stated because the interpolation rests on it:
+
+1. **Kinematic roll.**  At each node the roll is the one at which both
+   rigid wheels touch their rails at one height of the wheelset centre
+   (:func:`levelled_roll`); the elastic approaches of the two wheels differ
+   by micrometres under unequal loads, which moves the roll by about
+   ``1e-5`` rad (a loaded solve's).
+2. **Hertz similarity in the load.**  Each node's patches are solved at a
+   reference wheel load ``L0``; at a load ``L`` a patch is scaled by
+   ``s = (L/L0)^(1/3)`` in its plane, its pressure by ``s`` and its normal
+   force by ``s^3`` (exact for a Hertzian contact, close for the
+   non-Hertzian ones of a worn tread: the report measures it), about its
+   pressure centroid, which stays where the node put it.  With two patches
+   on one wheel both scale alike: their shares of the load are the node's.
+3. **Blending between nodes.**  A patch at a pose between nodes is the
+   weighted blend (bilinear weights in ``dy`` and yaw) of the nodes' matching
+   patches: origin (pressure centroid), normal and load blended linearly, the
+   pressure field the weighted sum of the members' fields each centred on its
+   own centroid (shape interpolation), resampled bilinearly on the blended
+   contact plane and trimmed to the blended number of cells in contact.  A
+   patch present at only some of the nodes fades in with their weights (a
+   flange contact that starts between two nodes grows from zero load).
+4. **Mirror symmetry.**  With the right wheel and rail the mirror images of
+   the left ones and a grid symmetric about ``dy = 0`` and ``yaw = 0``, the
+   right wheel's patches at ``(dy, yaw)`` are the left wheel's at ``(-dy,
+   -yaw)`` mirrored in ``y``; only the left wheel is solved.
+
+The vertical balance with the creep forces (CONTACT's "vertical force
+prescribed") is solved at run time by the caller on the scale ``s^3``
+(:meth:`ContactTable.lookup` returns the blended patches at ``s = 1``;
+:meth:`TablePatch.scaled` scales them).  Poses outside the grid raise
+:class:`TableRangeError` (the node counts ``out_of_table``); a pose next to a
+node where the wheel derailed raises
+:class:`~fastsim_ros.geometry.errors.DerailmentError`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import os
+import tempfile
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
+from fastsim_ros.geometry.placement import Pose
+from fastsim_ros.geometry.wheelset import (MAX_PATCHES, MIN_PATCH_CELLS, SIDES, Side,
+                                           WheelPatch, Wheelset)
+
+FloatArray = NDArray[np.float64]
+
+#: bump when the stored layout or the physics of a node changes: old files are rebuilt
+TABLE_VERSION = 1
+#: patches of neighbouring nodes are the same contact if their pressure centroids lie
+#: within this distance (m) and their normals within this angle (rad): a tread and a
+#: flange contact of one wheel lie 15-40 mm and 0.5-1.2 rad apart
+MATCH_DISTANCE = 6e-3
+MATCH_ANGLE = 0.5
+#: a pose this close to a node (in units of the step) takes that node alone
+NODE_SNAP = 1e-9
+#: the roll that levels both rigid wheels is solved to this height difference (m)
+ROLL_TOLERANCE = 1e-10
+ROLL_ITERATIONS = 60
+
+
+class TableError(GeometryError):
+    """A contact table cannot be built, read or used as asked."""
+
+
+class TableRangeError(TableError):
+    """A pose outside the table's grid (the node's ``out_of_table``)."""
+
+
+# ---------------------------------------------------------------------------- the roll
+
+
+def levelled_roll(wheelset: Wheelset, dy: float, yaw: float, *, start: float = 0.0
+                  ) -> tuple[float, float]:
+    """Return ``(roll, dz)``: the roll at which both rigid wheels touch at one height.
+
+    ``g(roll) = gap_left - gap_right`` (vertical gaps at ``dz = 0``) grows
+    like ``2 b roll`` (``b`` the wheel's lateral offset) on treads; a flange
+    contact bends it.  Secant steps from the geometric first step, kept in a
+    bracket once one is found (Illinois).  ``dz = -gap``: the wheelset
+    lowered until both wheels touch.  Raises
+    :class:`~fastsim_ros.geometry.errors.NoContactError` if no roll within
+    0.1 rad levels them.
+    """
+    b = wheelset.placement.wheel_offset
+
+    def mismatch(roll: float) -> tuple[float, float]:
+        pose = Pose(dy=dy, yaw=yaw, roll=roll)
+        left = wheelset.vertical_gap("left", pose)
+        right = wheelset.vertical_gap("right", pose)
+        return left - right, left
+
+    r0 = start
+    g0, gap0 = mismatch(r0)
+    if abs(g0) <= ROLL_TOLERANCE:
+        return r0, -gap0
+    r1 = r0 - g0 / (2.0 * b)
+    bracket: tuple[float, float] | None = None   # the last point on the other side of the root
+    for _ in range(ROLL_ITERATIONS):
+        if not abs(r1) <= 0.1:
+            raise NoContactError(f"no roll within 0.1 rad levels both wheels at dy={dy:.6g} m, "
+                                 f"yaw={yaw:.6g} rad")
+        g1, gap1 = mismatch(r1)
+        if abs(g1) <= ROLL_TOLERANCE:
+            return r1, -gap1
+        if bracket is None and g0 * g1 < 0.0:
+            bracket = (r0, g0)
+        if bracket is None:
+            # secant outside a bracket: a flange bends g(roll), but it stays monotone
+            r_next = r1 - g1 * (r1 - r0) / (g1 - g0) if g1 != g0 else r1 - g1 / (2.0 * b)
+        else:
+            # Illinois: regula falsi on the bracket, the end kept twice running halved
+            ra, ga = bracket
+            if g1 * g0 < 0.0 and (r0, g0) != bracket:
+                ra, ga = r0, g0
+            elif (r0, g0) != bracket:
+                ga *= 0.5
+            bracket = (ra, ga)
+            if abs(r1 - ra) <= 1e-15:
+                return r1, -gap1
+            r_next = r1 - g1 * (r1 - ra) / (g1 - ga)
+        r0, g0 = r1, g1
+        r1 = r_next
+    raise NoContactError(f"the levelling roll did not converge at dy={dy:.6g} m, "
+                         f"yaw={yaw:.6g} rad")
+
+
+# ---------------------------------------------------------------------------- patches
+
+
+@dataclass(frozen=True, eq=False)
+class TablePatch:
+    """One patch of one wheel at a node, in the wheelset frame (m, Pa, N).
+
+    ``origin``: the pressure centroid; ``normal``: the contact plane's unit
+    normal pointing into the wheel; ``u``, ``v``: the grid's in-plane unit
+    axes; cell ``(j, i)`` lies at ``origin + (a0 + i da) u + (b0 + j db) v``
+    with ``pressure[j, i]``; ``load``: ``sum p da db``; ``approach``: the
+    rigid approach of the normal solve (m).
+    """
+
+    origin: FloatArray
+    normal: FloatArray
+    u: FloatArray
+    v: FloatArray
+    a0: float
+    b0: float
+    da: float
+    db: float
+    pressure: FloatArray
+    load: float
+    approach: float
+
+    @classmethod
+    def of(cls, patch: WheelPatch) -> TablePatch:
+        """Return a solved wheel patch (its ``points`` in the wheelset frame) as a table patch."""
+        pts, p = patch.points, patch.pressure
+        ny, nx = p.shape
+        normal = np.asarray(patch.normal, dtype=float)
+        normal = normal / np.linalg.norm(normal)
+        u = pts[0, 1] - pts[0, 0] if nx > 1 else _in_plane((1.0, 0.0, 0.0), normal)
+        u = u / np.linalg.norm(u)
+        v = np.cross(normal, u)
+        if ny > 1 and float(np.dot(pts[1, 0] - pts[0, 0], v)) < 0.0:
+            # rows that run against n x u (the right wheel's side frame): turn them round,
+            # so that every table patch is right-handed (u, v, normal)
+            pts, p = pts[::-1], p[::-1]
+        total = float(p.sum())
+        origin = np.tensordot(p, pts, axes=2) / total
+        rel = pts[0, 0] - origin
+        return cls(origin, normal, u, v, float(rel @ u), float(rel @ v), float(patch.grid.dx),
+                   float(patch.grid.ds), np.ascontiguousarray(p, dtype=float),
+                   float(patch.load), float(patch.approach))
+
+    @property
+    def cells(self) -> int:
+        """Return the cells in contact."""
+        return int(np.count_nonzero(self.pressure > 0.0))
+
+    def mirrored(self) -> TablePatch:
+        """Return the patch mirrored in the wheelset's ``y`` (the other wheel's)."""
+        m = np.array([1.0, -1.0, 1.0])
+        # the mirror turns the frame left-handed: v is turned round with the rows, so the
+        # grid stays right-handed (cell j of the mirror is row nb-1-j of the original)
+        nb = self.pressure.shape[0]
+        return replace(self, origin=self.origin * m, normal=self.normal * m, u=self.u * m,
+                       v=-(self.v * m), b0=-(self.b0 + (nb - 1) * self.db),
+                       pressure=np.ascontiguousarray(self.pressure[::-1]))
+
+    def scaled(self, s: float) -> TablePatch:
+        """Return the patch under Hertz similarity: sizes times ``s``, pressure times ``s``."""
+        if s == 1.0:
+            return self
+        return blend([(1.0, self)], scale=s)
+
+    def cloud_arrays(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Return ``points, normal, pressure`` of the patch cloud (wheelset frame).
+
+        Rows run along the contact frame's ``y = z x x`` with ``x`` the
+        wheelset's ``x`` projected on the plane (the adapter's frame), so a
+        patch of either wheel reads like a rig's.
+        """
+        ex = _in_plane((1.0, 0.0, 0.0), self.normal)
+        if abs(float(ex @ self.u)) < 1.0 - 1e-9 or float(np.dot(np.cross(self.normal, self.u),
+                                                                  self.v)) < 0.0:
+            return blend([(1.0, self)]).cloud_arrays()
+        ny, nx = self.pressure.shape
+        a = self.a0 + self.da * np.arange(nx)
+        b = self.b0 + self.db * np.arange(ny)
+        points = (self.origin[None, None, :] + a[None, :, None] * self.u[None, None, :]
+                  + b[:, None, None] * self.v[None, None, :])
+        return points, self.normal, self.pressure
+
+    def vertical_normal_force(self, rotation: FloatArray) -> float:
+        """Return the normal force's vertical component in the track frame (N)."""
+        return self.load * float((rotation @ self.normal)[2])
+
+
+def _in_plane(vector: tuple[float, float, float] | FloatArray, normal: FloatArray) -> FloatArray:
+    """Return ``vector`` projected on the plane of ``normal``, normalised."""
+    w = np.asarray(vector, dtype=float)
+    w = w - float(w @ normal) * normal
+    return w / np.linalg.norm(w)
+
+
+@numba.njit(cache=True, nogil=True)
+def _gather(out: FloatArray, x0: float, s0: float, h: float, pressure: FloatArray, a0: float,
+            b0: float, da: float, db: float, m00: float, m01: float, m10: float, m11: float,
+            factor: float) -> None:  # pragma: no cover - compiled
+    """Add ``factor`` times a member's pressure, bilinearly sampled, to ``out``.
+
+    Output cell ``(j, i)`` lies at ``(x0 + i h, s0 + j h)`` in the blended
+    frame; ``m`` maps those coordinates to the member's ``(a, b)`` (its own
+    grid coordinates about its centroid, divided by the scale).
+    """
+    ns, nx = out.shape
+    nb, na = pressure.shape
+    for j in range(ns):
+        s = s0 + j * h
+        for i in range(nx):
+            x = x0 + i * h
+            fa = (m00 * x + m01 * s - a0) / da
+            fb = (m10 * x + m11 * s - b0) / db
+            ia = int(math.floor(fa))
+            ib = int(math.floor(fb))
+            if ia < -1 or ib < -1 or ia >= na or ib >= nb:
+                continue
+            ta = fa - ia
+            tb = fb - ib
+            acc = 0.0
+            if ib >= 0:
+                if ia >= 0:
+                    acc += (1.0 - ta) * (1.0 - tb) * pressure[ib, ia]
+                if ia + 1 < na:
+                    acc += ta * (1.0 - tb) * pressure[ib, ia + 1]
+            if ib + 1 < nb:
+                if ia >= 0:
+                    acc += (1.0 - ta) * tb * pressure[ib + 1, ia]
+                if ia + 1 < na:
+                    acc += ta * tb * pressure[ib + 1, ia + 1]
+            out[j, i] += factor * acc
+
+
+def blend(members: Sequence[tuple[float, TablePatch]], *, scale: float = 1.0,
+          fade: float = 1.0) -> TablePatch:
+    """Return the blend of matching patches (assumption 3), scaled by ``scale`` (assumption 2).
+
+    ``members``: ``(weight, patch)`` with weights summing to one; ``fade``:
+    the share of the nodes that have this patch (the blended load and cells
+    are multiplied by it).  The result lies in the contact frame of the
+    adapter (``u`` the wheelset's ``x`` projected), its load
+    ``fade s^3 sum w L``, its cells ``round(fade s^2 sum w cells)`` (the
+    largest of the resampled field: bilinear resampling spreads an edge by a
+    cell), its pressure centroid exactly the blended origin.
+    """
+    origin = sum((w * p.origin for w, p in members), np.zeros(3))
+    normal = sum((w * p.normal for w, p in members), np.zeros(3))
+    normal = normal / np.linalg.norm(normal)
+    u = _in_plane((1.0, 0.0, 0.0), normal)
+    v = np.cross(normal, u)
+    h = min(min(p.da, p.db) for _, p in members)
+    load = fade * scale ** 3 * sum(w * p.load for w, p in members)
+    cells = max(1, round(fade * scale ** 2 * sum(w * p.cells for w, p in members)))
+    # each member's frame onto the blended one: (x, s) = s * (a (u_k.u, u_k.v) + b (v_k.u, v_k.v))
+    maps = []
+    lo_x = lo_s = math.inf
+    hi_x = hi_s = -math.inf
+    for w, p in members:
+        fwd = np.array([[p.u @ u, p.v @ u], [p.u @ v, p.v @ v]]) * scale
+        nb, na = p.pressure.shape
+        corners = np.array([[p.a0, p.b0], [p.a0 + (na - 1) * p.da, p.b0],
+                            [p.a0, p.b0 + (nb - 1) * p.db],
+                            [p.a0 + (na - 1) * p.da, p.b0 + (nb - 1) * p.db]]) @ fwd.T
+        lo_x, hi_x = min(lo_x, corners[:, 0].min()), max(hi_x, corners[:, 0].max())
+        lo_s, hi_s = min(lo_s, corners[:, 1].min()), max(hi_s, corners[:, 1].max())
+        maps.append((w, p, np.linalg.inv(fwd)))
+    x0 = math.floor(lo_x / h) * h - h
+    s0 = math.floor(lo_s / h) * h - h
+    nx = int(math.ceil((hi_x - x0) / h)) + 2
+    ns = int(math.ceil((hi_s - s0) / h)) + 2
+    field = np.zeros((ns, nx))
+    for w, p, inv in maps:
+        _gather(field, x0, s0, h, p.pressure, p.a0, p.b0, p.da, p.db, float(inv[0, 0]),
+                float(inv[0, 1]), float(inv[1, 0]), float(inv[1, 1]), w * scale)
+    flat = field.ravel()
+    positive = int(np.count_nonzero(flat > 0.0))
+    if positive > cells:
+        # keep the largest cells: the resampling's spread edge is what is dropped
+        cut = np.partition(flat, flat.size - cells)[flat.size - cells]
+        keep = flat >= cut
+        if int(np.count_nonzero(keep)) > cells:   # ties at the cut: keep the first ones
+            order = np.flatnonzero(keep)
+            drop = order[np.argsort(flat[order], kind="stable")][:order.size - cells]
+            keep[drop] = False
+        flat[~keep] = 0.0
+    total = float(field.sum())
+    if total <= 0.0:
+        raise TableError("a blended patch came out empty")
+    field *= load / (total * h * h)
+    # the centroid of the kept cells is the blended origin: shift the grid onto it
+    xs = x0 + h * np.arange(nx)
+    ss = s0 + h * np.arange(ns)
+    weight = field.sum()
+    cx = float(field.sum(axis=0) @ xs / weight)
+    cs = float(field.sum(axis=1) @ ss / weight)
+    rows = np.flatnonzero(field.any(axis=1))
+    cols = np.flatnonzero(field.any(axis=0))
+    j0, j1 = max(0, int(rows[0]) - 1), min(ns, int(rows[-1]) + 2)
+    i0, i1 = max(0, int(cols[0]) - 1), min(nx, int(cols[-1]) + 2)
+    cropped = np.ascontiguousarray(field[j0:j1, i0:i1])
+    approach = scale ** 2 * sum(w * p.approach for w, p in members)
+    return TablePatch(origin, normal, u, v, x0 + i0 * h - cx, s0 + j0 * h - cs, h, h, cropped,
+                      load, approach)
+
+
+def match(groups: list[list[tuple[float, TablePatch]]], weight: float,
+          patches: Sequence[TablePatch]) -> None:
+    """Add a node's patches to the groups of matching patches (assumption 3)."""
+    for p in patches:
+        best, best_d = None, MATCH_DISTANCE
+        for g in groups:
+            ref = g[0][1]
+            d = float(np.linalg.norm(p.origin - ref.origin))
+            angle = math.acos(max(-1.0, min(1.0, float(p.normal @ ref.normal))))
+            if d <= best_d and angle <= MATCH_ANGLE and all(q is not p for _, q in g):
+                best, best_d = g, d
+        if best is None:
+            groups.append([(weight, p)])
+        else:
+            best.append((weight, p))
+
+
+# ---------------------------------------------------------------------------- the table
+
+
+@dataclass(frozen=True)
+class TableGrid:
+    """The nodes: lateral shifts ``dys`` (m) and yaws ``yaws`` (rad), both increasing."""
+
+    dys: tuple[float, ...]
+    yaws: tuple[float, ...]
+
+    @classmethod
+    def regular(cls, dy_min: float, dy_max: float, dy_step: float, yaw_max: float,
+                yaw_step: float) -> TableGrid:
+        """Return the grid ``dy_min..dy_max`` by ``dy_step``, ``-yaw_max..yaw_max`` by ``yaw_step``.
+
+        A step that does not divide its range is refused: the nodes must
+        fall on the range's ends (and on zero, for the mirror).
+        """
+        def axis(lo: float, hi: float, step: float, name: str) -> tuple[float, ...]:
+            if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(step)
+                    and step > 0.0 and hi >= lo):
+                raise TableError(f"table {name}: a range lo <= hi and a step > 0, got "
+                                 f"{lo!r}..{hi!r} by {step!r}")
+            n = (hi - lo) / step
+            if abs(n - round(n)) > 1e-6 or round(n) > 2000:
+                raise TableError(f"table {name}: the step {step:g} must divide the range "
+                                 f"{lo:g}..{hi:g} (at most 2000 steps)")
+            k = np.arange(round(n) + 1)
+            return tuple(float(v) for v in lo + k * (hi - lo) / max(round(n), 1))
+
+        dys = axis(dy_min, dy_max, dy_step, "dy")
+        yaws = axis(-yaw_max, yaw_max, yaw_step, "yaw") if yaw_max > 0.0 else (0.0,)
+        return cls(dys, yaws)
+
+    @property
+    def symmetric(self) -> bool:
+        """Return whether the grid is its own mirror image (``-dy``, ``-yaw`` are nodes)."""
+        return (np.allclose(self.dys, [-d for d in reversed(self.dys)], rtol=0.0, atol=1e-12)
+                and np.allclose(self.yaws, [-y for y in reversed(self.yaws)], rtol=0.0,
+                                atol=1e-12))
+
+    def nodes(self) -> list[tuple[float, float]]:
+        """Return every node ``(dy, yaw)``, yaw fastest."""
+        return [(d, y) for d in self.dys for y in self.yaws]
+
+    def weights(self, dy: float, yaw: float) -> list[tuple[int, int, float]]:
+        """Return the bilinear weights ``(i_dy, i_yaw, w)`` of a pose, largest first."""
+        out: list[tuple[int, int, float]] = []
+        for_dy = _axis_weights(self.dys, dy, "dy")
+        for_yaw = _axis_weights(self.yaws, yaw, "yaw")
+        for i, wi in for_dy:
+            for j, wj in for_yaw:
+                if wi * wj > 0.0:
+                    out.append((i, j, wi * wj))
+        out.sort(key=lambda t: -t[2])
+        return out
+
+
+def _axis_weights(nodes: tuple[float, ...], value: float, name: str) -> list[tuple[int, float]]:
+    if len(nodes) == 1:
+        if abs(value - nodes[0]) > 1e-12:
+            raise TableRangeError(f"{name} {value:.6g} outside the table (only {nodes[0]:g})")
+        return [(0, 1.0)]
+    lo, hi = nodes[0], nodes[-1]
+    step = (hi - lo) / (len(nodes) - 1)
+    if not lo - NODE_SNAP * step <= value <= hi + NODE_SNAP * step:
+        raise TableRangeError(f"{name} {value:.6g} outside the table's {lo:.6g}..{hi:.6g}")
+    f = (value - lo) / step
+    k = min(max(int(math.floor(f)), 0), len(nodes) - 2)
+    t = f - k
+    if t <= NODE_SNAP:
+        return [(k, 1.0)]
+    if t >= 1.0 - NODE_SNAP:
+        return [(k + 1, 1.0)]
+    return [(k, 1.0 - t), (k + 1, t)]
+
+
+@dataclass(frozen=True, eq=False)
+class TableNode:
+    """One node: its roll (rad), its loaded height (m, the left wheel's) and both wheels' patches.
+
+    ``derailed``: the wheelset cannot stand there (no roll levels it, a
+    wheel past its flange): poses next to it are refused.
+    """
+
+    roll: float
+    dz: float
+    patches: tuple[tuple[TablePatch, ...], tuple[TablePatch, ...]]
+    derailed: bool = False
+
+
+#: one contact of a wheel at a pose: the matching node patches with their normalised
+#: weights, and the fade (the weight of the nodes that have it)
+Group = tuple[tuple[tuple[float, TablePatch], ...], float]
+
+
+@dataclass(frozen=True, eq=False)
+class TableLookup:
+    """A pose from the table: the roll (rad) and each wheel's contacts (tread first)."""
+
+    roll: float
+    groups: tuple[tuple[Group, ...], tuple[Group, ...]]
+
+    def patches(self, side: Side, scale: float = 1.0) -> list[TablePatch]:
+        """Return one wheel's patches at the load scale ``s`` (assumptions 2 and 3)."""
+        out = []
+        for members, fade in self.groups[SIDES.index(side)]:
+            if scale == 1.0 and fade == 1.0 and len(members) == 1:
+                out.append(members[0][1])   # on a node: the node's own patch
+            else:
+                out.append(blend(members, scale=scale, fade=fade))
+        return out
+
+    def vertical_normal_force(self, side: Side, rotation: FloatArray) -> float:
+        """Return the wheel's normal forces' vertical sum in the track frame at ``s = 1`` (N).
+
+        The blend's load and normal are those of :func:`blend` without its
+        resampling, so the vertical balance's scale comes without a solve.
+        """
+        total = 0.0
+        for members, fade in self.groups[SIDES.index(side)]:
+            normal = sum((w * p.normal for w, p in members), np.zeros(3))
+            normal = normal / np.linalg.norm(normal)
+            total += fade * sum(w * p.load for w, p in members) * float((rotation @ normal)[2])
+        return total
+
+
+def solve_node(wheelset: Wheelset, load: float, dy: float, yaw: float,
+               sides: Sequence[Side] = SIDES) -> TableNode:
+    """Solve one node: the levelling roll, then each wheel at the reference ``load`` (N)."""
+    try:
+        roll, dz = levelled_roll(wheelset, dy, yaw)
+        pose = Pose(dy=dy, dz=dz, yaw=yaw, roll=roll)
+        out: list[tuple[TablePatch, ...]] = [(), ()]
+        for side in sides:
+            wheel = wheelset.wheel_loaded(side, pose, load)
+            patches = sorted(wheel.patches, key=lambda p: -p.region.reference[1])
+            # each patch in the wheelset frame of its own loaded height (the rigid approach
+            # lowers the wheelset by 15-40 um, which moves the rolling radius, hence xi)
+            out[SIDES.index(side)] = tuple(TablePatch.of(p) for p in patches)
+            dz = wheel.dz if side == "left" else dz
+        return TableNode(roll, dz, (out[0], out[1]))
+    except GeometryError:
+        return TableNode(0.0, 0.0, ((), ()), derailed=True)
+
+
+def _solve_nodes(args: tuple[Wheelset, float, list[tuple[float, float]], tuple[Side, ...]]
+                 ) -> list[TableNode]:
+    wheelset, load, nodes, sides = args
+    return [solve_node(wheelset, load, dy, yaw, sides) for dy, yaw in nodes]
+
+
+class ContactTable:
+    """The wheelset's patches on a grid of ``(dy, yaw)`` at a reference wheel load."""
+
+    def __init__(self, grid: TableGrid, load: float, nodes: Sequence[TableNode]) -> None:
+        if len(nodes) != len(grid.dys) * len(grid.yaws):
+            raise TableError("the table's nodes do not fill its grid")
+        self.grid = grid
+        self.load = float(load)
+        self.nodes = tuple(nodes)
+
+    @classmethod
+    def build(cls, wheelset: Wheelset, grid: TableGrid, load: float, *, workers: int = 1,
+              progress: Callable[[int, int], None] | None = None) -> ContactTable:
+        """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 4).
+
+        ``load``: the reference wheel load (N).  ``progress(done, total)``
+        is called as chunks finish.
+        """
+        if not (math.isfinite(load) and load > 0.0):
+            raise TableError(f"a contact table needs a reference wheel load > 0 N, got {load!r}")
+        mirror = wheelset.symmetric and grid.symmetric
+        sides: tuple[Side, ...] = ("left",) if mirror else SIDES
+        nodes = grid.nodes()
+        chunks = [nodes[k:k + 8] for k in range(0, len(nodes), 8)]
+        solved: list[TableNode] = []
+        if workers > 1 and len(chunks) > 1:
+            import multiprocessing
+            # spawn, not fork: the node may hold DDS threads that a fork would copy half-alive
+            ctx = multiprocessing.get_context("spawn")
+            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+                for part in pool.map(_solve_nodes, [(wheelset, load, c, sides) for c in chunks]):
+                    solved.extend(part)
+                    if progress:
+                        progress(len(solved), len(nodes))
+        else:
+            for c in chunks:
+                solved.extend(_solve_nodes((wheelset, load, c, sides)))
+                if progress:
+                    progress(len(solved), len(nodes))
+        if mirror:
+            n_dy, n_yaw = len(grid.dys), len(grid.yaws)
+            full = []
+            for k, node in enumerate(solved):
+                i, j = divmod(k, n_yaw)
+                twin = solved[(n_dy - 1 - i) * n_yaw + (n_yaw - 1 - j)]
+                right = tuple(p.mirrored() for p in twin.patches[0])
+                full.append(TableNode(node.roll, node.dz, (node.patches[0], right),
+                                      node.derailed or twin.derailed))
+            solved = full
+        return cls(grid, load, solved)
+
+    def node(self, i_dy: int, i_yaw: int) -> TableNode:
+        """Return the node at grid indices ``(i_dy, i_yaw)``."""
+        return self.nodes[i_dy * len(self.grid.yaws) + i_yaw]
+
+    def lookup(self, dy: float, yaw: float) -> TableLookup:
+        """Return the roll and both wheels' blended patches at ``(dy, yaw)`` (reference load).
+
+        Each patch comes with its fade (its nodes' share of the weight).
+        Raises :class:`TableRangeError` outside the grid and
+        :class:`~fastsim_ros.geometry.errors.DerailmentError` next to a
+        derailed node.
+        """
+        weights = self.grid.weights(dy, yaw)
+        nodes = [(w, self.node(i, j)) for i, j, w in weights]
+        if any(n.derailed for _, n in nodes):
+            raise DerailmentError(f"the wheelset derails near dy={dy:.6g} m, yaw={yaw:.6g} rad "
+                                  "(a table node)")
+        roll = sum(w * n.roll for w, n in nodes)
+        sides = []
+        for k in range(2):
+            groups: list[list[tuple[float, TablePatch]]] = []
+            for w, n in nodes:
+                match(groups, w, n.patches[k])
+            kept: list[tuple[Group, float, float]] = []
+            for g in groups:
+                fade = sum(w for w, _ in g)
+                members = tuple((w / fade, p) for w, p in g)
+                if fade * sum(w * p.cells for w, p in members) < MIN_PATCH_CELLS:
+                    continue   # a contact fading in below the smallest patch
+                y = sum(w * float(p.origin[1]) for w, p in members)
+                kept.append(((members, fade), fade * sum(w * p.load for w, p in members), y))
+            kept.sort(key=lambda t: -t[1])
+            kept = kept[:MAX_PATCHES]
+            # tread first: the field side, the larger |y| in the wheelset frame
+            kept.sort(key=lambda t: -abs(t[2]))
+            sides.append(tuple(t[0] for t in kept))
+        return TableLookup(roll, (sides[0], sides[1]))
+
+    # ------------------------------------------------------------------ files
+
+    def save(self, path: Path, key: str) -> None:
+        """Write the table to ``path`` (``.npz``) atomically, with its ``key``."""
+        meta, floats, pressure = [], [], []
+        offset = 0
+        for k, node in enumerate(self.nodes):
+            for side in range(2):
+                for p in node.patches[side]:
+                    nb, na = p.pressure.shape
+                    meta.append((k, side, nb, na, offset))
+                    offset += nb * na
+                    floats.append(np.concatenate([p.origin, p.normal, p.u, p.v,
+                                                  [p.a0, p.b0, p.da, p.db, p.load, p.approach]]))
+                    pressure.append(p.pressure.ravel())
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".part.npz")
+        try:
+            with os.fdopen(fd, "wb") as f:
+                np.savez(f, version=np.array(TABLE_VERSION), key=np.array(key),
+                         dys=np.array(self.grid.dys), yaws=np.array(self.grid.yaws),
+                         load=np.array(self.load),
+                         nodes=np.array([(n.roll, n.dz, float(n.derailed)) for n in self.nodes]),
+                         meta=np.array(meta, dtype=np.int64).reshape(-1, 5),
+                         floats=np.array(floats, dtype=float).reshape(-1, 18),
+                         pressure=np.concatenate(pressure) if pressure else np.zeros(0))
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
+    @classmethod
+    def read(cls, path: Path, key: str | None = None) -> ContactTable:
+        """Read a table written by :meth:`save`; a wrong version or ``key`` raises TableError."""
+        try:
+            with np.load(path, allow_pickle=False) as f:
+                if int(f["version"]) != TABLE_VERSION:
+                    raise TableError(f"{path}: table version {int(f['version'])}, "
+                                     f"expected {TABLE_VERSION}")
+                if key is not None and str(f["key"]) != key:
+                    raise TableError(f"{path}: made for other profiles or parameters")
+                grid = TableGrid(tuple(float(v) for v in f["dys"]),
+                                 tuple(float(v) for v in f["yaws"]))
+                load = float(f["load"])
+                node_rows, meta = f["nodes"], f["meta"]
+                floats, pressure = f["floats"], f["pressure"]
+        except (OSError, KeyError, ValueError) as e:
+            raise TableError(f"{path}: not a contact table ({e})") from None
+        patches: list[tuple[list[TablePatch], list[TablePatch]]] = [
+            ([], []) for _ in range(len(node_rows))]
+        for (k, side, nb, na, off), fl in zip(meta, floats):
+            p = np.array(pressure[off:off + nb * na]).reshape(nb, na)
+            patches[k][side].append(TablePatch(fl[0:3].copy(), fl[3:6].copy(), fl[6:9].copy(),
+                                               fl[9:12].copy(), float(fl[12]), float(fl[13]),
+                                               float(fl[14]), float(fl[15]), p, float(fl[16]),
+                                               float(fl[17])))
+        nodes = [TableNode(float(r), float(z), (tuple(ps[0]), tuple(ps[1])), bool(d))
+                 for (r, z, d), ps in zip(node_rows, patches)]
+        return cls(grid, load, nodes)
+
+
+def table_key(wheelset: Wheelset, grid: TableGrid, load: float) -> str:
+    """Return a digest of everything a table's nodes depend on."""
+    h = hashlib.sha256()
+    h.update(f"v{TABLE_VERSION};{grid.dys!r};{grid.yaws!r};{load!r};{wheelset.cell!r};"
+             f"{wheelset.shear_modulus!r};{wheelset.poisson_ratio!r};{wheelset.separation!r};"
+             f"{wheelset.placement!r}".encode())
+    for side in SIDES:
+        rail, wheel = wheelset.rails[side], wheelset.wheels[side]
+        for a in (rail.y, rail.z, wheel.axial, wheel.radius):
+            h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    return h.hexdigest()[:32]
+
+
+def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Path | None, *,
+                 workers: int | None = None, log: Callable[[str], None] | None = None
+                 ) -> ContactTable:
+    """Return the table from ``cache_dir`` if one was built for these inputs, else build and save it.
+
+    ``workers``: processes for a build (default: the machine's cores when
+    there are at least 200 nodes).
+    """
+    key = table_key(wheelset, grid, load)
+    path = cache_dir / f"contact_table_{key}.npz" if cache_dir is not None else None
+    if path is not None and path.exists():
+        try:
+            return ContactTable.read(path, key)
+        except TableError as e:
+            if log:
+                log(f"contact table: rebuilding, {e}")
+    n = len(grid.dys) * len(grid.yaws)
+    if workers is None:
+        workers = min(os.cpu_count() or 1, 8) if n >= 200 else 1
+    if log:
+        log(f"contact table: solving {n} nodes ({len(grid.dys)} shifts x {len(grid.yaws)} yaws) "
+            f"in {workers} process(es); cached in {path}" if path else "")
+    table = ContactTable.build(wheelset, grid, load, workers=workers)
+    if path is not None:
+        try:
+            table.save(path, key)
+        except OSError as e:
+            if log:
+                log(f"contact table: not cached ({e})")
+    return table
+
+
+__all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "TableError",
+           "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
+           "cached_table", "levelled_roll", "match", "solve_node", "table_key",
+           "Group"]
+
