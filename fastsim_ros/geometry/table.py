@@ -70,10 +70,12 @@ FloatArray = NDArray[np.float64]
 #: bump when the stored layout or the physics of a node changes: old files are rebuilt
 TABLE_VERSION = 1
 #: patches of neighbouring nodes are the same contact if their pressure centroids lie
-#: within this distance (m) and their normals within this angle (rad): a tread and a
-#: flange contact of one wheel lie 15-40 mm and 0.5-1.2 rad apart
-MATCH_DISTANCE = 6e-3
-MATCH_ANGLE = 0.5
+#: within this distance (m) and their normals within this angle (rad).  On S1002/UIC60 the
+#: tread contact runs 10.6 mm for a 1 mm shift near the centre, while the patches of one
+#: wheel lie at least D_SEP (8 mm) apart at their edges and their contact angles differ by
+#: 0.4 rad or more (tread 0.01-0.03, gauge corner 0.4-0.5, flange 1.1-1.2 rad)
+MATCH_DISTANCE = 12e-3
+MATCH_ANGLE = 0.3
 #: a pose this close to a node (in units of the step) takes that node alone
 NODE_SNAP = 1e-9
 #: the roll that levels both rigid wheels is solved to this height difference (m)
@@ -172,6 +174,16 @@ class TablePatch:
     pressure: FloatArray
     load: float
     approach: float
+    cells: int = -1
+    axes: tuple[tuple[float, ...], tuple[float, ...]] = ((), ())
+
+    def __post_init__(self) -> None:
+        if self.cells < 0:
+            object.__setattr__(self, "cells", int(np.count_nonzero(self.pressure > 0.0)))
+        # the axes as plain floats: the blend's arithmetic on them runs per pose, and numpy's
+        # per-call cost on 3-vectors would be most of it
+        object.__setattr__(self, "axes", (tuple(float(c) for c in self.u),
+                                          tuple(float(c) for c in self.v)))
 
     @classmethod
     def of(cls, patch: WheelPatch) -> TablePatch:
@@ -180,9 +192,15 @@ class TablePatch:
         ny, nx = p.shape
         normal = np.asarray(patch.normal, dtype=float)
         normal = normal / np.linalg.norm(normal)
-        u = pts[0, 1] - pts[0, 0] if nx > 1 else _in_plane((1.0, 0.0, 0.0), normal)
-        u = u / np.linalg.norm(u)
-        v = np.cross(normal, u)
+        # the planar grid runs along the wheelset's x projected on the contact plane (the
+        # adapter's contact frame): the table keeps that, so its patches need no resampling
+        u = _in_plane((1.0, 0.0, 0.0), normal)
+        if nx > 1:
+            along = pts[0, 1] - pts[0, 0]
+            if abs(float(along @ u)) < (1.0 - 1e-9) * float(np.linalg.norm(along)):
+                raise TableError("a patch grid not along the wheelset's x projected on its "
+                                 "plane")
+        v = _cross(normal, u)
         if ny > 1 and float(np.dot(pts[1, 0] - pts[0, 0], v)) < 0.0:
             # rows that run against n x u (the right wheel's side frame): turn them round,
             # so that every table patch is right-handed (u, v, normal)
@@ -193,11 +211,6 @@ class TablePatch:
         return cls(origin, normal, u, v, float(rel @ u), float(rel @ v), float(patch.grid.dx),
                    float(patch.grid.ds), np.ascontiguousarray(p, dtype=float),
                    float(patch.load), float(patch.approach))
-
-    @property
-    def cells(self) -> int:
-        """Return the cells in contact."""
-        return int(np.count_nonzero(self.pressure > 0.0))
 
     def mirrored(self) -> TablePatch:
         """Return the patch mirrored in the wheelset's ``y`` (the other wheel's)."""
@@ -222,15 +235,10 @@ class TablePatch:
         wheelset's ``x`` projected on the plane (the adapter's frame), so a
         patch of either wheel reads like a rig's.
         """
-        ex = _in_plane((1.0, 0.0, 0.0), self.normal)
-        if abs(float(ex @ self.u)) < 1.0 - 1e-9 or float(np.dot(np.cross(self.normal, self.u),
-                                                                  self.v)) < 0.0:
-            return blend([(1.0, self)]).cloud_arrays()
         ny, nx = self.pressure.shape
         a = self.a0 + self.da * np.arange(nx)
         b = self.b0 + self.db * np.arange(ny)
-        points = (self.origin[None, None, :] + a[None, :, None] * self.u[None, None, :]
-                  + b[:, None, None] * self.v[None, None, :])
+        points = (self.origin + a[None, :, None] * self.u) + b[:, None, None] * self.v
         return points, self.normal, self.pressure
 
     def vertical_normal_force(self, rotation: FloatArray) -> float:
@@ -283,93 +291,200 @@ def _gather(out: FloatArray, x0: float, s0: float, h: float, pressure: FloatArra
             out[j, i] += factor * acc
 
 
-def blend(members: Sequence[tuple[float, TablePatch]], *, scale: float = 1.0,
-          fade: float = 1.0) -> TablePatch:
-    """Return the blend of matching patches (assumption 3), scaled by ``scale`` (assumption 2).
+@numba.njit(cache=True, nogil=True)
+def _finish(field: FloatArray, cells: int, load: float, h: float, x0: float,
+            s0: float) -> tuple[int, int, int, int, float, float]:  # pragma: no cover - compiled
+    """Keep the ``cells`` largest values, scale the rest to ``load``; return the crop and centroid.
+
+    Returns ``(j0, j1, i0, i1, cx, cs)``: the rows and columns in contact
+    with one empty cell around, and the centroid ``(x, s)`` of the kept
+    field (m, in the field's coordinates).
+    """
+    ns, nx = field.shape
+    flat = field.ravel()
+    positive = 0
+    for k in range(flat.size):
+        if flat[k] > 0.0:
+            positive += 1
+        else:
+            flat[k] = 0.0
+    if positive > cells:
+        cut = np.partition(flat, flat.size - cells)[flat.size - cells]
+        above = 0
+        for k in range(flat.size):
+            if flat[k] > cut:
+                above += 1
+        ties = cells - above   # values equal to the cut that are kept: the first ones
+        for k in range(flat.size):
+            if flat[k] < cut:
+                flat[k] = 0.0
+            elif flat[k] == cut:
+                if ties > 0:
+                    ties -= 1
+                else:
+                    flat[k] = 0.0
+    total = 0.0
+    mx = 0.0
+    ms = 0.0
+    j0, j1, i0, i1 = ns, -1, nx, -1
+    for j in range(ns):
+        for i in range(nx):
+            v = field[j, i]
+            if v > 0.0:
+                total += v
+                mx += v * (x0 + i * h)
+                ms += v * (s0 + j * h)
+                j0 = min(j0, j)
+                j1 = max(j1, j)
+                i0 = min(i0, i)
+                i1 = max(i1, i)
+    if total <= 0.0:
+        return 0, 0, 0, 0, 0.0, 0.0
+    scale = load / (total * h * h)
+    for j in range(ns):
+        for i in range(nx):
+            field[j, i] *= scale
+    return (max(0, j0 - 1), min(ns, j1 + 2), max(0, i0 - 1), min(nx, i1 + 2), mx / total,
+            ms / total)
+
+
+class BlendPlan:
+    """Matching patches ready to blend at any load scale (assumptions 2 and 3).
 
     ``members``: ``(weight, patch)`` with weights summing to one; ``fade``:
     the share of the nodes that have this patch (the blended load and cells
-    are multiplied by it).  The result lies in the contact frame of the
-    adapter (``u`` the wheelset's ``x`` projected), its load
-    ``fade s^3 sum w L``, its cells ``round(fade s^2 sum w cells)`` (the
-    largest of the resampled field: bilinear resampling spreads an edge by a
-    cell), its pressure centroid exactly the blended origin.
+    are multiplied by it).  What does not depend on the scale (the blended
+    frame, each member's map onto it, the bounds) is done once, so that the
+    vertical balance's steps cost the resampling only.
     """
-    origin = sum((w * p.origin for w, p in members), np.zeros(3))
-    normal = sum((w * p.normal for w, p in members), np.zeros(3))
-    normal = normal / np.linalg.norm(normal)
-    u = _in_plane((1.0, 0.0, 0.0), normal)
-    v = np.cross(normal, u)
-    h = min(min(p.da, p.db) for _, p in members)
-    load = fade * scale ** 3 * sum(w * p.load for w, p in members)
-    cells = max(1, round(fade * scale ** 2 * sum(w * p.cells for w, p in members)))
-    # each member's frame onto the blended one: (x, s) = s * (a (u_k.u, u_k.v) + b (v_k.u, v_k.v))
-    maps = []
-    lo_x = lo_s = math.inf
-    hi_x = hi_s = -math.inf
-    for w, p in members:
-        fwd = np.array([[p.u @ u, p.v @ u], [p.u @ v, p.v @ v]]) * scale
-        nb, na = p.pressure.shape
-        corners = np.array([[p.a0, p.b0], [p.a0 + (na - 1) * p.da, p.b0],
-                            [p.a0, p.b0 + (nb - 1) * p.db],
-                            [p.a0 + (na - 1) * p.da, p.b0 + (nb - 1) * p.db]]) @ fwd.T
-        lo_x, hi_x = min(lo_x, corners[:, 0].min()), max(hi_x, corners[:, 0].max())
-        lo_s, hi_s = min(lo_s, corners[:, 1].min()), max(hi_s, corners[:, 1].max())
-        maps.append((w, p, np.linalg.inv(fwd)))
-    x0 = math.floor(lo_x / h) * h - h
-    s0 = math.floor(lo_s / h) * h - h
-    nx = int(math.ceil((hi_x - x0) / h)) + 2
-    ns = int(math.ceil((hi_s - s0) / h)) + 2
-    field = np.zeros((ns, nx))
-    for w, p, inv in maps:
-        _gather(field, x0, s0, h, p.pressure, p.a0, p.b0, p.da, p.db, float(inv[0, 0]),
-                float(inv[0, 1]), float(inv[1, 0]), float(inv[1, 1]), w * scale)
-    flat = field.ravel()
-    positive = int(np.count_nonzero(flat > 0.0))
-    if positive > cells:
-        # keep the largest cells: the resampling's spread edge is what is dropped
-        cut = np.partition(flat, flat.size - cells)[flat.size - cells]
-        keep = flat >= cut
-        if int(np.count_nonzero(keep)) > cells:   # ties at the cut: keep the first ones
-            order = np.flatnonzero(keep)
-            drop = order[np.argsort(flat[order], kind="stable")][:order.size - cells]
-            keep[drop] = False
-        flat[~keep] = 0.0
-    total = float(field.sum())
-    if total <= 0.0:
-        raise TableError("a blended patch came out empty")
-    field *= load / (total * h * h)
-    # the centroid of the kept cells is the blended origin: shift the grid onto it
-    xs = x0 + h * np.arange(nx)
-    ss = s0 + h * np.arange(ns)
-    weight = field.sum()
-    cx = float(field.sum(axis=0) @ xs / weight)
-    cs = float(field.sum(axis=1) @ ss / weight)
-    rows = np.flatnonzero(field.any(axis=1))
-    cols = np.flatnonzero(field.any(axis=0))
-    j0, j1 = max(0, int(rows[0]) - 1), min(ns, int(rows[-1]) + 2)
-    i0, i1 = max(0, int(cols[0]) - 1), min(nx, int(cols[-1]) + 2)
-    cropped = np.ascontiguousarray(field[j0:j1, i0:i1])
-    approach = scale ** 2 * sum(w * p.approach for w, p in members)
-    return TablePatch(origin, normal, u, v, x0 + i0 * h - cx, s0 + j0 * h - cs, h, h, cropped,
-                      load, approach)
+
+    def __init__(self, members: Sequence[tuple[float, TablePatch]], fade: float = 1.0) -> None:
+        self.members = tuple(members)
+        self.fade = fade
+        if len(members) == 1:
+            only = members[0][1]
+            origin, normal, u, v = only.origin, only.normal, only.u, only.v
+        else:
+            origin = np.zeros(3)
+            normal = np.zeros(3)
+            for w, p in members:
+                origin += w * p.origin
+                normal += w * p.normal
+            normal /= math.sqrt(float(normal @ normal))
+            # u: the wheelset's x projected on the plane, v = normal x u
+            n0 = float(normal[0])
+            u = np.array([1.0 - n0 * n0, -n0 * float(normal[1]), -n0 * float(normal[2])])
+            u /= math.sqrt(float(u @ u))
+            v = _cross(normal, u)
+        self.origin, self.normal, self.u, self.v = origin, normal, u, v
+        self.h = min(min(p.da, p.db) for _, p in members)
+        self.load = fade * sum(w * p.load for w, p in members)
+        self.cells = fade * sum(w * p.cells for w, p in members)
+        self.approach = sum(w * p.approach for w, p in members)
+        u0, u1, u2 = float(u[0]), float(u[1]), float(u[2])
+        v0, v1, v2 = float(v[0]), float(v[1]), float(v[2])
+        self.maps = []
+        lo_x = lo_s = math.inf
+        hi_x = hi_s = -math.inf
+        for w, p in members:
+            # the member's (a, b) onto the blend's (x, s) at scale 1
+            (pu0, pu1, pu2), (pv0, pv1, pv2) = p.axes
+            f00 = pu0 * u0 + pu1 * u1 + pu2 * u2
+            f01 = pv0 * u0 + pv1 * u1 + pv2 * u2
+            f10 = pu0 * v0 + pu1 * v1 + pu2 * v2
+            f11 = pv0 * v0 + pv1 * v1 + pv2 * v2
+            nb, na = p.pressure.shape
+            a1, b1 = p.a0 + (na - 1) * p.da, p.b0 + (nb - 1) * p.db
+            # the extremes of a linear map on a box lie at its corners
+            xa, xb = sorted((f00 * p.a0, f00 * a1))
+            xc, xd = sorted((f01 * p.b0, f01 * b1))
+            sa, sb = sorted((f10 * p.a0, f10 * a1))
+            sc, sd = sorted((f11 * p.b0, f11 * b1))
+            lo_x, hi_x = min(lo_x, xa + xc), max(hi_x, xb + xd)
+            lo_s, hi_s = min(lo_s, sa + sc), max(hi_s, sb + sd)
+            det = f00 * f11 - f01 * f10
+            self.maps.append((w, p, f11 / det, -f01 / det, -f10 / det, f00 / det))
+        self.bounds = (lo_x, hi_x, lo_s, hi_s)
+
+    @property
+    def single(self) -> TablePatch | None:
+        """Return the one node patch this plan is, or ``None`` (a blend or a fade)."""
+        return self.members[0][1] if len(self.members) == 1 and self.fade == 1.0 else None
+
+    def at(self, scale: float = 1.0) -> TablePatch:
+        """Return the blended patch at the Hertz scale ``s``.
+
+        Its load is ``fade s^3 sum w L``, its cells ``round(fade s^2 sum w
+        cells)`` (the largest of the resampled field: bilinear resampling
+        spreads an edge by a cell), its pressure centroid exactly the blended
+        origin, its grid along the adapter's contact frame.
+        """
+        single = self.single
+        if scale == 1.0 and single is not None:
+            return single   # on a node: the node's own patch
+        h = self.h
+        lo_x, hi_x, lo_s, hi_s = (scale * b for b in self.bounds)
+        x0 = math.floor(lo_x / h) * h - h
+        s0 = math.floor(lo_s / h) * h - h
+        nx = int(math.ceil((hi_x - x0) / h)) + 2
+        ns = int(math.ceil((hi_s - s0) / h)) + 2
+        field = np.zeros((ns, nx))
+        for w, p, m00, m01, m10, m11 in self.maps:
+            _gather(field, x0, s0, h, p.pressure, p.a0, p.b0, p.da, p.db, m00 / scale,
+                    m01 / scale, m10 / scale, m11 / scale, w * scale)
+        load = self.load * scale ** 3
+        cells = max(1, round(self.cells * scale ** 2))
+        j0, j1, i0, i1, cx, cs = _finish(field, cells, load, h, x0, s0)
+        if j1 <= j0:
+            raise TableError("a blended patch came out empty")
+        cropped = np.ascontiguousarray(field[j0:j1, i0:i1])
+        # the grid shifted so that the kept field's centroid is the blended origin
+        return TablePatch(self.origin, self.normal, self.u, self.v, x0 + i0 * h - cx,
+                          s0 + j0 * h - cs, h, h, cropped, load, scale ** 2 * self.approach)
+
+    def vertical_normal_force(self, rotation: FloatArray) -> float:
+        """Return the blend's normal force's vertical component at scale 1, track frame (N)."""
+        return self.load * float((rotation @ self.normal)[2])
+
+
+def blend(members: Sequence[tuple[float, TablePatch]], *, scale: float = 1.0,
+          fade: float = 1.0) -> TablePatch:
+    """Return the blend of matching patches at the scale ``s`` (see :class:`BlendPlan`)."""
+    return BlendPlan(members, fade).at(scale)
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Return ``a x b`` of two 3-vectors (numpy's cross costs 20 us on these)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
 
 
 def match(groups: list[list[tuple[float, TablePatch]]], weight: float,
           patches: Sequence[TablePatch]) -> None:
-    """Add a node's patches to the groups of matching patches (assumption 3)."""
+    """Add one node's patches to the groups of matching patches (assumption 3).
+
+    Each patch joins the nearest group (distance over MATCH_DISTANCE plus
+    angle over MATCH_ANGLE) within both limits that has no patch of this
+    node yet, else starts a group.
+    """
+    taken: set[int] = set()
     for p in patches:
-        best, best_d = None, MATCH_DISTANCE
-        for g in groups:
+        best, best_cost = -1, math.inf
+        for k, g in enumerate(groups):
+            if k in taken:
+                continue
             ref = g[0][1]
             d = float(np.linalg.norm(p.origin - ref.origin))
             angle = math.acos(max(-1.0, min(1.0, float(p.normal @ ref.normal))))
-            if d <= best_d and angle <= MATCH_ANGLE and all(q is not p for _, q in g):
-                best, best_d = g, d
-        if best is None:
+            cost = d / MATCH_DISTANCE + angle / MATCH_ANGLE
+            if d <= MATCH_DISTANCE and angle <= MATCH_ANGLE and cost < best_cost:
+                best, best_cost = k, cost
+        if best < 0:
             groups.append([(weight, p)])
+            taken.add(len(groups) - 1)
         else:
-            best.append((weight, p))
+            groups[best].append((weight, p))
+            taken.add(best)
 
 
 # ---------------------------------------------------------------------------- the table
@@ -463,40 +578,24 @@ class TableNode:
     derailed: bool = False
 
 
-#: one contact of a wheel at a pose: the matching node patches with their normalised
-#: weights, and the fade (the weight of the nodes that have it)
-Group = tuple[tuple[tuple[float, TablePatch], ...], float]
-
-
 @dataclass(frozen=True, eq=False)
 class TableLookup:
     """A pose from the table: the roll (rad) and each wheel's contacts (tread first)."""
 
     roll: float
-    groups: tuple[tuple[Group, ...], tuple[Group, ...]]
+    groups: tuple[tuple[BlendPlan, ...], tuple[BlendPlan, ...]]
 
     def patches(self, side: Side, scale: float = 1.0) -> list[TablePatch]:
         """Return one wheel's patches at the load scale ``s`` (assumptions 2 and 3)."""
-        out = []
-        for members, fade in self.groups[SIDES.index(side)]:
-            if scale == 1.0 and fade == 1.0 and len(members) == 1:
-                out.append(members[0][1])   # on a node: the node's own patch
-            else:
-                out.append(blend(members, scale=scale, fade=fade))
-        return out
+        return [g.at(scale) for g in self.groups[SIDES.index(side)]]
 
     def vertical_normal_force(self, side: Side, rotation: FloatArray) -> float:
         """Return the wheel's normal forces' vertical sum in the track frame at ``s = 1`` (N).
 
-        The blend's load and normal are those of :func:`blend` without its
-        resampling, so the vertical balance's scale comes without a solve.
+        The blend's load and normal without its resampling, so the vertical
+        balance's first scale comes without a solve.
         """
-        total = 0.0
-        for members, fade in self.groups[SIDES.index(side)]:
-            normal = sum((w * p.normal for w, p in members), np.zeros(3))
-            normal = normal / np.linalg.norm(normal)
-            total += fade * sum(w * p.load for w, p in members) * float((rotation @ normal)[2])
-        return total
+        return sum(g.vertical_normal_force(rotation) for g in self.groups[SIDES.index(side)])
 
 
 def solve_node(wheelset: Wheelset, load: float, dy: float, yaw: float,
@@ -598,18 +697,17 @@ class ContactTable:
             groups: list[list[tuple[float, TablePatch]]] = []
             for w, n in nodes:
                 match(groups, w, n.patches[k])
-            kept: list[tuple[Group, float, float]] = []
+            kept: list[tuple[BlendPlan, float]] = []
             for g in groups:
                 fade = sum(w for w, _ in g)
-                members = tuple((w / fade, p) for w, p in g)
-                if fade * sum(w * p.cells for w, p in members) < MIN_PATCH_CELLS:
+                plan = BlendPlan(tuple((w / fade, p) for w, p in g), fade)
+                if plan.cells < MIN_PATCH_CELLS:
                     continue   # a contact fading in below the smallest patch
-                y = sum(w * float(p.origin[1]) for w, p in members)
-                kept.append(((members, fade), fade * sum(w * p.load for w, p in members), y))
-            kept.sort(key=lambda t: -t[1])
+                kept.append((plan, abs(float(plan.origin[1]))))
+            kept.sort(key=lambda t: -t[0].load)
             kept = kept[:MAX_PATCHES]
             # tread first: the field side, the larger |y| in the wheelset frame
-            kept.sort(key=lambda t: -abs(t[2]))
+            kept.sort(key=lambda t: -t[1])
             sides.append(tuple(t[0] for t in kept))
         return TableLookup(roll, (sides[0], sides[1]))
 
@@ -722,5 +820,5 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
 __all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "TableError",
            "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
            "cached_table", "levelled_roll", "match", "solve_node", "table_key",
-           "Group"]
+           "BlendPlan"]
 
