@@ -153,10 +153,13 @@ def test_the_blend_tends_to_the_node_as_the_pose_nears_it(table, grid):
         errors.append(float(np.linalg.norm(patch.origin - node.origin)))
         assert patch.cells == round((1.0 - t) * node.cells + t * other.cells)
         assert patch.load == pytest.approx((1.0 - t) * node.load + t * other.load, rel=1e-12)
-        # the shape: the resampled field near the node's, pressure for pressure
-        assert patch.pressure.max() == pytest.approx(node.pressure.max(), rel=0.05 + t)
-    assert errors[0] > errors[1] > errors[2]
-    assert errors[2] < 1e-5
+        # the shape: the weighted sum of the fields, so the peak pressure near the weighted
+        # peaks (the members' peaks lie near, not on, one another)
+        peak = (1.0 - t) * node.pressure.max() + t * other.pressure.max()
+        assert patch.pressure.max() == pytest.approx(peak, rel=0.1)
+    # the origin runs along the line between the nodes' (the tread contact runs 10.6 mm here)
+    distance = float(np.linalg.norm(other.origin - node.origin))
+    assert errors == pytest.approx([0.3 * distance, 0.1 * distance, 0.01 * distance], rel=1e-9)
 
 
 def test_hertz_scaling_of_a_patch(table):
