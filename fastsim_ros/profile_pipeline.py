@@ -478,6 +478,7 @@ class ProfilePipeline:
             out: list[Vector] = []
             for wp in patches:
                 try:
+                    patch: ContactPatch | None
                     if isinstance(wp, TablePatch):
                         patch = table_contact_patch(wp, stamp_ns, max_cells=max_cells)
                     else:

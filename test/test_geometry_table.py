@@ -135,8 +135,8 @@ def test_between_nodes_load_roll_and_position_are_the_weighted_means(table, grid
         # the resampled field is trimmed to the blended cells, its centroid on the origin
         assert patch.cells == round(0.25 * pa.cells + 0.75 * pb.cells)
         np.testing.assert_allclose(_centroid(patch), origin, atol=1e-12)
-        assert patch.pressure.sum() * patch.da * patch.db == pytest.approx(patch.load,
-                                                                            rel=1e-12)
+        load = patch.pressure.sum() * patch.da * patch.db
+        assert load == pytest.approx(patch.load, rel=1e-12)
         # the patch lies in the adapter's contact frame (x the wheelset's x projected)
         ex = np.array([1.0, 0.0, 0.0]) - patch.normal[0] * patch.normal
         np.testing.assert_allclose(patch.u, ex / np.linalg.norm(ex), atol=1e-12)

@@ -500,7 +500,7 @@ class TableGrid:
     @classmethod
     def regular(cls, dy_min: float, dy_max: float, dy_step: float, yaw_max: float,
                 yaw_step: float) -> TableGrid:
-        """Return the grid ``dy_min..dy_max`` by ``dy_step``, ``-yaw_max..yaw_max`` by ``yaw_step``.
+        """Return the grid ``dy_min..dy_max`` by ``dy_step``, yaws ``-yaw_max..yaw_max``.
 
         A step that does not divide its range is refused: the nodes must
         fall on the range's ends (and on zero, for the mirror).
@@ -788,7 +788,7 @@ def table_key(wheelset: Wheelset, grid: TableGrid, load: float) -> str:
 def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Path | None, *,
                  workers: int | None = None, log: Callable[[str], None] | None = None
                  ) -> ContactTable:
-    """Return the table from ``cache_dir`` if one was built for these inputs, else build and save it.
+    """Return the table from ``cache_dir`` if built for these inputs, else build and keep it.
 
     ``workers``: processes for a build (default: the machine's cores when
     there are at least 200 nodes).
@@ -821,4 +821,3 @@ __all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "Ta
            "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
            "cached_table", "levelled_roll", "match", "solve_node", "table_key",
            "BlendPlan"]
-
