@@ -447,7 +447,9 @@ class ProfilePipeline:
                 if abs(force - load) <= BALANCE_TOLERANCE * load:
                     break
                 if len(tried) == 1:
-                    u = (load - (force - u * area)) / area
+                    # the creep forces scale about like the load (mu N once sliding):
+                    # T(u) ~ T0 u / u0 makes the second step land within 1e-6 mostly
+                    u = load / (area + (force - u * area) / u)
                 else:
                     (u0, r0, _), (u1, r1, _) = tried[-2], tried[-1]
                     u = u1 - r1 * (u1 - u0) / (r1 - r0) if r1 != r0 else u1 - r1 / area
