@@ -52,7 +52,6 @@ import math
 import os
 import tempfile
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -623,6 +622,58 @@ def _solve_nodes(args: tuple[Wheelset, float, list[tuple[float, float]], tuple[S
     return [solve_node(wheelset, load, dy, yaw, sides) for dy, yaw in nodes]
 
 
+def _solve_in_children(wheelset: Wheelset, load: float,
+                       chunks: list[list[tuple[float, float]]], sides: tuple[Side, ...],
+                       workers: int, progress: Callable[[int, int], None] | None
+                       ) -> list[TableNode]:
+    """Solve the chunks in ``workers`` child interpreters (``python -m ...table_worker``).
+
+    Not multiprocessing: its spawn re-imports the caller's main module (a
+    script without a main guard would start again in each child) and its
+    fork would copy a node's DDS threads half-alive.  Each child takes every
+    ``workers``-th chunk (the flange's costly nodes spread over all) as one
+    pickle on its stdin and answers one pickle on its stdout; a child that
+    fails has its chunks solved here.
+    """
+    import pickle
+    import subprocess
+    import sys
+
+    total = sum(len(c) for c in chunks)
+    shares = [list(range(w, len(chunks), workers)) for w in range(workers)]
+    env = dict(os.environ)
+    # the child finds this package where this process found it
+    root = str(Path(__file__).resolve().parents[2])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [root, env.get("PYTHONPATH", "")]))
+    children = []
+    for share in shares:
+        proc = subprocess.Popen([sys.executable, "-m", "fastsim_ros.geometry.table_worker"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, env=env)
+        assert proc.stdin is not None
+        proc.stdin.write(pickle.dumps((wheelset, load, [chunks[k] for k in share], sides)))
+        proc.stdin.close()
+        children.append((share, proc))
+    results: dict[int, list[TableNode]] = {}
+    done = 0
+    for share, proc in children:
+        assert proc.stdout is not None
+        raw = proc.stdout.read()
+        status = proc.wait()
+        try:
+            parts = pickle.loads(raw) if status == 0 else None
+        except (pickle.UnpicklingError, EOFError, ValueError):
+            parts = None
+        if parts is None or len(parts) != len(share):
+            parts = [_solve_nodes((wheelset, load, chunks[k], sides)) for k in share]
+        for k, part in zip(share, parts):
+            results[k] = part
+            done += len(part)
+        if progress:
+            progress(done, total)
+    return [node for k in range(len(chunks)) for node in results[k]]
+
+
 class ContactTable:
     """The wheelset's patches on a grid of ``(dy, yaw)`` at a reference wheel load."""
 
@@ -647,17 +698,10 @@ class ContactTable:
         sides: tuple[Side, ...] = ("left",) if mirror else SIDES
         nodes = grid.nodes()
         chunks = [nodes[k:k + 8] for k in range(0, len(nodes), 8)]
-        solved: list[TableNode] = []
         if workers > 1 and len(chunks) > 1:
-            import multiprocessing
-            # spawn, not fork: the node may hold DDS threads that a fork would copy half-alive
-            ctx = multiprocessing.get_context("spawn")
-            with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-                for part in pool.map(_solve_nodes, [(wheelset, load, c, sides) for c in chunks]):
-                    solved.extend(part)
-                    if progress:
-                        progress(len(solved), len(nodes))
+            solved = _solve_in_children(wheelset, load, chunks, sides, workers, progress)
         else:
+            solved = []
             for c in chunks:
                 solved.extend(_solve_nodes((wheelset, load, c, sides)))
                 if progress:
