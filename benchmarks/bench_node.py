@@ -95,6 +95,27 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
+def thread_cpu_seconds(pid: int) -> dict[str, float]:
+    """Return user + system CPU seconds of a process's threads, summed by thread name.
+
+    Threads of one name (Fast DDS's receive threads, say) are summed; the
+    main thread is named after the process.
+    """
+    out: dict[str, float] = {}
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        try:
+            text = (task / "stat").read_text()
+        except OSError:  # the thread ended meanwhile
+            continue
+        name = text[text.index("(") + 1:text.rindex(")")]
+        fields = text.rsplit(")", 1)[1].split()
+        if task.name == str(pid):
+            name = "main"
+        out[name] = out.get(name, 0.0) + (int(fields[11]) + int(fields[12])) / os.sysconf(
+            "SC_CLK_TCK")
+    return out
+
+
 def rss_mib(pid: int) -> float:
     """Return a process's resident memory (MiB)."""
     for line in Path(f"/proc/{pid}/status").read_text().splitlines():
@@ -200,7 +221,7 @@ def startup(trials: int) -> None:
 
 
 #: ["--native"]: py-spy samples C and C++ frames too (pausing the process at each sample)
-NATIVE: list[str] = []
+NATIVE: list[str] = ["--native"] if os.environ.get("BENCH_NATIVE") else []
 FLOOR = Path(__file__).resolve().parent / "dds_floor.py"
 
 
@@ -209,6 +230,8 @@ def target_command(target: str, names: list[str], executor: str,
     """Return the command line of the node or of the floor relay serving ``names``."""
     if target == "floor":
         return [sys.executable, str(FLOOR), "--contacts", *names]
+    if target == "floor+solve":
+        return [sys.executable, str(FLOOR), "--solve", "--contacts", *names]
     return [str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",
             "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]", *node_args]
 
@@ -272,6 +295,7 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
                                 "--format", "raw", "--duration", str(int(duration_s)),
                                 "--output", py_spy],
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    threads0 = thread_cpu_seconds(proc.pid)
     cpu0, wall0 = cpu_seconds(proc.pid), time.perf_counter()
     t_next = wall0
     stamp = 1_700_000_000 * 1_000_000_000
@@ -299,6 +323,7 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
             rss.append((now - wall0, rss_mib(proc.pid)))
     wall = time.perf_counter() - wall0
     cpu = cpu_seconds(proc.pid) - cpu0
+    threads = thread_cpu_seconds(proc.pid)
     drain = time.perf_counter()
     while time.perf_counter() - drain < 1.0:
         ex.spin_once(timeout_sec=0.01)
@@ -315,11 +340,17 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
     figures = {"received": 100.0 * got / inputs, "p50": float(np.median(lat)),
                "p99": float(np.percentile(lat, 99)), "cpu": 100.0 * cpu / wall,
                "late": float(late)}
+    # per thread (% of one core): the main thread runs the executor and every callback
+    shares = sorted(((100.0 * (t - threads0.get(name, 0.0)) / wall, name)
+                     for name, t in threads.items()), reverse=True)
+    figures["main"] = next((v for v, name in shares if name == "main"), 0.0)
     print(f"{extra}: {contacts} contacts x {rate:g} Hz for {wall:.1f} s: sent {inputs}, "
           f"wrenches {got}, dropped {inputs - got} ({100.0 * (inputs - got) / inputs:.2f}%), "
           f"latency p50 {figures['p50']:.3f} ms, p99 {figures['p99']:.3f} ms, "
           f"max {lat.max():.3f} ms; {target} CPU {figures['cpu']:.0f}% of one core; "
           f"driver re-anchored {late} times; exit {status}", flush=True)
+    busy = [f"{name} {v:.1f}" for v, name in shares if v >= 0.5]
+    print("  threads (% of a core): " + ", ".join(busy), flush=True)
     if soak:
         first = rss[1][1] if len(rss) > 2 else rss[0][1]
         samples_text = ", ".join(f"{t:.0f}: {m:.1f}" for t, m in rss)
@@ -329,32 +360,40 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
 
 
 def against_floor(contacts: int, rate: float, seconds: float, rounds: int, executor: str,
-                  node_args: list[str]) -> None:
+                  node_args: list[str], bound: bool = False) -> None:
     """Run the node and the floor alternately ``rounds`` times; print medians and ratios.
 
     TARGETS.md (4 x 1 kHz): received share within 0.2 points of the floor's,
-    p99 at most 2x the floor's, CPU at most 1.5x the floor's.
+    p99 at most 2x the floor's, CPU at most 1.5x the floor's.  ``bound``:
+    the floor that also solves a fixed patch per patch (``dds_floor.py
+    --solve``) runs in the rotation too: what the solve alone adds.
     """
-    runs: dict[str, list[dict[str, float]]] = {"node": [], "floor": []}
+    targets = ("node", "floor", "floor+solve") if bound else ("node", "floor")
+    runs: dict[str, list[dict[str, float]]] = {t: [] for t in targets}
     for r in range(rounds):
-        # alternate which goes first, so that a drift of the machine weighs on both
-        order = ("node", "floor") if r % 2 == 0 else ("floor", "node")
+        # rotate which goes first, so that a drift of the machine weighs on all
+        order = targets[r % len(targets):] + targets[:r % len(targets)]
         for target in order:
             runs[target].append(run(contacts, rate, seconds, 0.0, executor, node_args,
                                     target))
-    keys = ("received", "p50", "p99", "cpu")
+    keys = ("received", "p50", "p99", "cpu", "main")
     med = {t: {k: statistics.median(f[k] for f in runs[t]) for k in keys} for t in runs}
     n, f = med["node"], med["floor"]
     print(f"medians of {rounds} alternating runs, {contacts} contacts x {rate:g} Hz, "
           f"{seconds:g} s each:")
-    for t in ("node", "floor"):
+    for t in targets:
         m = med[t]
-        print(f"  {t:5s} received {m['received']:.2f}%, latency p50 {m['p50']:.3f} ms, "
-              f"p99 {m['p99']:.3f} ms, CPU {m['cpu']:.0f}% of one core")
+        print(f"  {t:11s} received {m['received']:.2f}%, latency p50 {m['p50']:.3f} ms, "
+              f"p99 {m['p99']:.3f} ms, CPU {m['cpu']:.0f}% of one core "
+              f"(main thread {m['main']:.0f}%)")
     print(f"  node/floor: received {n['received'] / f['received']:.4f} "
           f"({n['received'] - f['received']:+.2f} points; target >= -0.2), "
           f"p99 {n['p99'] / f['p99']:.2f}x (target <= 2), "
           f"CPU {n['cpu'] / f['cpu']:.2f}x (target <= 1.5)", flush=True)
+    if bound:
+        b = med["floor+solve"]
+        print(f"  floor+solve/floor: received {b['received'] - f['received']:+.2f} points, "
+              f"p99 {b['p99'] / f['p99']:.2f}x, CPU {b['cpu'] / f['cpu']:.2f}x", flush=True)
 
 
 def main() -> None:
@@ -374,7 +413,10 @@ def main() -> None:
                         help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
                         help="first time the per-message path in-process")
-    parser.add_argument("--target", choices=("node", "floor"), default="node",
+    parser.add_argument("--bound", action="store_true",
+                        help="with --floor: the floor that also solves a fixed patch "
+                        "(dds_floor.py --solve) in the rotation too")
+    parser.add_argument("--target", choices=("node", "floor", "floor+solve"), default="node",
                         help="what the single runs drive: the node or the DDS floor")
     parser.add_argument("--py-spy", default=None, metavar="FILE",
                         help="record the target with py-spy (collapsed stacks to FILE)")
@@ -402,7 +444,7 @@ def main() -> None:
         for executor in args.executors:
             if args.floor:
                 against_floor(n, args.rate, args.seconds, args.floor, executor,
-                              shlex.split(args.node_args))
+                              shlex.split(args.node_args), args.bound)
             else:
                 run(n, args.rate, args.seconds, args.soak, executor,
                     shlex.split(args.node_args), args.target, args.py_spy)

@@ -8,6 +8,11 @@ is copied into a pre-serialised ``WrenchStamped`` of that contact, which is
 published as bytes.  ``bench_node.py --floor`` drives it alternately with
 the node and prints node/floor ratios.
 
+``--solve``: the relay also runs the node's MAE solve (``MaeSolver.solve_arrays``)
+on one fixed, already converted 30 x 30-cell patch for every patch it
+answers: the least any node that solves each patch costs on this stack
+(``bench_node.py --floor N --bound`` drives it beside the node and the floor).
+
     .venv/bin/python benchmarks/dds_floor.py --contacts c0 c1 c2 c3
 """
 
@@ -16,6 +21,9 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
 
 import rclpy
 from rclpy.executors import ExternalShutdownException
@@ -35,8 +43,10 @@ STAMP = slice(4, 12)
 class Floor(Node):
     """Answer ``contact/<name>/patch`` with a fixed ``contact/<name>/wrench``, stamp copied."""
 
-    def __init__(self, contacts: Sequence[str], depth: int = 10) -> None:
+    def __init__(self, contacts: Sequence[str], depth: int = 10,
+                 solve: Callable[[], object] | None = None) -> None:
         super().__init__("fastsim_floor")
+        self._solve = solve
         qos_in = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
                             reliability=ReliabilityPolicy.BEST_EFFORT)
         qos_out = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
@@ -49,18 +59,43 @@ class Floor(Node):
             wrench.wrench.force.x, wrench.wrench.force.z = -1000.0, 60000.0
             pub = self.create_publisher(WrenchStamped, f"contact/{name}/wrench", qos_out)
             self.create_subscription(PointCloud2, f"contact/{name}/patch",
-                                     self._answer(pub, bytearray(serialize_message(wrench))),
+                                     self._answer(pub, bytearray(serialize_message(wrench)),
+                                                  solve),
                                      qos_in, raw=True)
 
     def _on_twist(self, raw: bytes) -> None:
         pass
 
     @staticmethod
-    def _answer(pub, wrench: bytearray) -> Callable[[bytes], None]:
-        def callback(raw: bytes) -> None:
+    def _answer(pub, wrench: bytearray,
+                solve: Callable[[], object] | None) -> Callable[[bytes], None]:
+        if solve is None:
+            def callback(raw: bytes) -> None:
+                wrench[STAMP] = raw[STAMP]
+                pub.publish(bytes(wrench))
+            return callback
+
+        def solving(raw: bytes) -> None:
+            solve()
             wrench[STAMP] = raw[STAMP]
             pub.publish(bytes(wrench))
-        return callback
+        return solving
+
+
+def fixed_solve() -> Callable[[], object]:
+    """Return a call of the default solve (mae_calibrated) on a fixed 30 x 30-cell patch."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from fastsim_ros.contact import compiled, samples
+    compiled.warm_up()
+    area = samples.semi_ellipses_patch(0.5, 2.0, cells=30, scale=8e-3, load=6e4)
+    solver = compiled.CalibratedMaeSolver(0.28, 8.0e10)  # the default method
+    pressure = np.ascontiguousarray(area.pressure, dtype=np.float64)
+
+    def solve() -> object:
+        return solver.solve_arrays(pressure, area.x0, area.y0, area.dx, area.dy, 1e-3, 0.0,
+                                   0.0, 0.3, bound="given", tractions=False, friction=None,
+                                   speed=20.0)
+    return solve
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -68,11 +103,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--contacts", nargs="+", default=["left", "right"])
     parser.add_argument("--depth", type=int, default=10, help="QoS depth (the node's qos_depth)")
+    parser.add_argument("--solve", action="store_true",
+                        help="also run the node's solve on a fixed patch for every patch")
     args, ros_args = parser.parse_known_args(argv)
     rclpy.init(args=[sys.argv[0], *ros_args])  # its signal handlers end spin_once
     node = None
     try:
-        node = Floor(args.contacts, args.depth)
+        node = Floor(args.contacts, args.depth, fixed_solve() if args.solve else None)
         executor = EventsExecutor()
         executor.add_node(node)
         while rclpy.ok():  # as the node: spin_once, which returns on SIGTERM

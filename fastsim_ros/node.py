@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import gc
 import importlib
+import math
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -62,6 +63,40 @@ _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
           "string_array": ParameterType.PARAMETER_STRING_ARRAY}
 _MESSAGE_TYPES = {"wrench": WrenchStamped, "creepage": Vector3Stamped, "frame": PoseStamped,
                   "traction": PointCloud2}
+
+
+class ThrottledLog:
+    """A warning at most once per ``period`` (s), checked before any message is built.
+
+    rclpy's own ``throttle_duration_sec`` decides only after it has located
+    its caller (``inspect`` and file-system calls, ~300 us here), for every
+    message it then drops: at kHz rates a run of rejected patches would cost
+    more than solving them.  Here a suppressed warning costs a clock read.
+    """
+
+    __slots__ = ("_logger", "_period", "_next", "suppressed")
+
+    def __init__(self, logger: Any, period: float = 1.0) -> None:
+        self._logger = logger
+        self._period = period
+        self._next = -math.inf
+        self.suppressed = 0
+
+    def due(self) -> bool:
+        """Return whether a warning may go out now (then the next one waits a period)."""
+        now = time.monotonic()
+        if now < self._next:
+            self.suppressed += 1
+            return False
+        self._next = now + self._period
+        return True
+
+    def warning(self, message: str) -> None:
+        """Log ``message``, with how many were suppressed since the last one."""
+        if self.suppressed:
+            message += f" (and {self.suppressed} more in the last {self._period:g} s)"
+            self.suppressed = 0
+        self._logger.warning(message)
 
 
 class StartupError(Exception):
@@ -122,6 +157,7 @@ class FastsimNode(Node):
         # the outputs somebody subscribes to, kept by DDS's matched events: only
         # those are encoded and published (a message to nobody is work for nothing)
         self._wanted: set[str] = set()
+        self._rejections = ThrottledLog(self.get_logger())
         outputs = {f"contact/{c}/{kind}": msgtype for c in config.contacts
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
@@ -189,12 +225,12 @@ class FastsimNode(Node):
             on = (self.pipeline.on_wheel_twist if spec.kind == "wheel_twist"
                   else self.pipeline.on_rail_twist)
             what = "wheelset" if spec.kind == "wheel_twist" else "rail"
+            log = ThrottledLog(self.get_logger())
 
             def kinematics(raw: bytes) -> None:
                 verdict = on(raw)
-                if verdict != "ok":
-                    self.get_logger().warning(f"{what} twist dropped: {verdict}",
-                                              throttle_duration_sec=1.0)
+                if verdict != "ok" and log.due():
+                    log.warning(f"{what} twist dropped: {verdict}")
             return kinematics
         take, publish = spec.take, self._publish
 
@@ -206,8 +242,9 @@ class FastsimNode(Node):
     def _publish(self, outcome: Outcome) -> None:
         """Publish an outcome's messages (CDR bytes), or log why there are none."""
         if not outcome.has_wrench:
-            self.get_logger().warning(f"{outcome.contact}: patch rejected, {outcome.status}: "
-                                      f"{outcome.detail}", throttle_duration_sec=1.0)
+            if self._rejections.due():
+                self._rejections.warning(f"{outcome.contact}: patch rejected, "
+                                         f"{outcome.status}: {outcome.detail}")
             return
         pubs = self._pubs
         for topic, data in self.pipeline.messages(outcome, self._wanted):

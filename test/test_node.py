@@ -210,7 +210,7 @@ def bad_inputs():
 
 
 def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
-    _, client = run_node("-p", "max_patch_cells:=10000", contacts=("left",))
+    proc, client = run_node("-p", "max_patch_cells:=10000", contacts=("left",))
     # before any twist: no kinematics
     assert exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 - MS),
                     rejected="no_kinematics") == []
@@ -256,6 +256,33 @@ def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
                     f" {values.get('no_contact')}; all: {values}")
     values = client.diagnostic_values("left")
     assert values["solved"] == str(len(bad_inputs()))
+    # the log names the first rejection at once (later ones within a second are summed)
+    assert "left: patch rejected, no_kinematics" in proc.output()
+
+
+def test_throttled_log_builds_no_message_while_suppressed():
+    from fastsim_ros.node import ThrottledLog
+
+    class Logger:
+        def __init__(self):
+            self.lines = []
+
+        def warning(self, message):
+            self.lines.append(message)
+
+    logger = Logger()
+    log = ThrottledLog(logger, period=3600.0)
+    assert log.due()
+    log.warning("first")
+    assert not any(log.due() for _ in range(5))
+    assert logger.lines == ["first"] and log.suppressed == 5
+    log = ThrottledLog(logger, period=0.0)  # every call due: nothing suppressed to report
+    assert log.due() and log.due()
+    log.warning("second")
+    assert logger.lines[-1] == "second"
+    log.suppressed = 2
+    log.warning("third")
+    assert logger.lines[-1] == "third (and 2 more in the last 0 s)" and log.suppressed == 0
 
 
 def test_refused_parameter_keeps_the_node_and_its_value(run_node):
