@@ -8,7 +8,7 @@ topics in the same order with the same values (CSV text equal byte for byte,
 every topic's messages decoded equal, the diagnostics but their wall-clock
 solve times), on the bundled bags and on a recording made to go through every
 branch: reverse running, a rail twist, float64, padded and reversed point
-layouts, a layout change, big-endian data, every rejection, twists of every
+layouts, layout changes (and back), empty grids, big-endian data, every rejection, twists of every
 kind, each method, bound and friction law, markers at every solve.
 """
 
@@ -107,6 +107,12 @@ def _twist_be(stamp_ns, linear, angular, frame="wheelset"):
     return b"\x00\x00\x00\x00" + body + struct.pack(">6d", *linear, *angular)
 
 
+def _empty(cloud):
+    """Return ``cloud`` as a grid of no cells (an empty patch: no contact)."""
+    cloud.height, cloud.width, cloud.row_step, cloud.data = 0, 0, 0, b""
+    return cloud
+
+
 def varied_bag(path):
     """Write a 2 s two-contact recording that takes every branch of the batched path."""
     hertz = ellipse(6e-3, 4e-3, nx=24, load=6e4)
@@ -173,6 +179,10 @@ def varied_bag(path):
             rraw = cdr(cloud_msg(egg, stamp_ns=t, pad=4, pressure=bad, **right))
         elif k in (40, 41):
             rraw = cdr(cloud_msg(egg, stamp_ns=t, pad=4, pressure=0 * egg.pressure, **right))
+        elif k in (30, 31, 35):
+            lraw = cdr(_empty(cloud_msg(hertz, stamp_ns=t, **left)))     # a grid of no cells
+        elif k in (150, 152):   # another layout for a moment, then the first one again
+            rraw = cdr(cloud_msg(egg, stamp_ns=t, **right))
         msgs.append(("/contact/left/patch", t, lraw))
         msgs.append(("/contact/right/patch", t, rraw))
     msgs.sort(key=lambda m: m[1])
@@ -220,6 +230,7 @@ def test_batched_path_equals_the_per_message_path_on_every_branch(tmp_path, vari
                    "standstill", "stale_kinematics"):
         assert counts["left"][reason] >= 1, reason
     assert counts["right"]["negative_pressure"] == 1 and counts["right"]["no_contact"] == 2
+    assert counts["left"]["no_contact"] >= 3    # the grids of no cells
     if variant == "small_grids_only":
         assert counts["left"]["too_large"] == 100   # the 20 x 32 patches
     rows = [line.split(",") for line in reference[0].splitlines()[1:]]

@@ -75,6 +75,8 @@ _MISSING, _WRONG_FRAME, _OLD = CODE["missing_field"], CODE["wrong_frame"], CODE[
 #: kinds of input the batch takes (anything else: the per-message path)
 KINDS = ("wheel_twist", "rail_twist", "patch")
 _FIRST = np.iinfo(np.int64).min
+#: patch layouts kept per topic (a grid that keeps changing shape: the rest one by one)
+MAX_LAYOUTS = 64
 #: where the adapter loop leaves the contact frame (origin, e_x, e_y, e_z) and the grid fit
 #: (x0, dx, worst_x, y0, dy, worst_y)
 _FRAME_SLOTS = np.array([b + k for b in (adapter.ORIGIN, adapter.E_X, adapter.E_Y, adapter.E_Z)
@@ -116,7 +118,9 @@ class Layout:
     can be scanned in bulk (little endian, one float type of ``width``
     bytes, word-aligned fields at word offsets ``cols``, a grid of
     ``height`` x ``cells`` within ``max_patch_cells``, enough data; ``row``
-    and ``step`` in words); otherwise the messages go one by one.
+    and ``step`` in words); ``empty``: the same but a grid of no cells (an
+    empty patch: no contact, nothing to read); otherwise the messages go
+    one by one.
     """
 
     template: NDArray[np.uint8]
@@ -130,6 +134,7 @@ class Layout:
     row: int = 0
     step: int = 0
     cols: Ints = field(default_factory=lambda: np.zeros(7, dtype=np.int64))
+    empty: bool = False
 
 
 def cloud_layout(raw: bytes, frame_id: str, max_cells: int) -> Layout | None:
@@ -168,7 +173,7 @@ def cloud_layout(raw: bytes, frame_id: str, max_cells: int) -> Layout | None:
         mask[a:b] = True
     slow = Layout(template, mask, len(raw), data_at, False)
     ny, nx = cloud.height, cloud.width
-    if cloud.frame_id != frame_id or cloud.is_bigendian or not 0 < ny * nx <= max_cells:
+    if cloud.frame_id != frame_id or cloud.is_bigendian or not ny * nx <= max_cells:
         return slow
     specs = [cloud.fields.get(name) for name in PATCH_FIELDS]
     if any(s is None or s.datatype not in (FLOAT32, FLOAT64) or s.count != 1
@@ -177,8 +182,11 @@ def cloud_layout(raw: bytes, frame_id: str, max_cells: int) -> Layout | None:
     width = 4 if specs[0].datatype == FLOAT32 else 8  # type: ignore[union-attr]
     offsets = [s.offset for s in specs]  # type: ignore[union-attr]
     if (any(o % width or o + width > cloud.point_step for o in offsets)
-            or cloud.point_step % width or cloud.row_step % width
-            or cloud.row_step < nx * cloud.point_step
+            or cloud.point_step % width or cloud.row_step % width):
+        return slow
+    if ny * nx == 0:  # patch_from_cloud checks the fields (passed, above), then: no contact
+        return Layout(template, mask, len(raw), data_at, False, empty=True)
+    if (cloud.row_step < nx * cloud.point_step
             or len(cloud.data) < (ny - 1) * cloud.row_step + nx * cloud.point_step):
         return slow
     return Layout(template, mask, len(raw), data_at, True, ny, nx, width,
@@ -253,7 +261,7 @@ class Timing:
     solve: float = 0.0
     state: float = 0.0
     solves: int = 0
-    #: ``(pressure, x0, y0, dx, dy, xi, eta, phi)`` of each solve, when kept
+    #: the solves as they were solved, when kept: :attr:`results.Profile.solves`
     inputs: list[tuple[Any, ...]] | None = None
 
 
@@ -337,7 +345,7 @@ class Batch:
             self.of_contact[cid] = ci
         self.twists = (_Twists(), _Twists())
         self.twist_layout, self.twist_doubles = twist_layout(self.frame_id)
-        self.layouts: dict[int, Layout | None] = {}
+        self.layouts: dict[int, list[Layout]] = {}
         self.state = _ContactState(len(self.contacts))
         self.timing = Timing(inputs=[] if keep_inputs else None)
         self._setup_solver()
@@ -506,22 +514,39 @@ class Batch:
         one_by_one: list[int] = []
         channel = w.channel[at]
         for cid in np.unique(channel).tolist():
-            mine = np.flatnonzero(channel == cid)
-            layout = self.layouts.get(cid)
-            if layout is None:
-                layout = cloud_layout(bytes(w.data(int(at[mine[0]]))), self.frame_id,
-                                      self.max_cells)
-                self.layouts[cid] = layout
-            if layout is None or not layout.fast:
-                one_by_one += mine.tolist()
-                continue
-            same = self._matching(w, at[mine], layout)
-            one_by_one += mine[~same].tolist()
-            rows = mine[same]
-            if rows.size:
-                group, rest = self._scan(w, at, rows, layout, p)
-                groups.append(group)
-                one_by_one += rest
+            left = np.flatnonzero(channel == cid)
+            known = self.layouts.setdefault(cid, [])
+            k = 0
+            while left.size:  # each message by the first of the topic's layouts it has
+                if k == len(known):
+                    if k == MAX_LAYOUTS:
+                        break
+                    # a layout not seen yet (the patch's grid changed): read it off the first
+                    # message left, which has it
+                    layout = cloud_layout(bytes(w.data(int(at[left[0]]))), self.frame_id,
+                                          self.max_cells)
+                    if layout is None:   # does not parse: one by one, for its words
+                        one_by_one.append(int(left[0]))
+                        left = left[1:]
+                        continue
+                    known.append(layout)
+                layout = known[k]
+                k += 1
+                same = self._matching(w, at[left], layout)
+                rows = left[same]
+                left = left[~same]
+                if rows.size == 0:
+                    continue
+                if layout.fast:
+                    group, rest = self._scan(w, at, rows, layout, p)
+                    groups.append(group)
+                    one_by_one += rest
+                elif layout.empty:
+                    p.stamp[rows] = self._stamps(w, at[rows])
+                    p.status[rows] = _EMPTY
+                else:
+                    one_by_one += rows.tolist()
+            one_by_one += left.tolist()
         singles: dict[int, ContactPatch] = {}
         for i in sorted(one_by_one):
             patch = self._one(w, int(at[i]), i, p)
@@ -693,16 +718,22 @@ class Batch:
             return
         where = np.zeros(p.status.size, dtype=np.bool_)
         where[todo] = True
-        items: list[tuple[Ints, Floats]] = []
+        # one compiled call per grid shape (the patches of every layout and topic of that shape)
+        shapes: dict[tuple[int, ...], list[tuple[Ints, Floats]]] = {}
         for g in groups:
             take = where[g.rows]
             if take.all():
-                items.append((g.rows, g.pressure))
+                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows, g.pressure))
             elif take.any():
-                items.append((g.rows[take], g.pressure[take]))
+                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows[take],
+                                                                    g.pressure[take]))
         for i, patch in singles.items():
             if where[i]:
-                items.append((np.array([i]), patch.pressure[None]))
+                shapes.setdefault(patch.pressure.shape, []).append((np.array([i]),
+                                                                    patch.pressure[None]))
+        items = [pieces[0] if len(pieces) == 1 else
+                 (np.concatenate([r for r, _ in pieces]), np.concatenate([q for _, q in pieces]))
+                 for pieces in shapes.values()]
         t0 = time.perf_counter()
         solved: list[Ints] = []
         for rows, ps in items:
@@ -722,8 +753,7 @@ class Batch:
             ok = status == contact_kernels.OK
             solved.append(rows[ok])
             if self.timing.inputs is not None:
-                self.timing.inputs += [(ps[k], *grid[k].tolist(), *xep[k].tolist())
-                                       for k in np.flatnonzero(ok).tolist()]
+                self.timing.inputs.append((ps, grid, xep, ok))
             sign = np.where(back, -1.0, 1.0)
             fx, fy, mz, n = sign * out[:, 0], sign * out[:, 1], out[:, 2], out[:, 3]
             with np.errstate(all="ignore"):

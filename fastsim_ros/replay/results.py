@@ -19,9 +19,11 @@ class Profile:
     (decode, adapt, kinematics, solve) of patches, ``twist``: of twists,
     ``emit``: building and serializing the output messages of a patch,
     ``write``: writing them (the per-message path).  ``phases``: the
-    totals (s) of the chunked path's phases.  ``solves``: ``(pressure, x0,
-    y0, dx, dy, xi, eta, phi)`` of every solve as it was solved, to time
-    the solver alone on the same inputs.
+    totals (s) of the chunked path's phases.  ``solves``: the solves as
+    they were solved, to time the solver alone on the same inputs, in
+    batches ``(pressure (k, ny, nx) Pa, grid (k, 4): x0, y0, dx, dy (m),
+    creepages (k, 3): xi, eta, phi, solved (k,) bool)`` (kept as the
+    replay had them: only the ``solved`` items count).
     """
 
     read: array = field(default_factory=lambda: array("q"))

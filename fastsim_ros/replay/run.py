@@ -28,6 +28,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from rclpy.serialization import serialize_message
 
 from fastsim_ros.params import SPECS, ParameterError
@@ -447,7 +448,7 @@ def _replay_messages(task: Task, reader: Any, staging: Path, pipeline: AnyPipeli
 
 
 def _solve_input(outcome: Any) -> tuple[Any, ...]:
-    """Return ``(pressure, x0, y0, dx, dy, xi, eta, phi)`` of a solved patch as it was solved."""
+    """Return a solved patch as it was solved: a batch of one (:attr:`Profile.solves`)."""
     patch, creep = outcome.patch, outcome.creepage
     p, x0, y0, phi = patch.pressure, patch.x0, patch.y0, creep.phi
     if creep.speed < 0.0:  # turned by 180 degrees, as the pipeline solves it
@@ -455,4 +456,5 @@ def _solve_input(outcome: Any) -> tuple[Any, ...]:
         x0 = -(x0 + (p.shape[1] - 1) * patch.dx)
         y0 = -(y0 + (p.shape[0] - 1) * patch.dy)
         phi = -phi
-    return (p, x0, y0, patch.dx, patch.dy, creep.xi, creep.eta, phi)
+    return (p[None], np.array([[x0, y0, patch.dx, patch.dy]]),
+            np.array([[creep.xi, creep.eta, phi]]), np.ones(1, dtype=np.bool_))
