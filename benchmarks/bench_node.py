@@ -14,6 +14,7 @@ rclpy publish) to show where the time goes.
 
     .venv/bin/python benchmarks/bench_node.py --contacts 2 4 --seconds 20
     .venv/bin/python benchmarks/bench_node.py --contacts 4 --soak 10
+    .venv/bin/python benchmarks/bench_node.py --profiles 3 --seconds 10   # profiles mode
 """
 
 from __future__ import annotations
@@ -441,11 +442,20 @@ def main() -> None:
     parser.add_argument("--floor", type=int, default=0, metavar="ROUNDS",
                         help="drive the node and the DDS floor (dds_floor.py) alternately, "
                         "ROUNDS times each, and print node/floor ratios of the medians")
+    parser.add_argument("--profiles", type=int, default=0, metavar="ROUNDS",
+                        help="the node in profiles mode (one wheelset, poses and twists at "
+                        "--rate) and in topics mode (two patches a cycle) alternately, ROUNDS "
+                        "times each (bench_profiles_node.py)")
     args = parser.parse_args()
     if args.baseline:
         global BASELINE
         BASELINE = Path(args.baseline).resolve()
     print(f"machine: {machine()}")
+    if args.profiles:
+        import bench_profiles_node
+        bench_profiles_node.side_by_side(sys.modules[__name__], args.rate, args.seconds,
+                                         args.profiles, shlex.split(args.node_args))
+        return
     if not NODE.exists():
         raise SystemExit(f"{NODE} is missing: run scripts/setup_env.sh")
     if args.startup:

@@ -146,7 +146,7 @@ class FastsimNode(Node):
         pipeline_kernels.warm_up()
         warm += time.perf_counter() - start
         try:  # profiles mode reads and places its profiles here
-            self.pipeline = make_pipeline(config)
+            self.pipeline = make_pipeline(config, log=self.get_logger().info)
         except parameters.ParameterError as e:  # a profile file or placement: one line
             raise StartupError(str(e)) from None
         depth = int(config["qos_depth"])
