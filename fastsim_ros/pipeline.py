@@ -37,7 +37,8 @@ from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
-from msg_adapters.cdr import Cloud, CloudReader, StampedTwist, read_twist
+from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist,
+                              stamped_doubles_template)
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
 from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud, words_of
@@ -224,12 +225,14 @@ class _ContactState:
 class _ContactTopics:
     """A contact's output topics (relative names), built once."""
 
-    __slots__ = ("wrench", "creepage", "frame", "traction")
+    __slots__ = ("wrench", "creepage", "frame", "traction", "wrench_cdr")
 
     def __init__(self, contact: str) -> None:
         base = f"contact/{contact}/"
         self.wrench, self.creepage = base + "wrench", base + "creepage"
         self.frame, self.traction = base + "frame", base + "traction"
+        # the contact's WrenchStamped, (Fx, Fy, N) and (0, 0, Mz): only numbers change
+        self.wrench_cdr = stamped_doubles_template(out.contact_frame_id(contact), 6).encode
 
 
 class _Every:
@@ -282,6 +285,7 @@ class Pipeline:
         # the twists last given to the compiled path, as its arrays (v, w)
         self._twist_arrays: dict[str, tuple[StampedTwist, np.ndarray]] = {}
         self._contacts = {name: _ContactState() for name in config.contacts}
+        self._fresh = 0  # contacts with a wrench not yet in a wheelset wrench
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
@@ -604,9 +608,12 @@ class Pipeline:
                     torque: tuple[float, float, float]) -> WheelsetWrench | None:
         """Keep the contact's wrench; return the wheelset wrench if every contact has a new one."""
         state.wrench = (stamp, force, torque)
-        state.wrench_fresh = True
-        if not all(s.wrench_fresh for s in self._contacts.values()):
+        if not state.wrench_fresh:
+            state.wrench_fresh = True
+            self._fresh += 1
+        if self._fresh < len(self._contacts):  # some contact has no new wrench yet
             return None
+        self._fresh = 0
         fs = [0.0, 0.0, 0.0]
         ts = [0.0, 0.0, 0.0]
         newest = stamp
@@ -653,8 +660,8 @@ class Pipeline:
             if topic in wanted:
                 msgs.append((topic, out.contact_wrench_cdr(stamp, c, 0.0, 0.0, 0.0, 0.0)))
         else:
-            if topic in wanted:
-                msgs.append((topic, out.contact_wrench_cdr(stamp, c, f.fx, f.fy, f.n, f.mz)))
+            if topic in wanted:  # (out.contact_wrench_cdr, from the contact's template)
+                msgs.append((topic, topics.wrench_cdr(stamp, f.fx, f.fy, f.n, 0.0, 0.0, f.mz)))
             topic = topics.creepage
             if topic in wanted:
                 msgs.append((topic, out.creepage_cdr(stamp, c, outcome.creepage)))
