@@ -8,6 +8,11 @@ wrench, or a rejection with its reason key (INTERFACE.md).  It never reads
 a clock for anything it outputs: stamps come from the messages, so a replay
 is deterministic (only the solve-time statistics use ``perf_counter``).
 No ``rclpy.node`` here: the node and ``fastsim_replay`` are thin front ends.
+A patch that is solved takes the compiled path
+(:func:`fastsim_ros.pipeline_kernels.solve_cloud`: the adapter's loop, the
+creepages, the MAE solve and the wheelset wrench in one call, equal to the
+bit to the Python path, which decides every rejection); its solve time is
+that call's.
 
 Physics (INTERFACE.md "Creepages", METHOD.md 1): the solvers roll towards
 ``+x``; when the rolling speed ``V`` is negative (reverse running) the patch
