@@ -260,7 +260,7 @@ def _builder(cls: type) -> Callable[..., Any]:
     one); the instance equals the ``__init__``'s (test_pipeline_kernels.py).
     """
     names = [f.name for f in fields(cls)]
-    assert list(cls.__slots__) == names and not hasattr(cls, "__post_init__")
+    assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
     args = ", ".join(names)
     body = "".join(f"    set_{n}(o, {n})\n" for n in names)
     scope: dict[str, Any] = {"new": object.__new__, "cls": cls}
