@@ -122,7 +122,8 @@ def table_of(config: PipelineConfig, wheelset: Wheelset,
                              "load (N) > 0")
     cache = str(config["table_cache"])
     directory = Path(cache).expanduser() if cache else None
-    return cached_table(wheelset, table_grid_of(config), load, directory, log=log)
+    return cached_table(wheelset, table_grid_of(config), load, directory,
+                        refine=int(config["table_refine"]), log=log)
 
 
 def table_contact_patch(patch: TablePatch, stamp_ns: int, *, max_cells: int) -> ContactPatch:
