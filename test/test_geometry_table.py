@@ -312,7 +312,7 @@ def test_refinement_halves_the_steps_where_a_flange_takes_over(wheelset):
         assert fine.node(fine.grid.dys.index(d), 0).roll == coarse.node(i, 0).roll
 
     def right_force(lookup_or_node):
-        """The right wheel's normal forces' sum (wheelset frame, N)."""
+        """Return the right wheel's normal forces' sum (wheelset frame, N)."""
         if isinstance(lookup_or_node, TableNode):
             patches = lookup_or_node.patches[1]
         else:
