@@ -79,6 +79,10 @@ def output_topics(contacts: tuple[str, ...], *, patches: bool = False) -> dict[s
     return topics
 
 
+#: a patch solved already: as converted, its creepages, forces and solve time (s)
+Solved = tuple[ContactPatch, Creepage, ContactForces, float]
+
+
 @dataclass(frozen=True)
 class PipelineConfig:
     """The checked parameters of INTERFACE.md (see :mod:`fastsim_ros.params`)."""
@@ -397,8 +401,15 @@ class Pipeline:
 
     # ---------------------------------------------------------------- patches
 
-    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview) -> Outcome:
-        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches."""
+    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview, *,
+                 solved: Solved | None = None) -> Outcome:
+        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches.
+
+        ``solved``: the patch as converted, its creepages, forces and solve
+        time (s), from :meth:`solve_patch` on this cloud's patch with this
+        stamp's kinematics (profiles mode's load balance solved it already):
+        then the stamp and frame are checked and the rest taken as given.
+        """
         state = self._contacts[contact]
         stats = state.stats
         if not isinstance(cloud, Cloud):
@@ -421,14 +432,19 @@ class Pipeline:
                 raise RejectedInput("old_stamp", f"stamp {stamp} ns is older than the last, "
                                     f"{state.last_stamp_ns} ns")
             state.last_stamp_ns = stamp
-            patch = patch_from_cloud(cloud, max_cells=self._max_cells)
-            if patch is None:
-                return self._no_contact(contact, state, stamp)
-            wheel, rail = self._kinematics(stamp)
-            creep = creepages(patch.frame, wheel, rail)
-            if not abs(creep.speed) >= self._min_speed:
-                raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
-            forces = self._solve(patch, creep, stats)
+            if solved is not None:
+                patch, creep, forces, seconds = solved
+                stats.add_solve_time(seconds)
+            else:
+                converted = patch_from_cloud(cloud, max_cells=self._max_cells)
+                if converted is None:
+                    return self._no_contact(contact, state, stamp)
+                patch = converted
+                wheel, rail = self._kinematics(stamp)
+                creep = creepages(patch.frame, wheel, rail)
+                if not abs(creep.speed) >= self._min_speed:
+                    raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
+                forces = self._solve(patch, creep, stats)
         except RejectedInput as e:
             stats.counts[e.reason] += 1
             stats.window_rejected += 1
@@ -449,8 +465,8 @@ class Pipeline:
                        wheelset, self._markers_due(state, stamp))
 
     def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
-                    rail: StampedTwist = REST, *,
-                    method: str | None = None) -> tuple[Creepage, ContactForces]:
+                    rail: StampedTwist = REST, *, method: str | None = None,
+                    timing: list[float] | None = None) -> tuple[Creepage, ContactForces]:
         """Return the creepages and creep forces of one converted patch under given twists.
 
         The rules of :meth:`on_patch` (standstill, the solver's refusals as
@@ -462,7 +478,11 @@ class Pipeline:
         if not abs(creep.speed) >= self._min_speed:
             raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
         if method is None or method == self.config["method"]:
-            return creep, self._solve(patch, creep, ContactStats())
+            stats = ContactStats()
+            forces = self._solve(patch, creep, stats)
+            if timing is not None:
+                timing.append(float(stats.solve_times[0]))
+            return creep, forces
         configured, self._solver = self._solver, self._solvers[method]
         try:
             return creep, self._solve(patch, creep, ContactStats())

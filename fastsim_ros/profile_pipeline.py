@@ -54,11 +54,12 @@ from fastsim_ros.geometry.placement import Placement, Pose, rotation
 from fastsim_ros.geometry.profiles import read_profile
 from fastsim_ros.geometry.table import (ContactTable, TableError, TableGrid, TablePatch,
                                         TableRangeError, cached_table)
+from fastsim_ros.geometry.table import warm_up as table_warm_up
 from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Wheelset,
                                            WheelsetContact)
 from fastsim_ros.params import PROFILE_CONTACTS, SPECS, ParameterError
 from fastsim_ros.pipeline import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic, Outcome,
-                                  Pipeline, PipelineConfig, output_topics, patch_topic)
+                                  Pipeline, PipelineConfig, Solved, output_topics, patch_topic)
 from msg_adapters.cdr import Cloud, StampedTwist
 from msg_adapters.errors import MalformedMessageError, RejectedInput
 from msg_adapters.patch import (MIN_CONTACT_CELLS, ContactFrame, ContactPatch, contact_axes,
@@ -212,6 +213,10 @@ class ProfilePipeline:
         self.pipeline = Pipeline(config, solver=solver)
         self.wheelset = wheelset_of(config)
         self.table = table_of(config, self.wheelset, log) if config["profile_table"] else None
+        #: the configured method's solves of the table patches in this pose's balance
+        self._solved: dict[int, Solved] = {}
+        if self.table is not None:
+            table_warm_up()   # the blend's kernels compiled or loaded before the first pose
         self.solve_roll = solve_roll
         self._loads: deque[StampedTwist] = deque(maxlen=LOAD_HISTORY)
         self._last_pose_ns: int | None = None
@@ -388,11 +393,16 @@ class ProfilePipeline:
             return self._dropped(stamp, e.reason, e.detail)
         loads = self.wheel_loads(stamp)
         contact: WheelsetContact | TableContact
+        solved: dict[str, Solved | None] = {}
         try:
             if self.table is not None and loads is not None:
+                self._solved.clear()
                 contact = self.table_solve(wheelset_pose.dy, wheelset_pose.yaw, wheel, rail,
                                            stamp, loads=loads)
                 patches = self.clouds_of(zip(SIDES, contact.patches), stamp)
+                solved = {contact_name(side, k): self._solved.get(id(tp))
+                          for side, wheel_patches in zip(SIDES, contact.patches)
+                          for k, tp in enumerate(wheel_patches)}
             else:
                 contact = self.solve(wheelset_pose, wheel, rail, stamp, loads=loads)
                 patches = self.clouds(contact, stamp)
@@ -405,7 +415,13 @@ class ProfilePipeline:
         except ContactError as e:
             return self._dropped(stamp, "degenerate", str(e))
         self._clouds = dict(patches)
-        outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
+        if self.table is not None and loads is not None:
+            # the balance's last step solved these very patches with the configured method:
+            # the pipeline takes those solves (the clouds carry the same patches, to rounding)
+            outcomes = tuple(self.pipeline.on_patch(name, cloud, solved=solved.get(name))
+                             for name, cloud in patches)
+        else:
+            outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
         return ProfileCycle(stamp, patches, outcomes, contact, loads)
 
     def solve(self, pose: Pose, wheel: StampedTwist, rail: StampedTwist, stamp_ns: int, *,
@@ -490,7 +506,10 @@ class ProfilePipeline:
                     if patch is None:
                         raise RejectedInput("degenerate", "an empty patch")
                     try:
-                        _, f = self.pipeline.solve_patch(patch, wheel, rail)
+                        timing: list[float] = []
+                        creep, f = self.pipeline.solve_patch(patch, wheel, rail, timing=timing)
+                        if isinstance(wp, TablePatch):
+                            self._solved[id(wp)] = (patch, creep, f, timing[0])
                     except RejectedInput as e:
                         if e.reason in ("standstill", "too_large", "nonfinite"):
                             raise

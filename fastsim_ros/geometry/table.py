@@ -459,6 +459,15 @@ class BlendPlan:
         return self.load * float((rotation @ self.normal)[2])
 
 
+def warm_up() -> None:
+    """Compile (or load from numba's disk cache) the blend's kernels on a tiny field."""
+    field = np.zeros((3, 3))
+    pressure = np.ones((2, 2))
+    _gather(field, -2e-4, -2e-4, 2e-4, pressure, -1e-4, -1e-4, 2e-4, 2e-4, 1.0, 0.0, 0.0, 1.0,
+            1.0)
+    _finish(field, 2, 1.0, 2e-4, -2e-4, -2e-4)
+
+
 def blend(members: Sequence[tuple[float, TablePatch]], *, scale: float = 1.0,
           fade: float = 1.0) -> TablePatch:
     """Return the blend of matching patches at the scale ``s`` (see :class:`BlendPlan`)."""
@@ -997,5 +1006,5 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
 
 __all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "TableError",
            "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
-           "cached_table", "levelled_roll", "match", "solve_node", "table_key",
+           "cached_table", "levelled_roll", "match", "solve_node", "table_key", "warm_up",
            "BlendPlan"]
