@@ -11,7 +11,7 @@ from fastsim_ros.geometry.placement import rotation
 from fastsim_ros.geometry.wheelset import LOAD_TOLERANCE
 from fastsim_ros.params import PROFILE_CONTACTS, ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
-from fastsim_ros.profile_pipeline import ProfilePipeline
+from fastsim_ros.profile_pipeline import BALANCE_TOLERANCE, ProfilePipeline
 from msg_adapters.cdr import StampedTwist
 from msg_adapters.profile_msgs import StampedPose, quaternion
 
@@ -216,7 +216,7 @@ def test_the_table_balances_each_wheels_load_with_the_creep_forces(tabled, dy, y
     for side in ("left", "right"):
         assert by[side].status == "solved"
         # the published wrenches' vertical sum, creep forces included, is the wheel's load
-        assert _vertical_force(by[side], roll, yaw) == pytest.approx(1e4, rel=2e-6)
+        assert _vertical_force(by[side], roll, yaw) == pytest.approx(1e4, rel=BALANCE_TOLERANCE)
 
 
 @pytest.mark.parametrize("dy, yaw", [(1.3e-3, 2.1e-3), (-2.7e-3, -6.4e-3), (2.25e-3, 0.0)])
@@ -260,7 +260,7 @@ def test_a_load_message_scales_the_table_patches_like_hertz(tabled):
     cycle = _serve(tabled, 40 * MS, 0.7e-3, 1e-3)
     assert cycle.loads == (8e3, 8e3)
     by = {o.contact: o for o in cycle.outcomes}
-    assert _vertical_force(by["left"], cycle.contact.roll, 1e-3) == pytest.approx(8e3, rel=2e-6)
+    assert _vertical_force(by["left"], cycle.contact.roll, 1e-3) == pytest.approx(8e3, rel=BALANCE_TOLERANCE)
     # the normal force ~ s^3 (the creep forces' vertical share, 1% here, scales alike)
     for k in range(2):
         ratio = (cycle.contact.scales[k] / reference.contact.scales[k]) ** 3
