@@ -260,7 +260,8 @@ def test_a_load_message_scales_the_table_patches_like_hertz(tabled):
     cycle = _serve(tabled, 40 * MS, 0.7e-3, 1e-3)
     assert cycle.loads == (8e3, 8e3)
     by = {o.contact: o for o in cycle.outcomes}
-    assert _vertical_force(by["left"], cycle.contact.roll, 1e-3) == pytest.approx(8e3, rel=BALANCE_TOLERANCE)
+    vertical = _vertical_force(by["left"], cycle.contact.roll, 1e-3)
+    assert vertical == pytest.approx(8e3, rel=BALANCE_TOLERANCE)
     # the normal force ~ s^3 (the creep forces' vertical share, 1% here, scales alike)
     for k in range(2):
         ratio = (cycle.contact.scales[k] / reference.contact.scales[k]) ** 3
