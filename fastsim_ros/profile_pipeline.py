@@ -421,7 +421,7 @@ class ProfilePipeline:
         if self.table is not None and loads is not None:
             # the balance's last step solved these very patches with the configured method:
             # the pipeline takes those solves (the clouds carry the same patches, to rounding)
-            outcomes = tuple(self.pipeline.on_patch(name, cloud, solved=solved.get(name))
+            outcomes = tuple(self.pipeline.on_patch(name, cloud, given=solved.get(name))
                              for name, cloud in patches)
         else:
             outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
