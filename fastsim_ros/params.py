@@ -237,6 +237,9 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("table_yaw_step", "double", 5.0e-3,
                   "contact table: step of the yaw (rad; divides 2 table_yaw_max)",
                   low=1.0e-5, high=0.1),
+    ParameterSpec("table_refine", "integer", 4,
+                  "contact table: times the shift intervals whose nodes differ (a contact "
+                  "taking over, a contact running fast) are halved", low=0, high=8),
     ParameterSpec("table_cache", "string", "~/.cache/fastsim_ros",
                   "directory of built contact tables (keyed by profiles and parameters; "
                   "empty: build every start, keep none)", empty_ok=True),

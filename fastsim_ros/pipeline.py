@@ -89,6 +89,10 @@ def output_topics(contacts: tuple[str, ...], *, patches: bool = False) -> dict[s
     return topics
 
 
+#: a patch solved already: as converted, its creepages, forces and solve time (s)
+Solved = tuple[ContactPatch, Creepage, ContactForces, float]
+
+
 @dataclass(frozen=True)
 class PipelineConfig:
     """The checked parameters of INTERFACE.md (see :mod:`fastsim_ros.params`)."""
@@ -452,8 +456,15 @@ class Pipeline:
 
     # ---------------------------------------------------------------- patches
 
-    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview) -> Outcome:
-        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches."""
+    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview, *,
+                 given: Solved | None = None) -> Outcome:
+        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches.
+
+        ``given``: the patch as converted, its creepages, forces and solve
+        time (s), from :meth:`solve_patch` on this cloud's patch with this
+        stamp's kinematics (profiles mode's load balance solved it already):
+        then the stamp and frame are checked and the rest taken as given.
+        """
         state = self._contacts[contact]
         stats = state.stats
         if not isinstance(cloud, Cloud):
@@ -476,16 +487,25 @@ class Pipeline:
                 raise RejectedInput("old_stamp", f"stamp {stamp} ns is older than the last, "
                                     f"{state.last_stamp_ns} ns")
             state.last_stamp_ns = stamp
-            solved = self._solve_compiled(cloud, state) if self._compiled is not None else None
-            if solved is None:  # the Python path: it gives the reason of a rejection
-                patch = patch_from_cloud(cloud, max_cells=self._max_cells)
-                if patch is None:
-                    return self._no_contact(contact, state, stamp)
-                wheel, rail = self._kinematics(stamp)
-                creep = creepages(patch.frame, wheel, rail)
-                if not abs(creep.speed) >= self._min_speed:
-                    raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
-                forces = self._solve(patch, creep, stats)
+            done = None
+            if given is not None:
+                patch, creep, forces, seconds = given
+                stats.add_solve_time(seconds)
+            else:
+                done = (self._solve_compiled(cloud, state) if self._compiled is not None
+                        else None)
+                if done is None:  # the Python path: it gives the reason of a rejection
+                    converted = patch_from_cloud(cloud, max_cells=self._max_cells)
+                    if converted is None:
+                        return self._no_contact(contact, state, stamp)
+                    patch = converted
+                    wheel, rail = self._kinematics(stamp)
+                    creep = creepages(patch.frame, wheel, rail)
+                    if not abs(creep.speed) >= self._min_speed:
+                        raise RejectedInput("standstill",
+                                            f"rolling speed {creep.speed:.4g} m/s")
+                    forces = self._solve(patch, creep, stats)
+            if done is None:
                 f_ws = patch.frame.to_wheelset((forces.fx, forces.fy, forces.n))
                 m_ws = patch.frame.to_wheelset((0.0, 0.0, forces.mz))
                 o = patch.frame.origin
@@ -493,7 +513,7 @@ class Pipeline:
                           o[2] * f_ws[0] - o[0] * f_ws[2] + m_ws[1],
                           o[0] * f_ws[1] - o[1] * f_ws[0] + m_ws[2])
             else:
-                patch, creep, forces, f_ws, torque = solved
+                patch, creep, forces, f_ws, torque = done
         except RejectedInput as e:
             stats.counts[e.reason] += 1
             stats.window_rejected += 1
@@ -562,8 +582,8 @@ class Pipeline:
                 (t0, t1, t2))
 
     def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
-                    rail: StampedTwist = REST, *,
-                    method: str | None = None) -> tuple[Creepage, ContactForces]:
+                    rail: StampedTwist = REST, *, method: str | None = None,
+                    timing: list[float] | None = None) -> tuple[Creepage, ContactForces]:
         """Return the creepages and creep forces of one converted patch under given twists.
 
         The rules of :meth:`on_patch` (standstill, the solver's refusals as
@@ -575,7 +595,11 @@ class Pipeline:
         if not abs(creep.speed) >= self._min_speed:
             raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
         if method is None or method == self.config["method"]:
-            return creep, self._solve(patch, creep, ContactStats())
+            stats = ContactStats()
+            forces = self._solve(patch, creep, stats)
+            if timing is not None:
+                timing.append(float(stats.solve_times[0]))
+            return creep, forces
         configured, self._solver = self._solver, self._solvers[method]
         try:
             return creep, self._solve(patch, creep, ContactStats())

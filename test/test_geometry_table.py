@@ -295,3 +295,46 @@ def test_a_build_in_worker_processes_equals_one_in_process(wheelset):
         for side in range(2):
             for p, q in zip(n.patches[side], m.patches[side], strict=True):
                 np.testing.assert_array_equal(p.pressure, q.pressure)
+
+
+def test_refinement_halves_the_steps_where_a_flange_takes_over(wheelset):
+    # -6.4..-6.0 mm: the right wheel's gauge corner gives way to its flange between -6.3 and
+    # -6.25 mm (the levelled roll runs from -1.5 to -0.76 mrad there, the contact angle from
+    # 1.2 to 0.55 rad, N by 15 kN over 0.02 mm); no mirror on this grid: both wheels
+    # solved, refined four times (the default)
+    grid = TableGrid((-6.4e-3, -6.3e-3, -6.2e-3, -6.1e-3, -6.0e-3), (0.0,))
+    coarse = ContactTable.build(wheelset, grid, LOAD)
+    fine = ContactTable.build(wheelset, grid, LOAD, refine=4)
+    steps = np.diff(fine.grid.dys)
+    finest = np.flatnonzero(steps < 0.1e-3 / 16 * 1.001)
+    assert finest.size and all(-6.3e-3 - 1e-12 <= fine.grid.dys[k] < -6.2e-3 for k in finest)
+    for i, d in enumerate(grid.dys):   # the base nodes as they were
+        assert fine.node(fine.grid.dys.index(d), 0).roll == coarse.node(i, 0).roll
+
+    def right_force(lookup_or_node):
+        """Return the right wheel's normal forces' sum (wheelset frame, N)."""
+        if isinstance(lookup_or_node, TableNode):
+            patches = lookup_or_node.patches[1]
+        else:
+            patches = lookup_or_node.patches("right")
+        return sum((p.load * p.normal for p in patches), np.zeros(3))
+
+    # in the transition, against the wheel solved there: the refined table is far closer
+    for dy in (-6.29e-3, -6.27e-3, -6.26e-3):
+        exact = right_force(solve_node(wheelset, LOAD, dy, 0.0))
+        err_fine = np.linalg.norm(right_force(fine.lookup(dy, 0.0)) - exact)
+        err_coarse = np.linalg.norm(right_force(coarse.lookup(dy, 0.0)) - exact)
+        assert err_fine < 0.25 * err_coarse
+        assert err_fine < 0.05 * np.linalg.norm(exact)
+
+
+def test_refinement_keeps_the_grid_symmetric_for_the_mirror(wheelset):
+    grid = TableGrid.regular(-6.4e-3, 6.4e-3, 0.4e-3, 0.0, 1e-3)
+    table = ContactTable.build(wheelset, grid, LOAD, refine=2)
+    assert table.grid.symmetric and len(table.grid.dys) > len(grid.dys)
+    k = next(i for i, d in enumerate(table.grid.dys) if d not in grid.dys)
+    mirror = table.grid.dys.index(min(table.grid.dys, key=lambda d: abs(d + table.grid.dys[k])))
+    left, right = table.node(k, 0).patches[0], table.node(mirror, 0).patches[1]
+    assert len(left) == len(right)
+    for p, q in zip(left, right):
+        np.testing.assert_allclose(q.origin, p.origin * np.array([1.0, -1.0, 1.0]), atol=1e-12)

@@ -47,6 +47,7 @@ node where the wheel derailed raises
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import math
 import os
@@ -67,7 +68,7 @@ from fastsim_ros.geometry.wheelset import (MAX_PATCHES, MIN_PATCH_CELLS, SIDES, 
 FloatArray = NDArray[np.float64]
 
 #: bump when the stored layout or the physics of a node changes: old files are rebuilt
-TABLE_VERSION = 1
+TABLE_VERSION = 2
 #: patches of neighbouring nodes are the same contact if their pressure centroids lie
 #: within this distance (m) and their normals within this angle (rad).  On S1002/UIC60 the
 #: tread contact runs 10.6 mm for a 1 mm shift near the centre, while the patches of one
@@ -75,6 +76,18 @@ TABLE_VERSION = 1
 #: 0.4 rad or more (tread 0.01-0.03, gauge corner 0.4-0.5, flange 1.1-1.2 rad)
 MATCH_DISTANCE = 12e-3
 MATCH_ANGLE = 0.3
+#: neighbouring shifts whose nodes differ more than this are refined by bisection (up to
+#: ``refine`` times): the contact angle (rad), the centroid (m), the patch load (share).
+#: A gauge corner or flange contact taking over between two nodes, or
+#: the tread contact running across the wheel near the centre (10 mm per mm of shift), is
+#: then blended over a sixteenth of a step instead of a whole one
+REFINE_ANGLE = 0.05
+REFINE_DISTANCE = 0.5e-3
+REFINE_LOAD = 0.1
+#: a looked-at interval is halved again unless the half-and-half blend of its ends is its
+#: midpoint node: centroid within this (m), load, cells and RMS extents within this share
+REFINE_MIDPOINT = 0.1e-3
+REFINE_SHAPE = 0.05
 #: a pose this close to a node (in units of the step) takes that node alone
 NODE_SNAP = 1e-9
 #: the roll that levels both rigid wheels is solved to this height difference (m)
@@ -446,6 +459,15 @@ class BlendPlan:
         return self.load * float((rotation @ self.normal)[2])
 
 
+def warm_up() -> None:
+    """Compile (or load from numba's disk cache) the blend's kernels on a tiny field."""
+    field = np.zeros((3, 3))
+    pressure = np.ones((2, 2))
+    _gather(field, -2e-4, -2e-4, 2e-4, pressure, -1e-4, -1e-4, 2e-4, 2e-4, 1.0, 0.0, 0.0, 1.0,
+            1.0)
+    _finish(field, 2, 1.0, 2e-4, -2e-4, -2e-4)
+
+
 def blend(members: Sequence[tuple[float, TablePatch]], *, scale: float = 1.0,
           fade: float = 1.0) -> TablePatch:
     """Return the blend of matching patches at the scale ``s`` (see :class:`BlendPlan`)."""
@@ -545,22 +567,96 @@ class TableGrid:
 
 
 def _axis_weights(nodes: tuple[float, ...], value: float, name: str) -> list[tuple[int, float]]:
+    """Return the linear weights of ``value`` on increasing ``nodes`` (refined: not uniform)."""
     if len(nodes) == 1:
         if abs(value - nodes[0]) > 1e-12:
             raise TableRangeError(f"{name} {value:.6g} outside the table (only {nodes[0]:g})")
         return [(0, 1.0)]
     lo, hi = nodes[0], nodes[-1]
-    step = (hi - lo) / (len(nodes) - 1)
-    if not lo - NODE_SNAP * step <= value <= hi + NODE_SNAP * step:
+    snap = NODE_SNAP * (hi - lo) / (len(nodes) - 1)
+    if not lo - snap <= value <= hi + snap:
         raise TableRangeError(f"{name} {value:.6g} outside the table's {lo:.6g}..{hi:.6g}")
-    f = (value - lo) / step
-    k = min(max(int(math.floor(f)), 0), len(nodes) - 2)
-    t = f - k
+    k = min(max(bisect.bisect_right(nodes, value) - 1, 0), len(nodes) - 2)
+    t = (value - nodes[k]) / (nodes[k + 1] - nodes[k])
     if t <= NODE_SNAP:
         return [(k, 1.0)]
     if t >= 1.0 - NODE_SNAP:
         return [(k + 1, 1.0)]
     return [(k, 1.0 - t), (k + 1, t)]
+
+
+def _pairs(a: TableNode, b: TableNode) -> list[tuple[TablePatch, TablePatch]] | None:
+    """Return the matching patch pairs of two nodes (both wheels), or ``None`` if any is unmatched.
+
+    ``None`` too if one node derailed and not the other; two derailed nodes
+    have no pairs.  (While a table with the mirror is built, only the left
+    wheel is there: the mirrored insertions cover the right.)
+    """
+    if a.derailed or b.derailed:
+        return [] if a.derailed == b.derailed else None
+    pairs = []
+    for side in range(2):
+        if len(a.patches[side]) != len(b.patches[side]):
+            return None
+        groups: list[list[tuple[float, TablePatch]]] = []
+        match(groups, 0.5, a.patches[side])
+        match(groups, 0.5, b.patches[side])
+        for g in groups:
+            if len(g) != 2:
+                return None
+            pairs.append((g[0][1], g[1][1]))
+    return pairs
+
+
+def _differ(a: TableNode, b: TableNode) -> bool:
+    """Return whether two neighbouring nodes differ enough to look between them.
+
+    Other patches, or a pair whose contact angles differ by more than
+    REFINE_ANGLE, centroids by more than REFINE_DISTANCE or loads by more
+    than REFINE_LOAD of the larger.
+    """
+    pairs = _pairs(a, b)
+    if pairs is None:
+        return True
+    for p, q in pairs:
+        angle = math.acos(max(-1.0, min(1.0, float(p.normal @ q.normal))))
+        if (angle > REFINE_ANGLE or float(np.linalg.norm(p.origin - q.origin)) > REFINE_DISTANCE
+                or abs(p.load - q.load) > REFINE_LOAD * max(p.load, q.load)):
+            return True
+    return False
+
+
+def _shape(p: TablePatch) -> tuple[float, float, float]:
+    """Return the cells and the RMS extents along ``u`` and ``v`` about the centroid (m)."""
+    nb, na = p.pressure.shape
+    a = p.a0 + p.da * np.arange(na)
+    b = p.b0 + p.db * np.arange(nb)
+    total = float(p.pressure.sum())
+    ma = float(p.pressure.sum(axis=0) @ (a * a)) / total
+    mb = float(p.pressure.sum(axis=1) @ (b * b)) / total
+    return float(p.cells), math.sqrt(max(ma, 0.0)), math.sqrt(max(mb, 0.0))
+
+
+def _blends_well(a: TableNode, b: TableNode, mid: TableNode) -> bool:
+    """Return whether the half-and-half blend of ``a`` and ``b`` is the node ``mid`` between them.
+
+    The blend's centroid within REFINE_MIDPOINT of the midpoint node's, its
+    load, cells and RMS extents within REFINE_SHAPE of them, the same patches.
+    """
+    pairs = _pairs(a, b)
+    if pairs is None or _pairs(a, mid) is None:
+        return False
+    mids = [q for _, q in _pairs(a, mid) or []]
+    for (p, q), m in zip(pairs, mids):
+        half = BlendPlan([(0.5, p), (0.5, q)])
+        if float(np.linalg.norm(half.origin - m.origin)) > REFINE_MIDPOINT:
+            return False
+        if abs(half.load - m.load) > REFINE_SHAPE * m.load:
+            return False
+        for x, y in zip(_shape(half.at(1.0 + 1e-12)), _shape(m)):
+            if abs(x - y) > REFINE_SHAPE * abs(y):
+                return False
+    return True
 
 
 @dataclass(frozen=True, eq=False)
@@ -686,37 +782,81 @@ class ContactTable:
 
     @classmethod
     def build(cls, wheelset: Wheelset, grid: TableGrid, load: float, *, workers: int = 1,
+              refine: int = 0,
               progress: Callable[[int, int], None] | None = None) -> ContactTable:
         """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 4).
 
-        ``load``: the reference wheel load (N).  ``progress(done, total)``
-        is called as chunks finish.
+        ``load``: the reference wheel load (N).  ``refine``: times the shift
+        intervals whose nodes are inconsistent (:func:`_consistent`, any yaw)
+        are halved; the inserted shifts are solved at every yaw (the grid
+        stays a tensor grid, and symmetric: ``-dy`` with ``dy``).
+        ``progress(done, total)`` is called as chunks finish.
         """
         if not (math.isfinite(load) and load > 0.0):
             raise TableError(f"a contact table needs a reference wheel load > 0 N, got {load!r}")
         mirror = wheelset.symmetric and grid.symmetric
         sides: tuple[Side, ...] = ("left",) if mirror else SIDES
-        nodes = grid.nodes()
-        chunks = [nodes[k:k + 8] for k in range(0, len(nodes), 8)]
-        if workers > 1 and len(chunks) > 1:
-            solved = _solve_in_children(wheelset, load, chunks, sides, workers, progress)
-        else:
-            solved = []
-            for c in chunks:
-                solved.extend(_solve_nodes((wheelset, load, c, sides)))
-                if progress:
-                    progress(len(solved), len(nodes))
-        if mirror:
-            n_dy, n_yaw = len(grid.dys), len(grid.yaws)
-            full = []
-            for k, node in enumerate(solved):
-                i, j = divmod(k, n_yaw)
-                twin = solved[(n_dy - 1 - i) * n_yaw + (n_yaw - 1 - j)]
-                right = tuple(p.mirrored() for p in twin.patches[0])
-                full.append(TableNode(node.roll, node.dz, (node.patches[0], right),
-                                      node.derailed or twin.derailed))
-            solved = full
-        return cls(grid, load, solved)
+        # nodes by integer keys (picometres, picoradians): a shift and its mirror image, or
+        # a midpoint reached from both sides, are one node whatever the float rounding
+        solved: dict[tuple[int, int], TableNode] = {}
+
+        def key(d: float, y: float) -> tuple[int, int]:
+            return round(d * 1e12), round(y * 1e12)
+
+        def solve(nodes: list[tuple[float, float]]) -> None:
+            chunks = [nodes[k:k + 8] for k in range(0, len(nodes), 8)]
+            if workers > 1 and len(chunks) > 1:
+                done = _solve_in_children(wheelset, load, chunks, sides, workers, progress)
+            else:
+                done = []
+                for c in chunks:
+                    done.extend(_solve_nodes((wheelset, load, c, sides)))
+                    if progress:
+                        progress(len(done), len(nodes))
+            solved.update((key(d, y), n) for (d, y), n in zip(nodes, done))
+
+        dys = {round(d * 1e12): d for d in grid.dys}
+        solve([(d, y) for d in grid.dys for y in grid.yaws])
+        # intervals to look into: first those whose ends differ; then the halves of those
+        # whose midpoint the blend of the ends misses
+        ordered = sorted(dys.values())
+        looking = [(d0, d1) for d0, d1 in zip(ordered[:-1], ordered[1:])
+                   if any(_differ(solved[key(d0, y)], solved[key(d1, y)]) for y in grid.yaws)]
+        for _ in range(refine):
+            inserted: dict[int, float] = {}
+            for d0, d1 in looking:
+                mid = 0.5 * (d0 + d1)
+                for d in ((mid, -mid) if mirror else (mid,)):
+                    if round(d * 1e12) not in dys:
+                        inserted.setdefault(round(d * 1e12), d)
+            if not inserted:
+                break
+            solve([(d, y) for d in sorted(inserted.values()) for y in grid.yaws])
+            dys.update(inserted)
+            following = []
+            for d0, d1 in looking:
+                mid = 0.5 * (d0 + d1)
+                if not all(_blends_well(solved[key(d0, y)], solved[key(d1, y)],
+                                        solved[key(mid, y)]) for y in grid.yaws):
+                    following += [(d0, mid), (mid, d1)]
+            if mirror:   # the mirror images of the intervals kept, once
+                mirrored = [(-d1, -d0) for d0, d1 in following]
+                seen = {(round(d0 * 1e12), round(d1 * 1e12)) for d0, d1 in following}
+                following += [(d0, d1) for d0, d1 in mirrored
+                              if (round(d0 * 1e12), round(d1 * 1e12)) not in seen]
+            looking = following
+        grid = TableGrid(tuple(sorted(dys.values())), grid.yaws)
+        nodes = []
+        for d in grid.dys:
+            for y in grid.yaws:
+                node = solved[key(d, y)]
+                if mirror:
+                    twin = solved[key(-d, -y)]
+                    right = tuple(p.mirrored() for p in twin.patches[0])
+                    node = TableNode(node.roll, node.dz, (node.patches[0], right),
+                                     node.derailed or twin.derailed)
+                nodes.append(node)
+        return cls(grid, load, nodes)
 
     def node(self, i_dy: int, i_yaw: int) -> TableNode:
         """Return the node at grid indices ``(i_dy, i_yaw)``."""
@@ -816,10 +956,10 @@ class ContactTable:
         return cls(grid, load, nodes)
 
 
-def table_key(wheelset: Wheelset, grid: TableGrid, load: float) -> str:
-    """Return a digest of everything a table's nodes depend on."""
+def table_key(wheelset: Wheelset, grid: TableGrid, load: float, refine: int = 0) -> str:
+    """Return a digest of everything a table's nodes depend on (``grid``: before refining)."""
     h = hashlib.sha256()
-    h.update(f"v{TABLE_VERSION};{grid.dys!r};{grid.yaws!r};{load!r};{wheelset.cell!r};"
+    h.update(f"v{TABLE_VERSION};{grid.dys!r};{grid.yaws!r};{load!r};r{refine};{wheelset.cell!r};"
              f"{wheelset.shear_modulus!r};{wheelset.poisson_ratio!r};{wheelset.separation!r};"
              f"{wheelset.placement!r}".encode())
     for side in SIDES:
@@ -830,14 +970,14 @@ def table_key(wheelset: Wheelset, grid: TableGrid, load: float) -> str:
 
 
 def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Path | None, *,
-                 workers: int | None = None, log: Callable[[str], None] | None = None
-                 ) -> ContactTable:
+                 refine: int = 0, workers: int | None = None,
+                 log: Callable[[str], None] | None = None) -> ContactTable:
     """Return the table from ``cache_dir`` if built for these inputs, else build and keep it.
 
     ``workers``: processes for a build (default: the machine's cores when
     there are at least 200 nodes).
     """
-    key = table_key(wheelset, grid, load)
+    key = table_key(wheelset, grid, load, refine)
     path = cache_dir / f"contact_table_{key}.npz" if cache_dir is not None else None
     if path is not None and path.exists():
         try:
@@ -851,7 +991,10 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
     if log:
         log(f"contact table: solving {n} nodes ({len(grid.dys)} shifts x {len(grid.yaws)} yaws) "
             f"in {workers} process(es); cached in {path}" if path else "")
-    table = ContactTable.build(wheelset, grid, load, workers=workers)
+    table = ContactTable.build(wheelset, grid, load, workers=workers, refine=refine)
+    if log and refine:
+        log(f"contact table: {len(table.grid.dys) - len(grid.dys)} shifts added where "
+            f"neighbouring nodes differed ({len(table.nodes)} nodes in all)")
     if path is not None:
         try:
             table.save(path, key)
@@ -863,5 +1006,5 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
 
 __all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "TableError",
            "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
-           "cached_table", "levelled_roll", "match", "solve_node", "table_key",
+           "cached_table", "levelled_roll", "match", "solve_node", "table_key", "warm_up",
            "BlendPlan"]
