@@ -16,6 +16,15 @@ wheel, 0.2 mm cells unless ``--cell``) it times, interleaved in one run:
 
 Prints medians and p99 (ms) with the machine.  Usage:
 ``python benchmarks/bench_geometry.py [--repeat N] [--cell H]``.
+
+``--table POSES``: instead, the contact table's path
+(``config/profiles_track_table.yaml``, the table read from its cache or
+built): ``pose (table)``, :meth:`ProfilePipeline.on_pose` on ``POSES``
+poses drawn over the range of A-2.2 (shift -10..10 mm, yaw within 24 mrad,
+10 kN per wheel, the twist of A-2.2), each its own (no two poses alike, so
+every one blends between nodes); ``table lookup`` (the nodes' weights,
+matching and blend plans, no resampling); and beside them, on a few of those
+poses, ``pose (per pose)`` (the same pipeline without the table).
 """
 
 from __future__ import annotations
@@ -67,11 +76,73 @@ def timed(fn: Callable[[], object], repeat: int) -> np.ndarray:
     return out * 1e3
 
 
+def table_rows(poses: int, per_pose: int) -> None:
+    """Time the table's path on ``poses`` poses and the per-pose path on ``per_pose`` of them."""
+    from fastsim_ros.params import load_params_file
+    from msg_adapters.cdr import StampedTwist
+
+    values = load_params_file(ROOT / "config" / "profiles_track_table.yaml")
+    start = time.perf_counter()
+    tabled = ProfilePipeline(PipelineConfig.from_values(values), log=print)
+    print(f"table ready in {time.perf_counter() - start:.2f} s "
+          f"({len(tabled.table.nodes) if tabled.table else 0} nodes)")
+    solved = ProfilePipeline(PipelineConfig.from_values({**values, "profile_table": False}))
+    rng = np.random.default_rng(7)
+    dys = rng.uniform(-10e-3, 10e-3, poses)
+    yaws = -2.4 * dys * rng.uniform(0.5, 1.0, poses)   # A-2.2 yaws as much as 2.4 mrad/mm
+    stamp = [0]
+
+    def cycle(p: ProfilePipeline, dy: float, yaw: float) -> str:
+        stamp[0] += 1
+        pose = Pose(dy, 0.0, yaw, 0.0)
+        twist = wheel_twist(pose, 2.0, 2.0 / 0.46, 0.0, 0.0)
+        p.on_wheel_twist(StampedTwist(stamp[0], twist.frame_id, twist.linear, twist.angular))
+        out = p.on_pose(StampedPose(stamp[0], "track", (0.0, dy, 0.0), quaternion(0.0, yaw)))
+        return out.outcomes[0].status
+
+    cycle(tabled, 0.0, 0.0)
+    cycle(solved, 0.0, 0.0)
+    statuses: dict[str, int] = {}
+    table_t, lookup_t, solved_t = [], [], []
+    every = max(1, poses // max(per_pose, 1))
+    for k, (dy, yaw) in enumerate(zip(dys, yaws)):
+        t0 = time.perf_counter()
+        status = cycle(tabled, float(dy), float(yaw))
+        t1 = time.perf_counter()
+        statuses[status] = statuses.get(status, 0) + 1
+        assert tabled.table is not None
+        tabled.table.lookup(float(dy), float(yaw))
+        t2 = time.perf_counter()
+        table_t.append(t1 - t0)
+        lookup_t.append(t2 - t1)
+        if per_pose and k % every == 0:
+            t3 = time.perf_counter()
+            cycle(solved, float(dy), float(yaw))
+            solved_t.append(time.perf_counter() - t3)
+    print(f"{'what':>18s} {'poses':>6s} {'median':>9s} {'p99':>9s} {'max':>9s}  (ms)")
+    for name, t in (("pose (table)", table_t), ("table lookup", lookup_t),
+                    ("pose (per pose)", solved_t)):
+        if t:
+            a = np.array(t) * 1e3
+            print(f"{name:>18s} {a.size:6d} {np.median(a):9.3f} {np.percentile(a, 99):9.3f} "
+                  f"{a.max():9.3f}")
+    print("left wheel's status over the table's poses: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(statuses.items())))
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=20)
     parser.add_argument("--cell", type=float, default=2e-4)
+    parser.add_argument("--table", type=int, default=0, metavar="POSES",
+                        help="time the contact table's path on POSES poses instead")
+    parser.add_argument("--per-pose", type=int, default=20, metavar="N",
+                        help="with --table: N of the poses also solved without the table")
     args = parser.parse_args()
+    if args.table:
+        print(f"machine: {machine()}")
+        table_rows(args.table, args.per_pose)
+        return 0
     print(f"machine: {machine()}; cell {args.cell * 1e3:g} mm; {args.repeat} repeats, "
           "interleaved; times in ms")
     print(f"{'pose':>18s} {'what':>16s} {'median':>9s} {'p99':>9s}")

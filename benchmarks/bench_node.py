@@ -14,6 +14,7 @@ rclpy publish) to show where the time goes.
 
     .venv/bin/python benchmarks/bench_node.py --contacts 2 4 --seconds 20
     .venv/bin/python benchmarks/bench_node.py --contacts 4 --soak 10
+    .venv/bin/python benchmarks/bench_node.py --profiles 3 --seconds 10   # profiles mode
 """
 
 from __future__ import annotations
@@ -153,7 +154,8 @@ def profile(calls: int) -> None:
     print(f"per-message path, {calls} calls (us): median / p99")
     for key, v in steps.items():
         print(f"  {key:22s} {statistics.median(v):7.1f} / {np.percentile(v, 99):7.1f}")
-    print(f"  {'solve alone (in on_patch)':22s} {p50:7.1f} / {p99:7.1f}")
+    # the pipeline's solve times: on its compiled path, the one call (adapter loop + solve)
+    print(f"  {'solve (compiled call)':22s} {p50:7.1f} / {p99:7.1f}")
     ctx = Context()
     rclpy.init(context=ctx)
     node = Node("bench_publish", context=ctx)
@@ -222,6 +224,8 @@ def startup(trials: int) -> None:
 #: ["--native"]: py-spy samples C and C++ frames too (pausing the process at each sample)
 NATIVE: list[str] = ["--native"] if os.environ.get("BENCH_NATIVE") else []
 FLOOR = Path(__file__).resolve().parent / "dds_floor.py"
+#: the checkout whose node runs as the target "baseline" (--baseline)
+BASELINE = ROOT
 
 
 def target_command(target: str, names: list[str], executor: str,
@@ -231,6 +235,11 @@ def target_command(target: str, names: list[str], executor: str,
         return [sys.executable, str(FLOOR), "--contacts", *names]
     if target == "floor+solve":
         return [sys.executable, str(FLOOR), "--solve", "--contacts", *names]
+    if target == "baseline":  # the node of another checkout's sources (BASELINE)
+        return [sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv.pop(1)); "
+                "from fastsim_ros.node import main; sys.exit(main())", str(BASELINE),
+                "--ros-args", "-p", f"executor:={executor}", "-p",
+                "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]", *node_args]
     return [str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",
             "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]", *node_args]
 
@@ -367,7 +376,11 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
     the floor that also solves a fixed patch per patch (``dds_floor.py
     --solve``) runs in the rotation too: what the solve alone adds.
     """
-    targets = ("node", "floor", "floor+solve") if bound else ("node", "floor")
+    targets: tuple[str, ...] = ("node", "floor")
+    if bound:
+        targets += ("floor+solve",)
+    if BASELINE != ROOT:
+        targets += ("baseline",)
     runs: dict[str, list[dict[str, float]]] = {t: [] for t in targets}
     for r in range(rounds):
         # rotate which goes first, so that a drift of the machine weighs on all
@@ -389,6 +402,10 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
           f"({n['received'] - f['received']:+.2f} points; target >= -0.2), "
           f"p99 {n['p99'] / f['p99']:.2f}x (target <= 2), "
           f"CPU {n['cpu'] / f['cpu']:.2f}x (target <= 1.5)", flush=True)
+    if "baseline" in med:
+        b = med["baseline"]
+        print(f"  baseline/floor: received {b['received'] - f['received']:+.2f} points, "
+              f"p99 {b['p99'] / f['p99']:.2f}x, CPU {b['cpu'] / f['cpu']:.2f}x", flush=True)
     if bound:
         b = med["floor+solve"]
         print(f"  floor+solve/floor: received {b['received'] - f['received']:+.2f} points, "
@@ -415,15 +432,31 @@ def main() -> None:
     parser.add_argument("--bound", action="store_true",
                         help="with --floor: the floor that also solves a fixed patch "
                         "(dds_floor.py --solve) in the rotation too")
-    parser.add_argument("--target", choices=("node", "floor", "floor+solve"), default="node",
+    parser.add_argument("--baseline", default=None, metavar="CHECKOUT",
+                        help="with --floor: the node of another checkout's sources (a "
+                        "worktree of main, say) in the rotation too, as 'baseline'")
+    parser.add_argument("--target", choices=("node", "floor", "floor+solve", "baseline"),
+                        default="node",
                         help="what the single runs drive: the node or the DDS floor")
     parser.add_argument("--py-spy", default=None, metavar="FILE",
                         help="record the target with py-spy (collapsed stacks to FILE)")
     parser.add_argument("--floor", type=int, default=0, metavar="ROUNDS",
                         help="drive the node and the DDS floor (dds_floor.py) alternately, "
                         "ROUNDS times each, and print node/floor ratios of the medians")
+    parser.add_argument("--profiles", type=int, default=0, metavar="ROUNDS",
+                        help="the node in profiles mode (one wheelset, poses and twists at "
+                        "--rate) and in topics mode (two patches a cycle) alternately, ROUNDS "
+                        "times each (bench_profiles_node.py)")
     args = parser.parse_args()
+    if args.baseline:
+        global BASELINE
+        BASELINE = Path(args.baseline).resolve()
     print(f"machine: {machine()}")
+    if args.profiles:
+        import bench_profiles_node
+        bench_profiles_node.side_by_side(sys.modules[__name__], args.rate, args.seconds,
+                                         args.profiles, shlex.split(args.node_args))
+        return
     if not NODE.exists():
         raise SystemExit(f"{NODE} is missing: run scripts/setup_env.sh")
     if args.startup:

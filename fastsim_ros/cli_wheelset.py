@@ -36,6 +36,7 @@ from fastsim_ros.contact.compiled import ContactForces
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 from fastsim_ros.geometry.errors import GeometryError
 from fastsim_ros.geometry.placement import Pose, rotation
+from fastsim_ros.geometry.wheelset import WheelsetContact
 from fastsim_ros.geometry.profiles import S1002, UIC60
 from fastsim_ros.params import ParameterError
 from fastsim_ros.pipeline import PipelineConfig
@@ -180,7 +181,7 @@ def solve_pose(args: argparse.Namespace, dy: float,
             cycle = _cycle(scout, Pose(dy, dz, yaw, 0.0), args, axle_spin)
             if cycle.contact is None:
                 _refused(cycle)
-            assert cycle.contact is not None
+            assert isinstance(cycle.contact, WheelsetContact)   # never a table here
             roll = cycle.contact.pose.roll
             dz = cycle.contact.pose.dz
         pipeline = ProfilePipeline(config, solver=solver)
@@ -213,7 +214,7 @@ def _refused(cycle: ProfileCycle) -> None:
 def result_of(cycle: ProfileCycle, pipeline: ProfilePipeline, method: str) -> dict[str, Any]:
     """Return the JSON object of INTERFACE.md for one solved pose."""
     contact = cycle.contact
-    assert contact is not None
+    assert isinstance(contact, WheelsetContact)   # the command line solves each pose
     pose = contact.pose
     rot = pose.rotation()
     centre = np.array([0.0, pose.dy, pipeline.wheelset.placement.nominal_radius + pose.dz])

@@ -49,6 +49,7 @@ from sensor_msgs.msg import PointCloud2
 from visualization_msgs.msg import MarkerArray
 
 from fastsim_ros import params as parameters
+from fastsim_ros import pipeline_kernels
 from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
@@ -142,9 +143,10 @@ class FastsimNode(Node):
         warm = compiled.warm_up()
         start = time.perf_counter()
         patch_adapter.warm_up()
+        pipeline_kernels.warm_up()
         warm += time.perf_counter() - start
         try:  # profiles mode reads and places its profiles here
-            self.pipeline = make_pipeline(config)
+            self.pipeline = make_pipeline(config, log=self.get_logger().info)
         except parameters.ParameterError as e:  # a profile file or placement: one line
             raise StartupError(str(e)) from None
         depth = int(config["qos_depth"])

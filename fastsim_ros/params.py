@@ -219,6 +219,30 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("wheel_load", "double", 0.0,
                   "vertical load per wheel (N) when no wheelset/load arrived; 0: the pose's "
                   "vertical position is used as given", low=0.0, high=1.0e7, dynamic=True),
+    # --- the contact table of profiles mode (fastsim_ros/geometry/table.py)
+    ParameterSpec("profile_table", "bool", False,
+                  "profiles mode: interpolate the patches in a table over lateral shift and "
+                  "yaw solved at start (or read from table_cache), at the reference load "
+                  "wheel_load, instead of solving each pose (about 1 ms a pose, not 20-200)"),
+    ParameterSpec("table_dy_min", "double", -0.012,
+                  "contact table: smallest lateral shift (m)", low=-0.05, high=0.05),
+    ParameterSpec("table_dy_max", "double", 0.012,
+                  "contact table: largest lateral shift (m)", low=-0.05, high=0.05),
+    ParameterSpec("table_dy_step", "double", 1.0e-4,
+                  "contact table: step of the lateral shift (m; divides the range)",
+                  low=1.0e-6, high=0.01),
+    ParameterSpec("table_yaw_max", "double", 0.025,
+                  "contact table: yaw range +-table_yaw_max (rad; 0: yaw 0 only)",
+                  low=0.0, high=0.1),
+    ParameterSpec("table_yaw_step", "double", 5.0e-3,
+                  "contact table: step of the yaw (rad; divides 2 table_yaw_max)",
+                  low=1.0e-5, high=0.1),
+    ParameterSpec("table_refine", "integer", 4,
+                  "contact table: times the shift intervals whose nodes differ (a contact "
+                  "taking over, a contact running fast) are halved", low=0, high=8),
+    ParameterSpec("table_cache", "string", "~/.cache/fastsim_ros",
+                  "directory of built contact tables (keyed by profiles and parameters; "
+                  "empty: build every start, keep none)", empty_ok=True),
 )
 
 SPECS: dict[str, ParameterSpec] = {spec.name: spec for spec in PARAMETERS}

@@ -8,6 +8,11 @@ wrench, or a rejection with its reason key (INTERFACE.md).  It never reads
 a clock for anything it outputs: stamps come from the messages, so a replay
 is deterministic (only the solve-time statistics use ``perf_counter``).
 No ``rclpy.node`` here: the node and ``fastsim_replay`` are thin front ends.
+A patch that is solved takes the compiled path
+(:func:`fastsim_ros.pipeline_kernels.solve_cloud`: the adapter's loop, the
+creepages, the MAE solve and the wheelset wrench in one call, equal to the
+bit to the Python path, which decides every rejection); its solve time is
+that call's.
 
 Physics (INTERFACE.md "Creepages", METHOD.md 1): the solvers roll towards
 ``+x``; when the rolling speed ``V`` is negative (reverse running) the patch
@@ -22,21 +27,26 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable, Container, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
 
 from fastsim_ros import params as parameters
+from fastsim_ros import pipeline_kernels as fast
+from fastsim_ros.contact import compiled
+from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from msg_adapters import outputs as out
-from msg_adapters.cdr import Cloud, CloudReader, StampedTwist, read_twist
+from msg_adapters import patch_kernels
+from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist,
+                              stamped_doubles_template)
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
-from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud
+from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud, words_of
 
 #: twists kept for matching patch stamps (at 1 kHz: 1 s of history)
 TWIST_HISTORY = 1024
@@ -77,6 +87,10 @@ def output_topics(contacts: tuple[str, ...], *, patches: bool = False) -> dict[s
     topics[MARKERS_TOPIC] = "visualization_msgs/msg/MarkerArray"
     topics[DIAGNOSTICS_TOPIC] = "diagnostic_msgs/msg/DiagnosticArray"
     return topics
+
+
+#: a patch solved already: as converted, its creepages, forces and solve time (s)
+Solved = tuple[ContactPatch, Creepage, ContactForces, float]
 
 
 @dataclass(frozen=True)
@@ -200,10 +214,13 @@ class ContactReport:
 
 class _ContactState:
     __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
-                 "wrench_fresh", "stats", "reader")
+                 "wrench_fresh", "stats", "reader", "frame_out", "result")
 
     def __init__(self) -> None:
         self.reader = CloudReader()  # the topic's header parsed once
+        # the compiled path's outputs, read right after each call
+        self.frame_out = np.empty(patch_kernels.OUT_SIZE)
+        self.result = np.empty(fast.RESULT_SIZE)
         self.last_stamp_ns: int | None = None
         self.last_frame: ContactFrame | None = None
         self.last_marker_ns: int | None = None
@@ -217,12 +234,14 @@ class _ContactState:
 class _ContactTopics:
     """A contact's output topics (relative names), built once."""
 
-    __slots__ = ("wrench", "creepage", "frame", "traction")
+    __slots__ = ("wrench", "creepage", "frame", "traction", "wrench_cdr")
 
     def __init__(self, contact: str) -> None:
         base = f"contact/{contact}/"
         self.wrench, self.creepage = base + "wrench", base + "creepage"
         self.frame, self.traction = base + "frame", base + "traction"
+        # the contact's WrenchStamped, (Fx, Fy, N) and (0, 0, Mz): only numbers change
+        self.wrench_cdr = stamped_doubles_template(out.contact_frame_id(contact), 6).encode
 
 
 class _Every:
@@ -233,6 +252,33 @@ class _Every:
 
 
 _EVERY = _Every()
+
+
+def _builder(cls: type) -> Callable[..., Any]:
+    """Return a constructor of a frozen, slotted dataclass taking every field in order.
+
+    The dataclass's own ``__init__`` sets each field through
+    ``object.__setattr__`` (what ``frozen`` costs); this one calls each slot's
+    setter directly: half the time, for the five results built per patch on
+    the compiled path.  No defaults, no ``__post_init__`` (none of them has
+    one); the instance equals the ``__init__``'s (test_pipeline_kernels.py).
+    """
+    names = [f.name for f in fields(cls)]
+    assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
+    args = ", ".join(names)
+    body = "".join(f"    set_{n}(o, {n})\n" for n in names)
+    scope: dict[str, Any] = {"new": object.__new__, "cls": cls}
+    scope.update({f"set_{n}": getattr(cls, n).__set__ for n in names})
+    exec(f"def build({args}):\n    o = new(cls)\n{body}    return o\n", scope)
+    build: Callable[..., Any] = scope["build"]
+    return build
+
+
+_new_frame = _builder(ContactFrame)
+_new_patch = _builder(ContactPatch)
+_new_creepage = _builder(Creepage)
+_new_forces = _builder(ContactForces)
+_new_outcome = _builder(Outcome)
 
 
 def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
@@ -272,7 +318,10 @@ class Pipeline:
             "fastsim_ellipse": EquivalentEllipseSolver(nu, g)}
         self._wheel: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
         self._rail: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
+        # the twists last given to the compiled path, as its arrays (v, w)
+        self._twist_arrays: dict[str, tuple[StampedTwist, np.ndarray]] = {}
         self._contacts = {name: _ContactState() for name in config.contacts}
+        self._fresh = 0  # contacts with a wrench not yet in a wheelset wrench
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
@@ -297,6 +346,16 @@ class Pipeline:
         rate = float(config["marker_rate"])
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
+        # the compiled path (pipeline_kernels.solve_cloud): the MAE methods without
+        # tractions; the solver's arguments as its solve_arrays passes them
+        self._compiled: tuple[Any, ...] | None = None
+        solver = self._solver
+        if isinstance(solver, MaeSolver) and not self._tractions:
+            code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
+            self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
+                              solver._knots, solver._polys, code, prm, mu_s,
+                              self._law is not None, solver._calibrated, solver._pair_knots,
+                              solver._pair_values)
 
     def update(self, changes: Mapping[str, Any]) -> None:
         """Apply new values of parameters (checked; the material and contacts stay)."""
@@ -397,8 +456,15 @@ class Pipeline:
 
     # ---------------------------------------------------------------- patches
 
-    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview) -> Outcome:
-        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches."""
+    def on_patch(self, contact: str, cloud: Cloud | bytes | memoryview, *,
+                 given: Solved | None = None) -> Outcome:
+        """Solve one patch (decoded or CDR) of ``contact`` with the kinematics it matches.
+
+        ``given``: the patch as converted, its creepages, forces and solve
+        time (s), from :meth:`solve_patch` on this cloud's patch with this
+        stamp's kinematics (profiles mode's load balance solved it already):
+        then the stamp and frame are checked and the rest taken as given.
+        """
         state = self._contacts[contact]
         stats = state.stats
         if not isinstance(cloud, Cloud):
@@ -421,14 +487,33 @@ class Pipeline:
                 raise RejectedInput("old_stamp", f"stamp {stamp} ns is older than the last, "
                                     f"{state.last_stamp_ns} ns")
             state.last_stamp_ns = stamp
-            patch = patch_from_cloud(cloud, max_cells=self._max_cells)
-            if patch is None:
-                return self._no_contact(contact, state, stamp)
-            wheel, rail = self._kinematics(stamp)
-            creep = creepages(patch.frame, wheel, rail)
-            if not abs(creep.speed) >= self._min_speed:
-                raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
-            forces = self._solve(patch, creep, stats)
+            done = None
+            if given is not None:
+                patch, creep, forces, seconds = given
+                stats.add_solve_time(seconds)
+            else:
+                done = (self._solve_compiled(cloud, state) if self._compiled is not None
+                        else None)
+                if done is None:  # the Python path: it gives the reason of a rejection
+                    converted = patch_from_cloud(cloud, max_cells=self._max_cells)
+                    if converted is None:
+                        return self._no_contact(contact, state, stamp)
+                    patch = converted
+                    wheel, rail = self._kinematics(stamp)
+                    creep = creepages(patch.frame, wheel, rail)
+                    if not abs(creep.speed) >= self._min_speed:
+                        raise RejectedInput("standstill",
+                                            f"rolling speed {creep.speed:.4g} m/s")
+                    forces = self._solve(patch, creep, stats)
+            if done is None:
+                f_ws = patch.frame.to_wheelset((forces.fx, forces.fy, forces.n))
+                m_ws = patch.frame.to_wheelset((0.0, 0.0, forces.mz))
+                o = patch.frame.origin
+                torque = (o[1] * f_ws[2] - o[2] * f_ws[1] + m_ws[0],
+                          o[2] * f_ws[0] - o[0] * f_ws[2] + m_ws[1],
+                          o[0] * f_ws[1] - o[1] * f_ws[0] + m_ws[2])
+            else:
+                patch, creep, forces, f_ws, torque = done
         except RejectedInput as e:
             stats.counts[e.reason] += 1
             stats.window_rejected += 1
@@ -438,19 +523,67 @@ class Pipeline:
         changed = _frame_moved(state.last_frame, patch.frame)
         if changed:
             state.last_frame = patch.frame
-        f_ws = patch.frame.to_wheelset((forces.fx, forces.fy, forces.n))
-        m_ws = patch.frame.to_wheelset((0.0, 0.0, forces.mz))
-        o = patch.frame.origin
-        torque = (o[1] * f_ws[2] - o[2] * f_ws[1] + m_ws[0],
-                  o[2] * f_ws[0] - o[0] * f_ws[2] + m_ws[1],
-                  o[0] * f_ws[1] - o[1] * f_ws[0] + m_ws[2])
         wheelset = self._add_wrench(state, stamp, f_ws, torque)
-        return Outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces, patch,
-                       wheelset, self._markers_due(state, stamp))
+        return _new_outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces,
+                            patch, wheelset, self._markers_due(state, stamp))
+
+    def _twist_array(self, what: str, twist: StampedTwist) -> np.ndarray:
+        """Return a twist's ``(v, w)`` as an array (built once per twist)."""
+        last = self._twist_arrays.get(what)
+        if last is not None and last[0] is twist:
+            return last[1]
+        values = np.array(twist.linear + twist.angular, dtype=np.float64)
+        self._twist_arrays[what] = (twist, values)
+        return values
+
+    def _solve_compiled(self, cloud: Cloud, state: _ContactState) -> tuple[
+            ContactPatch, Creepage, ContactForces, tuple[float, float, float],
+            tuple[float, float, float]] | None:
+        """Solve a patch on the compiled path; None where the Python path must decide.
+
+        Returns the patch, its creepages and forces, and its wrench in the
+        wheelset frame (force, torque about the origin), each to the bit as
+        the Python path gives them.  None for an input the Python path may
+        reject (or find without contact): it then runs from the start.
+        """
+        ny, nx = cloud.height, cloud.width
+        if not 0 < ny * nx <= self._max_cells:
+            return None
+        try:
+            words, row, step, cols = words_of(cloud)
+            wheel, rail = self._kinematics(cloud.stamp_ns)
+        except RejectedInput:
+            return None
+        assert self._compiled is not None
+        (rule, parabolic, shear_modulus, knots, polys, law, prm, mu, slip_dependent,
+         calibrated, pair_knots, pair_values) = self._compiled
+        pressure = np.empty((ny, nx))
+        frame_out, result = state.frame_out, state.result
+        start = time.perf_counter()
+        status = fast.solve_cloud(
+            words, ny, nx, row, step, cols, pressure, frame_out,
+            self._twist_array("wheel", wheel), self._twist_array("rail", rail),
+            self._min_speed, rule, parabolic, shear_modulus, knots, polys, law, prm, mu,
+            slip_dependent, calibrated, pair_knots, pair_values, result)
+        elapsed = time.perf_counter() - start
+        if status != fast.SOLVED:
+            return None
+        # the adapter's loop and the solve, timed together on this path
+        state.stats.add_solve_time(elapsed)
+        (o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2, ez0, ez1, ez2) = frame_out[
+            patch_kernels.ORIGIN:patch_kernels.E_Z + 3].tolist()
+        (x0, y0, dx, dy, load, cells, row_order, column_order, xi, eta, phi, speed, fx, fy,
+         mz, n, slip_fraction, f0, f1, f2, t0, t1, t2) = result.tolist()
+        frame = _new_frame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
+        patch = _new_patch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, int(cells),
+                           int(row_order), int(column_order))
+        return (patch, _new_creepage(xi, eta, phi, speed),
+                _new_forces(fx, fy, mz, n, slip_fraction, None, None, None, None), (f0, f1, f2),
+                (t0, t1, t2))
 
     def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
-                    rail: StampedTwist = REST, *,
-                    method: str | None = None) -> tuple[Creepage, ContactForces]:
+                    rail: StampedTwist = REST, *, method: str | None = None,
+                    timing: list[float] | None = None) -> tuple[Creepage, ContactForces]:
         """Return the creepages and creep forces of one converted patch under given twists.
 
         The rules of :meth:`on_patch` (standstill, the solver's refusals as
@@ -462,7 +595,11 @@ class Pipeline:
         if not abs(creep.speed) >= self._min_speed:
             raise RejectedInput("standstill", f"rolling speed {creep.speed:.4g} m/s")
         if method is None or method == self.config["method"]:
-            return creep, self._solve(patch, creep, ContactStats())
+            stats = ContactStats()
+            forces = self._solve(patch, creep, stats)
+            if timing is not None:
+                timing.append(float(stats.solve_times[0]))
+            return creep, forces
         configured, self._solver = self._solver, self._solvers[method]
         try:
             return creep, self._solve(patch, creep, ContactStats())
@@ -528,9 +665,12 @@ class Pipeline:
                     torque: tuple[float, float, float]) -> WheelsetWrench | None:
         """Keep the contact's wrench; return the wheelset wrench if every contact has a new one."""
         state.wrench = (stamp, force, torque)
-        state.wrench_fresh = True
-        if not all(s.wrench_fresh for s in self._contacts.values()):
+        if not state.wrench_fresh:
+            state.wrench_fresh = True
+            self._fresh += 1
+        if self._fresh < len(self._contacts):  # some contact has no new wrench yet
             return None
+        self._fresh = 0
         fs = [0.0, 0.0, 0.0]
         ts = [0.0, 0.0, 0.0]
         newest = stamp
@@ -577,8 +717,8 @@ class Pipeline:
             if topic in wanted:
                 msgs.append((topic, out.contact_wrench_cdr(stamp, c, 0.0, 0.0, 0.0, 0.0)))
         else:
-            if topic in wanted:
-                msgs.append((topic, out.contact_wrench_cdr(stamp, c, f.fx, f.fy, f.n, f.mz)))
+            if topic in wanted:  # (out.contact_wrench_cdr, from the contact's template)
+                msgs.append((topic, topics.wrench_cdr(stamp, f.fx, f.fy, f.n, 0.0, 0.0, f.mz)))
             topic = topics.creepage
             if topic in wanted:
                 msgs.append((topic, out.creepage_cdr(stamp, c, outcome.creepage)))

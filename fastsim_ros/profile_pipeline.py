@@ -25,36 +25,66 @@ Loads: the newest ``wheelset/load`` not after the pose and at most
 moment: the left wheel carries ``(F + M/b)/2`` with ``b`` the wheel
 profile's lateral offset); else ``wheel_load`` per wheel; else (``0``) the
 pose's vertical position as given.
+
+With ``profile_table`` the patches come from a contact table
+(:mod:`~fastsim_ros.geometry.table`) solved over lateral shift and yaw at the
+reference load ``wheel_load`` when the pipeline starts (or read from
+``table_cache``): each pose then costs a lookup, a blend and the vertical
+balance with the creep forces on the Hertz-similar scale of the patches,
+about a millisecond instead of 20-200.  The pose's roll and height are not
+used then: the table's roll is the one at which both rigid wheels touch, the
+height follows from the loads.  A pose outside the table is dropped as
+``out_of_table``.
 """
 
 from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Container, Mapping, Sequence
+from collections.abc import Callable, Container, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 
 from fastsim_ros.contact.errors import ContactError
 from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
-from fastsim_ros.geometry.placement import Placement, Pose
+from fastsim_ros.geometry.placement import Placement, Pose, rotation
 from fastsim_ros.geometry.profiles import read_profile
+from fastsim_ros.geometry.table import (ContactTable, TableError, TableGrid, TablePatch,
+                                        TableRangeError, cached_table)
+from fastsim_ros.geometry.table import warm_up as table_warm_up
 from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Wheelset,
                                            WheelsetContact)
 from fastsim_ros.params import PROFILE_CONTACTS, SPECS, ParameterError
 from fastsim_ros.pipeline import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic, Outcome,
-                                  Pipeline, PipelineConfig, output_topics, patch_topic)
+                                  Pipeline, PipelineConfig, Solved, output_topics, patch_topic)
 from msg_adapters.cdr import Cloud, StampedTwist
 from msg_adapters.errors import MalformedMessageError, RejectedInput
-from msg_adapters.patch import MIN_CONTACT_CELLS, patch_from_cloud
+from msg_adapters.patch import (MIN_CONTACT_CELLS, ContactFrame, ContactPatch, contact_axes,
+                                patch_from_cloud)
 from msg_adapters.profile_msgs import (StampedPose, cloud_cdr, patch_cloud, read_load,
                                        read_pose)
 
 POSE_TOPIC, LOAD_TOPIC = "wheelset/pose", "wheelset/load"
 #: loads kept for matching pose stamps
 LOAD_HISTORY = 1024
+#: the table's vertical balance with the creep forces: to this share of the load (1 N at
+#: 10 kN: the creep forces then err by 1e-4 of themselves, twenty times below the table's
+#: median interpolation error, docs/validation_table.md), in at most BALANCE_ITERATIONS
+#: secant steps on the scale s^3; where the patch's cells step (a cell more or less at a
+#: new scale) it may stop at ACCEPT_BALANCE
+BALANCE_TOLERANCE = 1e-4
+ACCEPT_BALANCE = 1e-3
+BALANCE_ITERATIONS = 12
+
+
+class CloudSource(Protocol):
+    """A solved patch that gives its cloud: ``points, normal, pressure`` (wheelset frame)."""
+
+    def cloud_arrays(self) -> tuple[Any, Any, Any]:
+        """Return the cell centres (m), the normal and the pressure (Pa)."""
 
 
 def contact_name(side: Side, index: int) -> str:
@@ -70,6 +100,52 @@ def placement_of(values: Any) -> Placement:
                      flange_back_distance=float(values["flange_back_distance"]),
                      flange_back_position=float(values["flange_back_position"]),
                      nominal_radius=float(values["nominal_radius"]))
+
+
+def table_grid_of(config: PipelineConfig) -> TableGrid:
+    """Return the contact table's grid from the ``table_*`` parameters (ParameterError if bad)."""
+    try:
+        return TableGrid.regular(float(config["table_dy_min"]), float(config["table_dy_max"]),
+                                 float(config["table_dy_step"]), float(config["table_yaw_max"]),
+                                 float(config["table_yaw_step"]))
+    except TableError as e:
+        raise ParameterError(f"contact table parameters: {e}") from None
+
+
+def table_of(config: PipelineConfig, wheelset: Wheelset,
+             log: Callable[[str], None] | None = None) -> ContactTable:
+    """Return the contact table of a configuration: read from ``table_cache`` or built there.
+
+    Its reference load is ``wheel_load``, which must be positive.
+    """
+    load = float(config["wheel_load"])
+    if load <= 0.0:
+        raise ParameterError("parameter 'wheel_load': profile_table needs the reference wheel "
+                             "load (N) > 0")
+    cache = str(config["table_cache"])
+    directory = Path(cache).expanduser() if cache else None
+    return cached_table(wheelset, table_grid_of(config), load, directory,
+                        refine=int(config["table_refine"]), log=log)
+
+
+def table_contact_patch(patch: TablePatch, stamp_ns: int, *, max_cells: int) -> ContactPatch:
+    """Return a table patch as the adapter makes it of its cloud (to rounding), cloud skipped.
+
+    The table's patches lie in the adapter's contact frame (``x`` the
+    wheelset's projected) with their pressure centroid at the origin, so the
+    frame and grid are the table's own; the adapter's bounds still apply.
+    """
+    ny, nx = patch.pressure.shape
+    if ny * nx > max_cells:
+        raise RejectedInput("too_large", f"{ny} x {nx} cells exceed max_patch_cells = "
+                            f"{max_cells}")
+    if patch.cells < MIN_CONTACT_CELLS:
+        raise RejectedInput("degenerate", f"{patch.cells} cells in contact")
+    o, n = patch.origin, patch.normal
+    frame = ContactFrame((float(o[0]), float(o[1]), float(o[2])),
+                         contact_axes((float(n[0]), float(n[1]), float(n[2]))))
+    return ContactPatch(stamp_ns, frame, patch.pressure, patch.a0, patch.b0, patch.da, patch.db,
+                        patch.load, patch.cells, 1, 1)
 
 
 def wheelset_of(config: PipelineConfig) -> Wheelset:
@@ -107,19 +183,43 @@ class ProfileCycle:
     stamp_ns: int
     patches: tuple[tuple[str, Cloud], ...]
     outcomes: tuple[Outcome, ...]
-    contact: WheelsetContact | None
+    contact: WheelsetContact | TableContact | None
     loads: tuple[float, float] | None
+
+
+@dataclass(frozen=True, eq=False)
+class TableContact:
+    """Both wheels' patches from the contact table at one pose.
+
+    ``roll``: the table's (rad); ``patches``: left then right wheel, tread
+    first, each at its wheel's load; ``scales``: the Hertz scale ``s`` of
+    each wheel's patches (``nan`` for a lifted wheel); ``vertical``: each
+    wheel's vertical force (N, normal and creep forces) where the balance
+    stopped.
+    """
+
+    roll: float
+    patches: tuple[tuple[TablePatch, ...], tuple[TablePatch, ...]]
+    scales: tuple[float, float]
+    vertical: tuple[float, float]
 
 
 class ProfilePipeline:
     """Poses + loads + twists -> patches -> the pipeline's outputs (INTERFACE.md)."""
 
     def __init__(self, config: PipelineConfig, *, solve_roll: bool = False,
-                 solver: Any = None) -> None:
+                 solver: Any = None, log: Callable[[str], None] | None = None) -> None:
         if config["patch_source"] != "profiles":
             raise ParameterError("a ProfilePipeline needs patch_source: profiles")
         self.pipeline = Pipeline(config, solver=solver)
         self.wheelset = wheelset_of(config)
+        self.table = table_of(config, self.wheelset, log) if config["profile_table"] else None
+        #: the configured method's solves of the table patches in this pose's balance
+        self._solved: dict[int, Solved] = {}
+        #: each wheel's creep forces' vertical sum per unit s^3 at its last balance (N)
+        self._creep_share: dict[str, float] = {"left": 0.0, "right": 0.0}
+        if self.table is not None:
+            table_warm_up()   # the blend's kernels compiled or loaded before the first pose
         self.solve_roll = solve_roll
         self._loads: deque[StampedTwist] = deque(maxlen=LOAD_HISTORY)
         self._last_pose_ns: int | None = None
@@ -295,36 +395,128 @@ class ProfilePipeline:
         except RejectedInput as e:
             return self._dropped(stamp, e.reason, e.detail)
         loads = self.wheel_loads(stamp)
+        contact: WheelsetContact | TableContact
+        solved: dict[str, Solved | None] = {}
         try:
-            contact = self.solve(wheelset_pose, wheel, rail, stamp, loads=loads)
+            if self.table is not None and loads is not None:
+                self._solved.clear()
+                contact = self.table_solve(wheelset_pose.dy, wheelset_pose.yaw, wheel, rail,
+                                           stamp, loads=loads)
+                patches = self.clouds_of(zip(SIDES, contact.patches), stamp)
+                solved = {contact_name(side, k): self._solved.get(id(tp))
+                          for side, wheel_patches in zip(SIDES, contact.patches)
+                          for k, tp in enumerate(wheel_patches)}
+            else:
+                contact = self.solve(wheelset_pose, wheel, rail, stamp, loads=loads)
+                patches = self.clouds(contact, stamp)
         except RejectedInput as e:
             return self._dropped(stamp, e.reason, e.detail)
+        except TableRangeError as e:
+            return self._dropped(stamp, "out_of_table", str(e))
         except (DerailmentError, NoContactError) as e:
             return self._dropped(stamp, "derailment", str(e))
         except ContactError as e:
             return self._dropped(stamp, "degenerate", str(e))
-        patches = self.clouds(contact, stamp)
         self._clouds = dict(patches)
-        outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
+        if self.table is not None and loads is not None:
+            # the balance's last step solved these very patches with the configured method:
+            # the pipeline takes those solves (the clouds carry the same patches, to rounding)
+            outcomes = tuple(self.pipeline.on_patch(name, cloud, given=solved.get(name))
+                             for name, cloud in patches)
+        else:
+            outcomes = tuple(self.pipeline.on_patch(name, cloud) for name, cloud in patches)
         return ProfileCycle(stamp, patches, outcomes, contact, loads)
 
     def solve(self, pose: Pose, wheel: StampedTwist, rail: StampedTwist, stamp_ns: int, *,
               loads: tuple[float, float] | None) -> WheelsetContact:
         """Return both wheels' contacts at a pose under the twists (creep forces balanced)."""
+        creep_forces = self.creep_forces(pose.rotation(), wheel, rail, stamp_ns)
+        return self.wheelset.solve(pose, loads=loads, solve_roll=self.solve_roll,
+                                   tangential=creep_forces)
+
+    def table_solve(self, dy: float, yaw: float, wheel: StampedTwist, rail: StampedTwist,
+                    stamp_ns: int, *, loads: tuple[float, float]) -> TableContact:
+        """Return both wheels' patches from the contact table, each wheel's load balanced.
+
+        A wheel's vertical force is ``u A + T(u)``: ``A`` its patches'
+        normal forces' vertical sum at the reference load, ``u = s^3`` the
+        Hertz scale's cube, ``T`` the creep forces' vertical sum on the
+        patches at that scale (the configured method, as in the per-pose
+        balance).  Secant steps on ``u`` from ``u = L/A``.
+        """
+        assert self.table is not None
+        lookup = self.table.lookup(dy, yaw)
+        rot = rotation(lookup.roll, yaw)
+        creep_forces = self.creep_forces(rot, wheel, rail, stamp_ns)
+        sides: list[tuple[TablePatch, ...]] = []
+        scales: list[float] = []
+        vertical: list[float] = []
+        for side, load in zip(SIDES, loads):
+            area = lookup.vertical_normal_force(side, rot)
+            if load <= 0.0 or area <= 0.0:
+                sides.append(())
+                scales.append(math.nan)
+                vertical.append(0.0)
+                continue
+            tried: list[tuple[float, float, tuple[TablePatch, ...]]] = []
+            # the first step takes the creep forces' vertical share of the wheel's last pose
+            # (a rig's poses follow one another closely): one solve is then enough mostly
+            u = load / (area + self._creep_share[side])
+            for _ in range(BALANCE_ITERATIONS):
+                patches = tuple(lookup.patches(side, u ** (1.0 / 3.0)))
+                force = u * area + sum(f[2] for f in creep_forces(side, patches))
+                tried.append((u, force - load, patches))
+                if abs(force - load) <= BALANCE_TOLERANCE * load:
+                    break
+                if len(tried) == 1:
+                    # the creep forces scale about like the load (mu N once sliding):
+                    # T(u) ~ T0 u / u0 makes the second step land within the tolerance
+                    u = load / (area + (force - u * area) / u)
+                else:
+                    (u0, r0, _), (u1, r1, _) = tried[-2], tried[-1]
+                    u = u1 - r1 * (u1 - u0) / (r1 - r0) if r1 != r0 else u1 - r1 / area
+                if not u > 0.0:
+                    break
+            u, residual, patches = min(tried, key=lambda t: abs(t[1]))
+            if abs(residual) > ACCEPT_BALANCE * load:
+                raise RejectedInput("degenerate", f"the {side} wheel's vertical balance from "
+                                    f"the contact table did not converge ({residual:.3g} N)")
+            share = (load + residual - u * area) / u
+            self._creep_share[side] = share if math.isfinite(share) else 0.0
+            sides.append(patches)
+            scales.append(u ** (1.0 / 3.0))
+            vertical.append(load + residual)
+        return TableContact(lookup.roll, (sides[0], sides[1]), (scales[0], scales[1]),
+                            (vertical[0], vertical[1]))
+
+    def creep_forces(self, rot: Any, wheel: StampedTwist, rail: StampedTwist,
+                     stamp_ns: int) -> Callable[[Side, Sequence[CloudSource]], list[Vector]]:
+        """Return a function: each patch's creep force (N, track frame) under the twists.
+
+        ``rot``: the wheelset's axes in the track frame.  A patch the method
+        refuses is solved by FastSim on its equivalent ellipse (see below);
+        standstill, a too large patch and non-finite values are raised.
+        """
         frame = self.config["wheelset_frame"]
         max_cells = int(self.config["max_patch_cells"])
 
-        def creep_forces(side: Side, patches: Sequence[WheelPatch]) -> list[Vector]:
-            rot = pose.rotation()
+        def creep_forces(side: Side, patches: Sequence[CloudSource]) -> list[Vector]:
             out: list[Vector] = []
             for wp in patches:
-                cloud = patch_cloud(stamp_ns, frame, *wp.cloud_arrays())
                 try:
-                    patch = patch_from_cloud(cloud, max_cells=max_cells)
+                    patch: ContactPatch | None
+                    if isinstance(wp, TablePatch):
+                        patch = table_contact_patch(wp, stamp_ns, max_cells=max_cells)
+                    else:
+                        patch = patch_from_cloud(patch_cloud(stamp_ns, frame, *wp.cloud_arrays()),
+                                                 max_cells=max_cells)
                     if patch is None:
                         raise RejectedInput("degenerate", "an empty patch")
                     try:
-                        _, f = self.pipeline.solve_patch(patch, wheel, rail)
+                        timing: list[float] = []
+                        creep, f = self.pipeline.solve_patch(patch, wheel, rail, timing=timing)
+                        if isinstance(wp, TablePatch):
+                            self._solved[id(wp)] = (patch, creep, f, timing[0])
                     except RejectedInput as e:
                         if e.reason in ("standstill", "too_large", "nonfinite"):
                             raise
@@ -344,16 +536,20 @@ class ProfilePipeline:
                 out.append((float(f_t[0]), float(f_t[1]), float(f_t[2])))
             return out
 
-        return self.wheelset.solve(pose, loads=loads, solve_roll=self.solve_roll,
-                                   tangential=creep_forces)
+        return creep_forces
 
     def clouds(self, contact: WheelsetContact, stamp_ns: int) -> tuple[tuple[str, Cloud], ...]:
         """Return the patch cloud of each of the four contacts (empty without such a patch)."""
+        return self.clouds_of(((w.side, _tread_first(w.patches)) for w in contact.wheels),
+                              stamp_ns)
+
+    def clouds_of(self, wheels: Any, stamp_ns: int) -> tuple[tuple[str, Cloud], ...]:
+        """Return the four contacts' clouds from ``(side, patches tread first)`` per wheel."""
         frame = self.config["wheelset_frame"]
         by_name: dict[str, Cloud] = {}
-        for wheel in contact.wheels:
-            for index, wp in enumerate(_tread_first(wheel.patches)):
-                by_name[contact_name(wheel.side, index)] = patch_cloud(
+        for side, patches in wheels:
+            for index, wp in enumerate(patches):
+                by_name[contact_name(side, index)] = patch_cloud(
                     stamp_ns, frame, *wp.cloud_arrays())
         empty = np.zeros((0, 0))
         return tuple((name, by_name.get(name) or patch_cloud(stamp_ns, frame, np.zeros((0, 0, 3)),
@@ -370,10 +566,14 @@ class ProfilePipeline:
 AnyPipeline = Pipeline | ProfilePipeline
 
 
-def make_pipeline(config: PipelineConfig) -> AnyPipeline:
-    """Return the pipeline of the configured patch source (the node's and the replay's)."""
+def make_pipeline(config: PipelineConfig, *,
+                  log: Callable[[str], None] | None = None) -> AnyPipeline:
+    """Return the pipeline of the configured patch source (the node's and the replay's).
+
+    ``log``: where a contact table's build is announced (profiles mode).
+    """
     if config["patch_source"] == "profiles":
-        return ProfilePipeline(config)
+        return ProfilePipeline(config, log=log)
     return Pipeline(config)
 
 
@@ -383,4 +583,5 @@ def _tread_first(patches: Sequence[WheelPatch]) -> list[WheelPatch]:
 
 
 __all__ = ["LOAD_TOPIC", "POSE_TOPIC", "ProfileCycle", "ProfilePipeline", "SIDES",
+           "TableContact", "table_grid_of", "table_of",
            "contact_name", "make_pipeline", "placement_of", "wheelset_of", "MIN_CONTACT_CELLS"]

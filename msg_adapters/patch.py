@@ -205,6 +205,15 @@ def _words(cloud: Cloud) -> tuple[NDArray[Any], int, int, NDArray[np.int64]]:
 _PLAIN_COLUMNS = np.arange(7, dtype=np.int64)
 
 
+def words_of(cloud: Cloud) -> tuple[NDArray[Any], int, int, NDArray[np.int64]]:
+    """Return the cloud's points for the adapter's loop: ``(words, row, step, cols)``.
+
+    As the conversion reads them (see ``_words``); raises
+    :class:`RejectedInput` for a layout or a buffer the conversion refuses.
+    """
+    return _words(cloud)
+
+
 Axes = tuple[tuple[float, float, float], tuple[float, float, float],
              tuple[float, float, float]]
 

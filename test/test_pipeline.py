@@ -408,6 +408,7 @@ def out_values(pipe):
 
 WARM_PATH_PROBE = """
 import numba
+from fastsim_ros import pipeline_kernels
 from fastsim_ros.contact import compiled, kernels, samples
 from fastsim_ros.params import METHODS
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
@@ -416,10 +417,12 @@ from ros_messages import cdr, cloud_msg, rolling_twist
 
 compiled.warm_up()
 patch.warm_up()
+pipeline_kernels.warm_up()
 
 
 def signatures():
-    return {(mod.__name__, name): len(f.signatures) for mod in (kernels, patch_kernels)
+    return {(mod.__name__, name): len(f.signatures)
+            for mod in (kernels, patch_kernels, pipeline_kernels)
             for name, f in vars(mod).items() if isinstance(f, numba.core.registry.CPUDispatcher)}
 
 

@@ -182,6 +182,8 @@ class Wheelset:
         self.shear_modulus = float(shear_modulus)
         self.poisson_ratio = float(poisson_ratio)
         self.separation = (a_sep, d_sep, d_comb)
+        #: the right side is the left's mirror image (a contact table solves one wheel)
+        self.symmetric = right_wheel is None and right_rail is None
         self.rails: dict[Side, RailSide] = {
             "left": place_rail(rail, self.placement),
             "right": place_rail(right_rail or rail, self.placement)}

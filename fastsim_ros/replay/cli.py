@@ -14,7 +14,7 @@ from typing import Any
 
 from fastsim_ros.params import ParameterError, defaults, load_params_file
 from fastsim_ros.pipeline import PipelineConfig
-from fastsim_ros.profile_pipeline import wheelset_of
+from fastsim_ros.profile_pipeline import table_of, wheelset_of
 from fastsim_ros.replay.bagio import input_name
 from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
 from fastsim_ros.replay import storage
@@ -108,7 +108,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         try:
             values = load_params_file(args.params)
             if values["patch_source"] == "profiles":  # its profiles read before any work
-                wheelset_of(PipelineConfig.from_values(values))
+                config = PipelineConfig.from_values(values)
+                wheelset = wheelset_of(config)
+                if values["profile_table"]:
+                    # the contact table built (or read) once here, into its cache, so that
+                    # the tasks only read it: a pool does not build it N times over
+                    table_of(config, wheelset,
+                             log=lambda m: print(f"{PROG}: {m}", file=sys.stderr, flush=True))
         except ParameterError as e:
             return _fail(f"{args.params}: {e}" if str(args.params) not in str(e) else str(e))
     if args.scheduler is not None and args.jobs != 1:

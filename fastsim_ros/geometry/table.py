@@ -1,0 +1,1010 @@
+"""A contact table: the wheelset's patches precomputed over lateral shift and yaw.
+
+The per-pose path (:class:`~fastsim_ros.geometry.wheelset.Wheelset`) solves
+the contact search and the non-Hertzian normal problem for every pose: 20 to
+200 ms, far beyond a 1 kHz loop (TARGETS.md: a pose at most 1 ms median).
+A rig's wheelset moves over a few millimetres and milliradians, so the
+patches are solved once on a grid of nodes ``(dy, yaw)`` and interpolated:
+what multibody codes do with their contact tables (CONTACT's own module 1
+solves each case afresh; the table trades that for speed, and
+``docs/validation_table.md`` measures the price against both).
+
+Assumptions, each stated because the interpolation rests on it:
+
+1. **Kinematic roll.**  At each node the roll is the one at which both
+   rigid wheels touch their rails at one height of the wheelset centre
+   (:func:`levelled_roll`); the elastic approaches of the two wheels differ
+   by micrometres under unequal loads, which moves the roll by about
+   ``1e-5`` rad (a loaded solve's).
+2. **Hertz similarity in the load.**  Each node's patches are solved at a
+   reference wheel load ``L0``; at a load ``L`` a patch is scaled by
+   ``s = (L/L0)^(1/3)`` in its plane, its pressure by ``s`` and its normal
+   force by ``s^3`` (exact for a Hertzian contact, close for the
+   non-Hertzian ones of a worn tread: the report measures it), about its
+   pressure centroid, which stays where the node put it.  With two patches
+   on one wheel both scale alike: their shares of the load are the node's.
+3. **Blending between nodes.**  A patch at a pose between nodes is the
+   weighted blend (bilinear weights in ``dy`` and yaw) of the nodes' matching
+   patches: origin (pressure centroid), normal and load blended linearly, the
+   pressure field the weighted sum of the members' fields each centred on its
+   own centroid (shape interpolation), resampled bilinearly on the blended
+   contact plane and trimmed to the blended number of cells in contact.  A
+   patch present at only some of the nodes fades in with their weights (a
+   flange contact that starts between two nodes grows from zero load).
+4. **Mirror symmetry.**  With the right wheel and rail the mirror images of
+   the left ones and a grid symmetric about ``dy = 0`` and ``yaw = 0``, the
+   right wheel's patches at ``(dy, yaw)`` are the left wheel's at ``(-dy,
+   -yaw)`` mirrored in ``y``; only the left wheel is solved.
+
+The vertical balance with the creep forces (CONTACT's "vertical force
+prescribed") is solved at run time by the caller on the scale ``s^3``
+(:meth:`ContactTable.lookup` returns the blended patches at ``s = 1``;
+:meth:`TablePatch.scaled` scales them).  Poses outside the grid raise
+:class:`TableRangeError` (the node counts ``out_of_table``); a pose next to a
+node where the wheel derailed raises
+:class:`~fastsim_ros.geometry.errors.DerailmentError`.
+"""
+
+from __future__ import annotations
+
+import bisect
+import hashlib
+import math
+import os
+import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numba
+import numpy as np
+from numpy.typing import NDArray
+
+from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
+from fastsim_ros.geometry.placement import Pose
+from fastsim_ros.geometry.wheelset import (MAX_PATCHES, MIN_PATCH_CELLS, SIDES, Side,
+                                           WheelPatch, Wheelset)
+
+FloatArray = NDArray[np.float64]
+
+#: bump when the stored layout or the physics of a node changes: old files are rebuilt
+TABLE_VERSION = 2
+#: patches of neighbouring nodes are the same contact if their pressure centroids lie
+#: within this distance (m) and their normals within this angle (rad).  On S1002/UIC60 the
+#: tread contact runs 10.6 mm for a 1 mm shift near the centre, while the patches of one
+#: wheel lie at least D_SEP (8 mm) apart at their edges and their contact angles differ by
+#: 0.4 rad or more (tread 0.01-0.03, gauge corner 0.4-0.5, flange 1.1-1.2 rad)
+MATCH_DISTANCE = 12e-3
+MATCH_ANGLE = 0.3
+#: neighbouring shifts whose nodes differ more than this are refined by bisection (up to
+#: ``refine`` times): the contact angle (rad), the centroid (m), the patch load (share).
+#: A gauge corner or flange contact taking over between two nodes, or
+#: the tread contact running across the wheel near the centre (10 mm per mm of shift), is
+#: then blended over a sixteenth of a step instead of a whole one
+REFINE_ANGLE = 0.05
+REFINE_DISTANCE = 0.5e-3
+REFINE_LOAD = 0.1
+#: a looked-at interval is halved again unless the half-and-half blend of its ends is its
+#: midpoint node: centroid within this (m), load, cells and RMS extents within this share
+REFINE_MIDPOINT = 0.1e-3
+REFINE_SHAPE = 0.05
+#: a pose this close to a node (in units of the step) takes that node alone
+NODE_SNAP = 1e-9
+#: the roll that levels both rigid wheels is solved to this height difference (m)
+ROLL_TOLERANCE = 1e-10
+ROLL_ITERATIONS = 60
+
+
+class TableError(GeometryError):
+    """A contact table cannot be built, read or used as asked."""
+
+
+class TableRangeError(TableError):
+    """A pose outside the table's grid (the node's ``out_of_table``)."""
+
+
+# ---------------------------------------------------------------------------- the roll
+
+
+def levelled_roll(wheelset: Wheelset, dy: float, yaw: float, *, start: float = 0.0
+                  ) -> tuple[float, float]:
+    """Return ``(roll, dz)``: the roll at which both rigid wheels touch at one height.
+
+    ``g(roll) = gap_left - gap_right`` (vertical gaps at ``dz = 0``) grows
+    like ``2 b roll`` (``b`` the wheel's lateral offset) on treads; a flange
+    contact bends it.  Secant steps from the geometric first step, kept in a
+    bracket once one is found (Illinois).  ``dz = -gap``: the wheelset
+    lowered until both wheels touch.  Raises
+    :class:`~fastsim_ros.geometry.errors.NoContactError` if no roll within
+    0.1 rad levels them.
+    """
+    b = wheelset.placement.wheel_offset
+
+    def mismatch(roll: float) -> tuple[float, float]:
+        pose = Pose(dy=dy, yaw=yaw, roll=roll)
+        left = wheelset.vertical_gap("left", pose)
+        right = wheelset.vertical_gap("right", pose)
+        return left - right, left
+
+    r0 = start
+    g0, gap0 = mismatch(r0)
+    if abs(g0) <= ROLL_TOLERANCE:
+        return r0, -gap0
+    r1 = r0 - g0 / (2.0 * b)
+    bracket: tuple[float, float] | None = None   # the last point on the other side of the root
+    for _ in range(ROLL_ITERATIONS):
+        if not abs(r1) <= 0.1:
+            raise NoContactError(f"no roll within 0.1 rad levels both wheels at dy={dy:.6g} m, "
+                                 f"yaw={yaw:.6g} rad")
+        g1, gap1 = mismatch(r1)
+        if abs(g1) <= ROLL_TOLERANCE:
+            return r1, -gap1
+        if bracket is None and g0 * g1 < 0.0:
+            bracket = (r0, g0)
+        if bracket is None:
+            # secant outside a bracket: a flange bends g(roll), but it stays monotone
+            r_next = r1 - g1 * (r1 - r0) / (g1 - g0) if g1 != g0 else r1 - g1 / (2.0 * b)
+        else:
+            # Illinois: regula falsi on the bracket, the end kept twice running halved
+            ra, ga = bracket
+            if g1 * g0 < 0.0 and (r0, g0) != bracket:
+                ra, ga = r0, g0
+            elif (r0, g0) != bracket:
+                ga *= 0.5
+            bracket = (ra, ga)
+            if abs(r1 - ra) <= 1e-15:
+                return r1, -gap1
+            r_next = r1 - g1 * (r1 - ra) / (g1 - ga)
+        r0, g0 = r1, g1
+        r1 = r_next
+    raise NoContactError(f"the levelling roll did not converge at dy={dy:.6g} m, "
+                         f"yaw={yaw:.6g} rad")
+
+
+# ---------------------------------------------------------------------------- patches
+
+
+@dataclass(frozen=True, eq=False)
+class TablePatch:
+    """One patch of one wheel at a node, in the wheelset frame (m, Pa, N).
+
+    ``origin``: the pressure centroid; ``normal``: the contact plane's unit
+    normal pointing into the wheel; ``u``, ``v``: the grid's in-plane unit
+    axes; cell ``(j, i)`` lies at ``origin + (a0 + i da) u + (b0 + j db) v``
+    with ``pressure[j, i]``; ``load``: ``sum p da db``; ``approach``: the
+    rigid approach of the normal solve (m).
+    """
+
+    origin: FloatArray
+    normal: FloatArray
+    u: FloatArray
+    v: FloatArray
+    a0: float
+    b0: float
+    da: float
+    db: float
+    pressure: FloatArray
+    load: float
+    approach: float
+    cells: int = -1
+    axes: tuple[tuple[float, ...], tuple[float, ...]] = ((), ())
+
+    def __post_init__(self) -> None:
+        if self.cells < 0:
+            object.__setattr__(self, "cells", int(np.count_nonzero(self.pressure > 0.0)))
+        # the axes as plain floats: the blend's arithmetic on them runs per pose, and numpy's
+        # per-call cost on 3-vectors would be most of it
+        object.__setattr__(self, "axes", (tuple(float(c) for c in self.u),
+                                          tuple(float(c) for c in self.v)))
+
+    @classmethod
+    def of(cls, patch: WheelPatch) -> TablePatch:
+        """Return a solved wheel patch (its ``points`` in the wheelset frame) as a table patch."""
+        pts, p = patch.points, patch.pressure
+        ny, nx = p.shape
+        normal = np.asarray(patch.normal, dtype=float)
+        normal = normal / np.linalg.norm(normal)
+        # the planar grid runs along the wheelset's x projected on the contact plane (the
+        # adapter's contact frame): the table keeps that, so its patches need no resampling
+        u = _in_plane((1.0, 0.0, 0.0), normal)
+        if nx > 1:
+            along = pts[0, 1] - pts[0, 0]
+            if abs(float(along @ u)) < (1.0 - 1e-9) * float(np.linalg.norm(along)):
+                raise TableError("a patch grid not along the wheelset's x projected on its "
+                                 "plane")
+        v = _cross(normal, u)
+        if ny > 1 and float(np.dot(pts[1, 0] - pts[0, 0], v)) < 0.0:
+            # rows that run against n x u (the right wheel's side frame): turn them round,
+            # so that every table patch is right-handed (u, v, normal)
+            pts, p = pts[::-1], p[::-1]
+        total = float(p.sum())
+        origin = np.tensordot(p, pts, axes=2) / total
+        rel = pts[0, 0] - origin
+        return cls(origin, normal, u, v, float(rel @ u), float(rel @ v), float(patch.grid.dx),
+                   float(patch.grid.ds), np.ascontiguousarray(p, dtype=float),
+                   float(patch.load), float(patch.approach))
+
+    def mirrored(self) -> TablePatch:
+        """Return the patch mirrored in the wheelset's ``y`` (the other wheel's)."""
+        m = np.array([1.0, -1.0, 1.0])
+        # the mirror turns the frame left-handed: v is turned round with the rows, so the
+        # grid stays right-handed (cell j of the mirror is row nb-1-j of the original)
+        nb = self.pressure.shape[0]
+        return replace(self, origin=self.origin * m, normal=self.normal * m, u=self.u * m,
+                       v=-(self.v * m), b0=-(self.b0 + (nb - 1) * self.db),
+                       pressure=np.ascontiguousarray(self.pressure[::-1]))
+
+    def scaled(self, s: float) -> TablePatch:
+        """Return the patch under Hertz similarity: sizes times ``s``, pressure times ``s``."""
+        if s == 1.0:
+            return self
+        return blend([(1.0, self)], scale=s)
+
+    def cloud_arrays(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Return ``points, normal, pressure`` of the patch cloud (wheelset frame).
+
+        Rows run along the contact frame's ``y = z x x`` with ``x`` the
+        wheelset's ``x`` projected on the plane (the adapter's frame), so a
+        patch of either wheel reads like a rig's.
+        """
+        ny, nx = self.pressure.shape
+        a = self.a0 + self.da * np.arange(nx)
+        b = self.b0 + self.db * np.arange(ny)
+        points = (self.origin + a[None, :, None] * self.u) + b[:, None, None] * self.v
+        return points, self.normal, self.pressure
+
+    def vertical_normal_force(self, rotation: FloatArray) -> float:
+        """Return the normal force's vertical component in the track frame (N)."""
+        return self.load * float((rotation @ self.normal)[2])
+
+
+def _in_plane(vector: tuple[float, float, float] | FloatArray, normal: FloatArray) -> FloatArray:
+    """Return ``vector`` projected on the plane of ``normal``, normalised."""
+    w = np.asarray(vector, dtype=float)
+    w = w - float(w @ normal) * normal
+    return w / np.linalg.norm(w)
+
+
+@numba.njit(cache=True, nogil=True)
+def _gather(out: FloatArray, x0: float, s0: float, h: float, pressure: FloatArray, a0: float,
+            b0: float, da: float, db: float, m00: float, m01: float, m10: float, m11: float,
+            factor: float) -> None:  # pragma: no cover - compiled
+    """Add ``factor`` times a member's pressure, bilinearly sampled, to ``out``.
+
+    Output cell ``(j, i)`` lies at ``(x0 + i h, s0 + j h)`` in the blended
+    frame; ``m`` maps those coordinates to the member's ``(a, b)`` (its own
+    grid coordinates about its centroid, divided by the scale).
+    """
+    ns, nx = out.shape
+    nb, na = pressure.shape
+    for j in range(ns):
+        s = s0 + j * h
+        for i in range(nx):
+            x = x0 + i * h
+            fa = (m00 * x + m01 * s - a0) / da
+            fb = (m10 * x + m11 * s - b0) / db
+            ia = int(math.floor(fa))
+            ib = int(math.floor(fb))
+            if ia < -1 or ib < -1 or ia >= na or ib >= nb:
+                continue
+            ta = fa - ia
+            tb = fb - ib
+            acc = 0.0
+            if ib >= 0:
+                if ia >= 0:
+                    acc += (1.0 - ta) * (1.0 - tb) * pressure[ib, ia]
+                if ia + 1 < na:
+                    acc += ta * (1.0 - tb) * pressure[ib, ia + 1]
+            if ib + 1 < nb:
+                if ia >= 0:
+                    acc += (1.0 - ta) * tb * pressure[ib + 1, ia]
+                if ia + 1 < na:
+                    acc += ta * tb * pressure[ib + 1, ia + 1]
+            out[j, i] += factor * acc
+
+
+@numba.njit(cache=True, nogil=True)
+def _finish(field: FloatArray, cells: int, load: float, h: float, x0: float,
+            s0: float) -> tuple[int, int, int, int, float, float]:  # pragma: no cover - compiled
+    """Keep the ``cells`` largest values, scale the rest to ``load``; return the crop and centroid.
+
+    Returns ``(j0, j1, i0, i1, cx, cs)``: the rows and columns in contact
+    with one empty cell around, and the centroid ``(x, s)`` of the kept
+    field (m, in the field's coordinates).
+    """
+    ns, nx = field.shape
+    flat = field.ravel()
+    positive = 0
+    for k in range(flat.size):
+        if flat[k] > 0.0:
+            positive += 1
+        else:
+            flat[k] = 0.0
+    if positive > cells:
+        cut = np.partition(flat, flat.size - cells)[flat.size - cells]
+        above = 0
+        for k in range(flat.size):
+            if flat[k] > cut:
+                above += 1
+        ties = cells - above   # values equal to the cut that are kept: the first ones
+        for k in range(flat.size):
+            if flat[k] < cut:
+                flat[k] = 0.0
+            elif flat[k] == cut:
+                if ties > 0:
+                    ties -= 1
+                else:
+                    flat[k] = 0.0
+    total = 0.0
+    mx = 0.0
+    ms = 0.0
+    j0, j1, i0, i1 = ns, -1, nx, -1
+    for j in range(ns):
+        for i in range(nx):
+            v = field[j, i]
+            if v > 0.0:
+                total += v
+                mx += v * (x0 + i * h)
+                ms += v * (s0 + j * h)
+                j0 = min(j0, j)
+                j1 = max(j1, j)
+                i0 = min(i0, i)
+                i1 = max(i1, i)
+    if total <= 0.0:
+        return 0, 0, 0, 0, 0.0, 0.0
+    scale = load / (total * h * h)
+    for j in range(ns):
+        for i in range(nx):
+            field[j, i] *= scale
+    return (max(0, j0 - 1), min(ns, j1 + 2), max(0, i0 - 1), min(nx, i1 + 2), mx / total,
+            ms / total)
+
+
+class BlendPlan:
+    """Matching patches ready to blend at any load scale (assumptions 2 and 3).
+
+    ``members``: ``(weight, patch)`` with weights summing to one; ``fade``:
+    the share of the nodes that have this patch (the blended load and cells
+    are multiplied by it).  What does not depend on the scale (the blended
+    frame, each member's map onto it, the bounds) is done once, so that the
+    vertical balance's steps cost the resampling only.
+    """
+
+    def __init__(self, members: Sequence[tuple[float, TablePatch]], fade: float = 1.0) -> None:
+        self.members = tuple(members)
+        self.fade = fade
+        if len(members) == 1:
+            only = members[0][1]
+            origin, normal, u, v = only.origin, only.normal, only.u, only.v
+        else:
+            origin = np.zeros(3)
+            normal = np.zeros(3)
+            for w, p in members:
+                origin += w * p.origin
+                normal += w * p.normal
+            normal /= math.sqrt(float(normal @ normal))
+            # u: the wheelset's x projected on the plane, v = normal x u
+            n0 = float(normal[0])
+            u = np.array([1.0 - n0 * n0, -n0 * float(normal[1]), -n0 * float(normal[2])])
+            u /= math.sqrt(float(u @ u))
+            v = _cross(normal, u)
+        self.origin, self.normal, self.u, self.v = origin, normal, u, v
+        self.h = min(min(p.da, p.db) for _, p in members)
+        self.load = fade * sum(w * p.load for w, p in members)
+        self.cells = fade * sum(w * p.cells for w, p in members)
+        self.approach = sum(w * p.approach for w, p in members)
+        u0, u1, u2 = float(u[0]), float(u[1]), float(u[2])
+        v0, v1, v2 = float(v[0]), float(v[1]), float(v[2])
+        self.maps = []
+        lo_x = lo_s = math.inf
+        hi_x = hi_s = -math.inf
+        for w, p in members:
+            # the member's (a, b) onto the blend's (x, s) at scale 1
+            (pu0, pu1, pu2), (pv0, pv1, pv2) = p.axes
+            f00 = pu0 * u0 + pu1 * u1 + pu2 * u2
+            f01 = pv0 * u0 + pv1 * u1 + pv2 * u2
+            f10 = pu0 * v0 + pu1 * v1 + pu2 * v2
+            f11 = pv0 * v0 + pv1 * v1 + pv2 * v2
+            nb, na = p.pressure.shape
+            a1, b1 = p.a0 + (na - 1) * p.da, p.b0 + (nb - 1) * p.db
+            # the extremes of a linear map on a box lie at its corners
+            xa, xb = sorted((f00 * p.a0, f00 * a1))
+            xc, xd = sorted((f01 * p.b0, f01 * b1))
+            sa, sb = sorted((f10 * p.a0, f10 * a1))
+            sc, sd = sorted((f11 * p.b0, f11 * b1))
+            lo_x, hi_x = min(lo_x, xa + xc), max(hi_x, xb + xd)
+            lo_s, hi_s = min(lo_s, sa + sc), max(hi_s, sb + sd)
+            det = f00 * f11 - f01 * f10
+            self.maps.append((w, p, f11 / det, -f01 / det, -f10 / det, f00 / det))
+        self.bounds = (lo_x, hi_x, lo_s, hi_s)
+
+    @property
+    def single(self) -> TablePatch | None:
+        """Return the one node patch this plan is, or ``None`` (a blend or a fade)."""
+        return self.members[0][1] if len(self.members) == 1 and self.fade == 1.0 else None
+
+    def at(self, scale: float = 1.0) -> TablePatch:
+        """Return the blended patch at the Hertz scale ``s``.
+
+        Its load is ``fade s^3 sum w L``, its cells ``round(fade s^2 sum w
+        cells)`` (the largest of the resampled field: bilinear resampling
+        spreads an edge by a cell), its pressure centroid exactly the blended
+        origin, its grid along the adapter's contact frame.
+        """
+        single = self.single
+        if scale == 1.0 and single is not None:
+            return single   # on a node: the node's own patch
+        h = self.h
+        lo_x, hi_x, lo_s, hi_s = (scale * b for b in self.bounds)
+        x0 = math.floor(lo_x / h) * h - h
+        s0 = math.floor(lo_s / h) * h - h
+        nx = int(math.ceil((hi_x - x0) / h)) + 2
+        ns = int(math.ceil((hi_s - s0) / h)) + 2
+        field = np.zeros((ns, nx))
+        for w, p, m00, m01, m10, m11 in self.maps:
+            _gather(field, x0, s0, h, p.pressure, p.a0, p.b0, p.da, p.db, m00 / scale,
+                    m01 / scale, m10 / scale, m11 / scale, w * scale)
+        load = self.load * scale ** 3
+        cells = max(1, round(self.cells * scale ** 2))
+        j0, j1, i0, i1, cx, cs = _finish(field, cells, load, h, x0, s0)
+        if j1 <= j0:
+            raise TableError("a blended patch came out empty")
+        cropped = np.ascontiguousarray(field[j0:j1, i0:i1])
+        # the grid shifted so that the kept field's centroid is the blended origin
+        return TablePatch(self.origin, self.normal, self.u, self.v, x0 + i0 * h - cx,
+                          s0 + j0 * h - cs, h, h, cropped, load, scale ** 2 * self.approach)
+
+    def vertical_normal_force(self, rotation: FloatArray) -> float:
+        """Return the blend's normal force's vertical component at scale 1, track frame (N)."""
+        return self.load * float((rotation @ self.normal)[2])
+
+
+def warm_up() -> None:
+    """Compile (or load from numba's disk cache) the blend's kernels on a tiny field."""
+    field = np.zeros((3, 3))
+    pressure = np.ones((2, 2))
+    _gather(field, -2e-4, -2e-4, 2e-4, pressure, -1e-4, -1e-4, 2e-4, 2e-4, 1.0, 0.0, 0.0, 1.0,
+            1.0)
+    _finish(field, 2, 1.0, 2e-4, -2e-4, -2e-4)
+
+
+def blend(members: Sequence[tuple[float, TablePatch]], *, scale: float = 1.0,
+          fade: float = 1.0) -> TablePatch:
+    """Return the blend of matching patches at the scale ``s`` (see :class:`BlendPlan`)."""
+    return BlendPlan(members, fade).at(scale)
+
+
+def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Return ``a x b`` of two 3-vectors (numpy's cross costs 20 us on these)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
+
+
+def match(groups: list[list[tuple[float, TablePatch]]], weight: float,
+          patches: Sequence[TablePatch]) -> None:
+    """Add one node's patches to the groups of matching patches (assumption 3).
+
+    Each patch joins the nearest group (distance over MATCH_DISTANCE plus
+    angle over MATCH_ANGLE) within both limits that has no patch of this
+    node yet, else starts a group.
+    """
+    taken: set[int] = set()
+    for p in patches:
+        best, best_cost = -1, math.inf
+        for k, g in enumerate(groups):
+            if k in taken:
+                continue
+            ref = g[0][1]
+            d = float(np.linalg.norm(p.origin - ref.origin))
+            angle = math.acos(max(-1.0, min(1.0, float(p.normal @ ref.normal))))
+            cost = d / MATCH_DISTANCE + angle / MATCH_ANGLE
+            if d <= MATCH_DISTANCE and angle <= MATCH_ANGLE and cost < best_cost:
+                best, best_cost = k, cost
+        if best < 0:
+            groups.append([(weight, p)])
+            taken.add(len(groups) - 1)
+        else:
+            groups[best].append((weight, p))
+            taken.add(best)
+
+
+# ---------------------------------------------------------------------------- the table
+
+
+@dataclass(frozen=True)
+class TableGrid:
+    """The nodes: lateral shifts ``dys`` (m) and yaws ``yaws`` (rad), both increasing."""
+
+    dys: tuple[float, ...]
+    yaws: tuple[float, ...]
+
+    @classmethod
+    def regular(cls, dy_min: float, dy_max: float, dy_step: float, yaw_max: float,
+                yaw_step: float) -> TableGrid:
+        """Return the grid ``dy_min..dy_max`` by ``dy_step``, yaws ``-yaw_max..yaw_max``.
+
+        A step that does not divide its range is refused: the nodes must
+        fall on the range's ends (and on zero, for the mirror).
+        """
+        def axis(lo: float, hi: float, step: float, name: str) -> tuple[float, ...]:
+            if not (math.isfinite(lo) and math.isfinite(hi) and math.isfinite(step)
+                    and step > 0.0 and hi >= lo):
+                raise TableError(f"table {name}: a range lo <= hi and a step > 0, got "
+                                 f"{lo!r}..{hi!r} by {step!r}")
+            n = (hi - lo) / step
+            if abs(n - round(n)) > 1e-6 or round(n) > 2000:
+                raise TableError(f"table {name}: the step {step:g} must divide the range "
+                                 f"{lo:g}..{hi:g} (at most 2000 steps)")
+            k = np.arange(round(n) + 1)
+            return tuple(float(v) for v in lo + k * (hi - lo) / max(round(n), 1))
+
+        dys = axis(dy_min, dy_max, dy_step, "dy")
+        yaws = axis(-yaw_max, yaw_max, yaw_step, "yaw") if yaw_max > 0.0 else (0.0,)
+        return cls(dys, yaws)
+
+    @property
+    def symmetric(self) -> bool:
+        """Return whether the grid is its own mirror image (``-dy``, ``-yaw`` are nodes)."""
+        return (np.allclose(self.dys, [-d for d in reversed(self.dys)], rtol=0.0, atol=1e-12)
+                and np.allclose(self.yaws, [-y for y in reversed(self.yaws)], rtol=0.0,
+                                atol=1e-12))
+
+    def nodes(self) -> list[tuple[float, float]]:
+        """Return every node ``(dy, yaw)``, yaw fastest."""
+        return [(d, y) for d in self.dys for y in self.yaws]
+
+    def weights(self, dy: float, yaw: float) -> list[tuple[int, int, float]]:
+        """Return the bilinear weights ``(i_dy, i_yaw, w)`` of a pose, largest first."""
+        out: list[tuple[int, int, float]] = []
+        for_dy = _axis_weights(self.dys, dy, "dy")
+        for_yaw = _axis_weights(self.yaws, yaw, "yaw")
+        for i, wi in for_dy:
+            for j, wj in for_yaw:
+                if wi * wj > 0.0:
+                    out.append((i, j, wi * wj))
+        out.sort(key=lambda t: -t[2])
+        return out
+
+
+def _axis_weights(nodes: tuple[float, ...], value: float, name: str) -> list[tuple[int, float]]:
+    """Return the linear weights of ``value`` on increasing ``nodes`` (refined: not uniform)."""
+    if len(nodes) == 1:
+        if abs(value - nodes[0]) > 1e-12:
+            raise TableRangeError(f"{name} {value:.6g} outside the table (only {nodes[0]:g})")
+        return [(0, 1.0)]
+    lo, hi = nodes[0], nodes[-1]
+    snap = NODE_SNAP * (hi - lo) / (len(nodes) - 1)
+    if not lo - snap <= value <= hi + snap:
+        raise TableRangeError(f"{name} {value:.6g} outside the table's {lo:.6g}..{hi:.6g}")
+    k = min(max(bisect.bisect_right(nodes, value) - 1, 0), len(nodes) - 2)
+    t = (value - nodes[k]) / (nodes[k + 1] - nodes[k])
+    if t <= NODE_SNAP:
+        return [(k, 1.0)]
+    if t >= 1.0 - NODE_SNAP:
+        return [(k + 1, 1.0)]
+    return [(k, 1.0 - t), (k + 1, t)]
+
+
+def _pairs(a: TableNode, b: TableNode) -> list[tuple[TablePatch, TablePatch]] | None:
+    """Return the matching patch pairs of two nodes (both wheels), or ``None`` if any is unmatched.
+
+    ``None`` too if one node derailed and not the other; two derailed nodes
+    have no pairs.  (While a table with the mirror is built, only the left
+    wheel is there: the mirrored insertions cover the right.)
+    """
+    if a.derailed or b.derailed:
+        return [] if a.derailed == b.derailed else None
+    pairs = []
+    for side in range(2):
+        if len(a.patches[side]) != len(b.patches[side]):
+            return None
+        groups: list[list[tuple[float, TablePatch]]] = []
+        match(groups, 0.5, a.patches[side])
+        match(groups, 0.5, b.patches[side])
+        for g in groups:
+            if len(g) != 2:
+                return None
+            pairs.append((g[0][1], g[1][1]))
+    return pairs
+
+
+def _differ(a: TableNode, b: TableNode) -> bool:
+    """Return whether two neighbouring nodes differ enough to look between them.
+
+    Other patches, or a pair whose contact angles differ by more than
+    REFINE_ANGLE, centroids by more than REFINE_DISTANCE or loads by more
+    than REFINE_LOAD of the larger.
+    """
+    pairs = _pairs(a, b)
+    if pairs is None:
+        return True
+    for p, q in pairs:
+        angle = math.acos(max(-1.0, min(1.0, float(p.normal @ q.normal))))
+        if (angle > REFINE_ANGLE or float(np.linalg.norm(p.origin - q.origin)) > REFINE_DISTANCE
+                or abs(p.load - q.load) > REFINE_LOAD * max(p.load, q.load)):
+            return True
+    return False
+
+
+def _shape(p: TablePatch) -> tuple[float, float, float]:
+    """Return the cells and the RMS extents along ``u`` and ``v`` about the centroid (m)."""
+    nb, na = p.pressure.shape
+    a = p.a0 + p.da * np.arange(na)
+    b = p.b0 + p.db * np.arange(nb)
+    total = float(p.pressure.sum())
+    ma = float(p.pressure.sum(axis=0) @ (a * a)) / total
+    mb = float(p.pressure.sum(axis=1) @ (b * b)) / total
+    return float(p.cells), math.sqrt(max(ma, 0.0)), math.sqrt(max(mb, 0.0))
+
+
+def _blends_well(a: TableNode, b: TableNode, mid: TableNode) -> bool:
+    """Return whether the half-and-half blend of ``a`` and ``b`` is the node ``mid`` between them.
+
+    The blend's centroid within REFINE_MIDPOINT of the midpoint node's, its
+    load, cells and RMS extents within REFINE_SHAPE of them, the same patches.
+    """
+    pairs = _pairs(a, b)
+    if pairs is None or _pairs(a, mid) is None:
+        return False
+    mids = [q for _, q in _pairs(a, mid) or []]
+    for (p, q), m in zip(pairs, mids):
+        half = BlendPlan([(0.5, p), (0.5, q)])
+        if float(np.linalg.norm(half.origin - m.origin)) > REFINE_MIDPOINT:
+            return False
+        if abs(half.load - m.load) > REFINE_SHAPE * m.load:
+            return False
+        for x, y in zip(_shape(half.at(1.0 + 1e-12)), _shape(m)):
+            if abs(x - y) > REFINE_SHAPE * abs(y):
+                return False
+    return True
+
+
+@dataclass(frozen=True, eq=False)
+class TableNode:
+    """One node: its roll (rad), its loaded height (m, the left wheel's) and both wheels' patches.
+
+    ``derailed``: the wheelset cannot stand there (no roll levels it, a
+    wheel past its flange): poses next to it are refused.
+    """
+
+    roll: float
+    dz: float
+    patches: tuple[tuple[TablePatch, ...], tuple[TablePatch, ...]]
+    derailed: bool = False
+
+
+@dataclass(frozen=True, eq=False)
+class TableLookup:
+    """A pose from the table: the roll (rad) and each wheel's contacts (tread first)."""
+
+    roll: float
+    groups: tuple[tuple[BlendPlan, ...], tuple[BlendPlan, ...]]
+
+    def patches(self, side: Side, scale: float = 1.0) -> list[TablePatch]:
+        """Return one wheel's patches at the load scale ``s`` (assumptions 2 and 3)."""
+        return [g.at(scale) for g in self.groups[SIDES.index(side)]]
+
+    def vertical_normal_force(self, side: Side, rotation: FloatArray) -> float:
+        """Return the wheel's normal forces' vertical sum in the track frame at ``s = 1`` (N).
+
+        The blend's load and normal without its resampling, so the vertical
+        balance's first scale comes without a solve.
+        """
+        return sum(g.vertical_normal_force(rotation) for g in self.groups[SIDES.index(side)])
+
+
+def solve_node(wheelset: Wheelset, load: float, dy: float, yaw: float,
+               sides: Sequence[Side] = SIDES) -> TableNode:
+    """Solve one node: the levelling roll, then each wheel at the reference ``load`` (N)."""
+    try:
+        roll, dz = levelled_roll(wheelset, dy, yaw)
+        pose = Pose(dy=dy, dz=dz, yaw=yaw, roll=roll)
+        out: list[tuple[TablePatch, ...]] = [(), ()]
+        for side in sides:
+            wheel = wheelset.wheel_loaded(side, pose, load)
+            patches = sorted(wheel.patches, key=lambda p: -p.region.reference[1])
+            # each patch in the wheelset frame of its own loaded height (the rigid approach
+            # lowers the wheelset by 15-40 um, which moves the rolling radius, hence xi)
+            out[SIDES.index(side)] = tuple(TablePatch.of(p) for p in patches)
+            dz = wheel.dz if side == "left" else dz
+        return TableNode(roll, dz, (out[0], out[1]))
+    except GeometryError:
+        return TableNode(0.0, 0.0, ((), ()), derailed=True)
+
+
+def _solve_nodes(args: tuple[Wheelset, float, list[tuple[float, float]], tuple[Side, ...]]
+                 ) -> list[TableNode]:
+    wheelset, load, nodes, sides = args
+    return [solve_node(wheelset, load, dy, yaw, sides) for dy, yaw in nodes]
+
+
+def _solve_in_children(wheelset: Wheelset, load: float,
+                       chunks: list[list[tuple[float, float]]], sides: tuple[Side, ...],
+                       workers: int, progress: Callable[[int, int], None] | None
+                       ) -> list[TableNode]:
+    """Solve the chunks in ``workers`` child interpreters (``python -m ...table_worker``).
+
+    Not multiprocessing: its spawn re-imports the caller's main module (a
+    script without a main guard would start again in each child) and its
+    fork would copy a node's DDS threads half-alive.  Each child takes every
+    ``workers``-th chunk (the flange's costly nodes spread over all) as one
+    pickle on its stdin and answers one pickle on its stdout; a child that
+    fails has its chunks solved here.
+    """
+    import pickle
+    import subprocess
+    import sys
+
+    total = sum(len(c) for c in chunks)
+    shares = [list(range(w, len(chunks), workers)) for w in range(workers)]
+    env = dict(os.environ)
+    # the child finds this package where this process found it
+    root = str(Path(__file__).resolve().parents[2])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [root, env.get("PYTHONPATH", "")]))
+    children = []
+    for share in shares:
+        proc = subprocess.Popen([sys.executable, "-m", "fastsim_ros.geometry.table_worker"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.DEVNULL, env=env)
+        assert proc.stdin is not None
+        proc.stdin.write(pickle.dumps((wheelset, load, [chunks[k] for k in share], sides)))
+        proc.stdin.close()
+        children.append((share, proc))
+    results: dict[int, list[TableNode]] = {}
+    done = 0
+    for share, proc in children:
+        assert proc.stdout is not None
+        raw = proc.stdout.read()
+        status = proc.wait()
+        try:
+            parts = pickle.loads(raw) if status == 0 else None
+        except (pickle.UnpicklingError, EOFError, ValueError):
+            parts = None
+        if parts is None or len(parts) != len(share):
+            parts = [_solve_nodes((wheelset, load, chunks[k], sides)) for k in share]
+        for k, part in zip(share, parts):
+            results[k] = part
+            done += len(part)
+        if progress:
+            progress(done, total)
+    return [node for k in range(len(chunks)) for node in results[k]]
+
+
+class ContactTable:
+    """The wheelset's patches on a grid of ``(dy, yaw)`` at a reference wheel load."""
+
+    def __init__(self, grid: TableGrid, load: float, nodes: Sequence[TableNode]) -> None:
+        if len(nodes) != len(grid.dys) * len(grid.yaws):
+            raise TableError("the table's nodes do not fill its grid")
+        self.grid = grid
+        self.load = float(load)
+        self.nodes = tuple(nodes)
+
+    @classmethod
+    def build(cls, wheelset: Wheelset, grid: TableGrid, load: float, *, workers: int = 1,
+              refine: int = 0,
+              progress: Callable[[int, int], None] | None = None) -> ContactTable:
+        """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 4).
+
+        ``load``: the reference wheel load (N).  ``refine``: times the shift
+        intervals whose nodes are inconsistent (:func:`_consistent`, any yaw)
+        are halved; the inserted shifts are solved at every yaw (the grid
+        stays a tensor grid, and symmetric: ``-dy`` with ``dy``).
+        ``progress(done, total)`` is called as chunks finish.
+        """
+        if not (math.isfinite(load) and load > 0.0):
+            raise TableError(f"a contact table needs a reference wheel load > 0 N, got {load!r}")
+        mirror = wheelset.symmetric and grid.symmetric
+        sides: tuple[Side, ...] = ("left",) if mirror else SIDES
+        # nodes by integer keys (picometres, picoradians): a shift and its mirror image, or
+        # a midpoint reached from both sides, are one node whatever the float rounding
+        solved: dict[tuple[int, int], TableNode] = {}
+
+        def key(d: float, y: float) -> tuple[int, int]:
+            return round(d * 1e12), round(y * 1e12)
+
+        def solve(nodes: list[tuple[float, float]]) -> None:
+            chunks = [nodes[k:k + 8] for k in range(0, len(nodes), 8)]
+            if workers > 1 and len(chunks) > 1:
+                done = _solve_in_children(wheelset, load, chunks, sides, workers, progress)
+            else:
+                done = []
+                for c in chunks:
+                    done.extend(_solve_nodes((wheelset, load, c, sides)))
+                    if progress:
+                        progress(len(done), len(nodes))
+            solved.update((key(d, y), n) for (d, y), n in zip(nodes, done))
+
+        dys = {round(d * 1e12): d for d in grid.dys}
+        solve([(d, y) for d in grid.dys for y in grid.yaws])
+        # intervals to look into: first those whose ends differ; then the halves of those
+        # whose midpoint the blend of the ends misses
+        ordered = sorted(dys.values())
+        looking = [(d0, d1) for d0, d1 in zip(ordered[:-1], ordered[1:])
+                   if any(_differ(solved[key(d0, y)], solved[key(d1, y)]) for y in grid.yaws)]
+        for _ in range(refine):
+            inserted: dict[int, float] = {}
+            for d0, d1 in looking:
+                mid = 0.5 * (d0 + d1)
+                for d in ((mid, -mid) if mirror else (mid,)):
+                    if round(d * 1e12) not in dys:
+                        inserted.setdefault(round(d * 1e12), d)
+            if not inserted:
+                break
+            solve([(d, y) for d in sorted(inserted.values()) for y in grid.yaws])
+            dys.update(inserted)
+            following = []
+            for d0, d1 in looking:
+                mid = 0.5 * (d0 + d1)
+                if not all(_blends_well(solved[key(d0, y)], solved[key(d1, y)],
+                                        solved[key(mid, y)]) for y in grid.yaws):
+                    following += [(d0, mid), (mid, d1)]
+            if mirror:   # the mirror images of the intervals kept, once
+                mirrored = [(-d1, -d0) for d0, d1 in following]
+                seen = {(round(d0 * 1e12), round(d1 * 1e12)) for d0, d1 in following}
+                following += [(d0, d1) for d0, d1 in mirrored
+                              if (round(d0 * 1e12), round(d1 * 1e12)) not in seen]
+            looking = following
+        grid = TableGrid(tuple(sorted(dys.values())), grid.yaws)
+        nodes = []
+        for d in grid.dys:
+            for y in grid.yaws:
+                node = solved[key(d, y)]
+                if mirror:
+                    twin = solved[key(-d, -y)]
+                    right = tuple(p.mirrored() for p in twin.patches[0])
+                    node = TableNode(node.roll, node.dz, (node.patches[0], right),
+                                     node.derailed or twin.derailed)
+                nodes.append(node)
+        return cls(grid, load, nodes)
+
+    def node(self, i_dy: int, i_yaw: int) -> TableNode:
+        """Return the node at grid indices ``(i_dy, i_yaw)``."""
+        return self.nodes[i_dy * len(self.grid.yaws) + i_yaw]
+
+    def lookup(self, dy: float, yaw: float) -> TableLookup:
+        """Return the roll and both wheels' blended patches at ``(dy, yaw)`` (reference load).
+
+        Each patch comes with its fade (its nodes' share of the weight).
+        Raises :class:`TableRangeError` outside the grid and
+        :class:`~fastsim_ros.geometry.errors.DerailmentError` next to a
+        derailed node.
+        """
+        weights = self.grid.weights(dy, yaw)
+        nodes = [(w, self.node(i, j)) for i, j, w in weights]
+        if any(n.derailed for _, n in nodes):
+            raise DerailmentError(f"the wheelset derails near dy={dy:.6g} m, yaw={yaw:.6g} rad "
+                                  "(a table node)")
+        roll = sum(w * n.roll for w, n in nodes)
+        sides = []
+        for k in range(2):
+            groups: list[list[tuple[float, TablePatch]]] = []
+            for w, n in nodes:
+                match(groups, w, n.patches[k])
+            kept: list[tuple[BlendPlan, float]] = []
+            for g in groups:
+                fade = sum(w for w, _ in g)
+                plan = BlendPlan(tuple((w / fade, p) for w, p in g), fade)
+                if plan.cells < MIN_PATCH_CELLS:
+                    continue   # a contact fading in below the smallest patch
+                kept.append((plan, abs(float(plan.origin[1]))))
+            kept.sort(key=lambda t: -t[0].load)
+            kept = kept[:MAX_PATCHES]
+            # tread first: the field side, the larger |y| in the wheelset frame
+            kept.sort(key=lambda t: -t[1])
+            sides.append(tuple(t[0] for t in kept))
+        return TableLookup(roll, (sides[0], sides[1]))
+
+    # ------------------------------------------------------------------ files
+
+    def save(self, path: Path, key: str) -> None:
+        """Write the table to ``path`` (``.npz``) atomically, with its ``key``."""
+        meta, floats, pressure = [], [], []
+        offset = 0
+        for k, node in enumerate(self.nodes):
+            for side in range(2):
+                for p in node.patches[side]:
+                    nb, na = p.pressure.shape
+                    meta.append((k, side, nb, na, offset))
+                    offset += nb * na
+                    floats.append(np.concatenate([p.origin, p.normal, p.u, p.v,
+                                                  [p.a0, p.b0, p.da, p.db, p.load, p.approach]]))
+                    pressure.append(p.pressure.ravel())
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".part.npz")
+        try:
+            with os.fdopen(fd, "wb") as f:
+                np.savez(f, version=np.array(TABLE_VERSION), key=np.array(key),
+                         dys=np.array(self.grid.dys), yaws=np.array(self.grid.yaws),
+                         load=np.array(self.load),
+                         nodes=np.array([(n.roll, n.dz, float(n.derailed)) for n in self.nodes]),
+                         meta=np.array(meta, dtype=np.int64).reshape(-1, 5),
+                         floats=np.array(floats, dtype=float).reshape(-1, 18),
+                         pressure=np.concatenate(pressure) if pressure else np.zeros(0))
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+
+    @classmethod
+    def read(cls, path: Path, key: str | None = None) -> ContactTable:
+        """Read a table written by :meth:`save`; a wrong version or ``key`` raises TableError."""
+        try:
+            with np.load(path, allow_pickle=False) as f:
+                if int(f["version"]) != TABLE_VERSION:
+                    raise TableError(f"{path}: table version {int(f['version'])}, "
+                                     f"expected {TABLE_VERSION}")
+                if key is not None and str(f["key"]) != key:
+                    raise TableError(f"{path}: made for other profiles or parameters")
+                grid = TableGrid(tuple(float(v) for v in f["dys"]),
+                                 tuple(float(v) for v in f["yaws"]))
+                load = float(f["load"])
+                node_rows, meta = f["nodes"], f["meta"]
+                floats, pressure = f["floats"], f["pressure"]
+        except (OSError, KeyError, ValueError) as e:
+            raise TableError(f"{path}: not a contact table ({e})") from None
+        patches: list[tuple[list[TablePatch], list[TablePatch]]] = [
+            ([], []) for _ in range(len(node_rows))]
+        for (k, side, nb, na, off), fl in zip(meta, floats):
+            p = np.array(pressure[off:off + nb * na]).reshape(nb, na)
+            patches[k][side].append(TablePatch(fl[0:3].copy(), fl[3:6].copy(), fl[6:9].copy(),
+                                               fl[9:12].copy(), float(fl[12]), float(fl[13]),
+                                               float(fl[14]), float(fl[15]), p, float(fl[16]),
+                                               float(fl[17])))
+        nodes = [TableNode(float(r), float(z), (tuple(ps[0]), tuple(ps[1])), bool(d))
+                 for (r, z, d), ps in zip(node_rows, patches)]
+        return cls(grid, load, nodes)
+
+
+def table_key(wheelset: Wheelset, grid: TableGrid, load: float, refine: int = 0) -> str:
+    """Return a digest of everything a table's nodes depend on (``grid``: before refining)."""
+    h = hashlib.sha256()
+    h.update(f"v{TABLE_VERSION};{grid.dys!r};{grid.yaws!r};{load!r};r{refine};{wheelset.cell!r};"
+             f"{wheelset.shear_modulus!r};{wheelset.poisson_ratio!r};{wheelset.separation!r};"
+             f"{wheelset.placement!r}".encode())
+    for side in SIDES:
+        rail, wheel = wheelset.rails[side], wheelset.wheels[side]
+        for a in (rail.y, rail.z, wheel.axial, wheel.radius):
+            h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    return h.hexdigest()[:32]
+
+
+def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Path | None, *,
+                 refine: int = 0, workers: int | None = None,
+                 log: Callable[[str], None] | None = None) -> ContactTable:
+    """Return the table from ``cache_dir`` if built for these inputs, else build and keep it.
+
+    ``workers``: processes for a build (default: the machine's cores when
+    there are at least 200 nodes).
+    """
+    key = table_key(wheelset, grid, load, refine)
+    path = cache_dir / f"contact_table_{key}.npz" if cache_dir is not None else None
+    if path is not None and path.exists():
+        try:
+            return ContactTable.read(path, key)
+        except TableError as e:
+            if log:
+                log(f"contact table: rebuilding, {e}")
+    n = len(grid.dys) * len(grid.yaws)
+    if workers is None:
+        workers = min(os.cpu_count() or 1, 8) if n >= 200 else 1
+    if log:
+        log(f"contact table: solving {n} nodes ({len(grid.dys)} shifts x {len(grid.yaws)} yaws) "
+            f"in {workers} process(es); cached in {path}" if path else "")
+    table = ContactTable.build(wheelset, grid, load, workers=workers, refine=refine)
+    if log and refine:
+        log(f"contact table: {len(table.grid.dys) - len(grid.dys)} shifts added where "
+            f"neighbouring nodes differed ({len(table.nodes)} nodes in all)")
+    if path is not None:
+        try:
+            table.save(path, key)
+        except OSError as e:
+            if log:
+                log(f"contact table: not cached ({e})")
+    return table
+
+
+__all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "TableError",
+           "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
+           "cached_table", "levelled_roll", "match", "solve_node", "table_key", "warm_up",
+           "BlendPlan"]

@@ -1,0 +1,340 @@
+#!/usr/bin/env python3
+"""The contact table of profiles mode against CONTACT and the per-pose solve: validation_table.md.
+
+Three comparisons, all through :class:`~fastsim_ros.profile_pipeline.ProfilePipeline`
+(the node's own code) with the default method (the calibrated MAE) and the
+table of ``config/profiles_track_table.yaml`` (built into its cache if it is
+not there: a few minutes on 2 cores):
+
+1. **A-2.2 from the table**: the benchmark's 21 poses (shift and yaw; the
+   table's own levelled roll, not CONTACT's), its twists, 10 kN per wheel;
+   each wheel's force in the track frame against CONTACT's published exact
+   results and against the per-pose path's default-method results
+   (``docs/data/validation_profiles.json``), in % of mu N; the contact
+   angle and N against CONTACT's (one-region poses).
+2. **Between the nodes**: shifts off the nodes (a third of a step past one)
+   over the table's range at yaw 0 and at a few yaws, table against the
+   per-pose solve at the table's roll: the price of the interpolation.
+3. **Loads by similarity**: 7 kN and 13 kN per wheel (the table is solved
+   at 10 kN) at the A-2.2 poses, table against per-pose.
+
+Usage: ``python scripts/validate_table.py [--report-only]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
+from fastsim_ros.geometry import benchmark  # noqa: E402
+from fastsim_ros.geometry.placement import Pose, rotation  # noqa: E402
+from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
+from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
+from msg_adapters.cdr import StampedTwist  # noqa: E402
+from msg_adapters.profile_msgs import StampedPose, quaternion  # noqa: E402
+
+DOCS = ROOT / "docs"
+DATA = DOCS / "data" / "validation_table.json"
+PROFILES = DOCS / "data" / "validation_profiles.json"
+REPORT = DOCS / "validation_table.md"
+CONFIG = ROOT / "config" / "profiles_track_table.yaml"
+TARGET = {"exact": 5.0, "default": 10.0, "angle": 0.01, "n": 0.01}
+
+
+def _machine() -> str:
+    cpu = "unknown CPU"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
+
+
+def _values(table: bool) -> dict[str, Any]:
+    values = load_params_file(CONFIG)
+    values.update(profile_table=table, shear_modulus=benchmark.SHEAR_MODULUS,
+                  poisson_ratio=benchmark.POISSON, friction_coefficient=benchmark.MU,
+                  cell_size=benchmark.CELL)
+    return values
+
+
+class Runner:
+    """The table pipeline and the per-pose one, serving poses in turn (stamps rising)."""
+
+    def __init__(self) -> None:
+        start = time.perf_counter()
+        self.table = ProfilePipeline(PipelineConfig.from_values(_values(True)), log=print)
+        self.table_seconds = time.perf_counter() - start
+        self.per_pose = ProfilePipeline(PipelineConfig.from_values(_values(False)))
+        self.stamp = 0
+
+    def serve(self, pipeline: ProfilePipeline, dy: float, yaw: float, roll: float, *,
+              speed: float = benchmark.SPEED, axle_spin: float | None = None,
+              load: float = benchmark.LOAD) -> dict[str, Any]:
+        """One pose: each wheel's force of the rail (track frame), patches' N and angles."""
+        self.stamp += 1_000_000
+        pose = Pose(dy=dy, yaw=yaw, roll=roll)
+        spin = speed / 0.46 if axle_spin is None else axle_spin
+        pipeline.on_wheel_twist(_stamped(wheel_twist(pose, speed, spin, 0.0, 0.0), self.stamp))
+        pipeline.on_load(StampedTwist(self.stamp, "wheelset", (0.0, 0.0, 2.0 * load),
+                                      (0.0, 0.0, 0.0)))
+        start = time.perf_counter()
+        cycle = pipeline.on_pose(StampedPose(self.stamp, "track", (0.0, dy, 0.0),
+                                             quaternion(roll, yaw)))
+        seconds = time.perf_counter() - start
+        contact = cycle.contact
+        if contact is None:
+            return {"error": "; ".join(sorted({o.status for o in cycle.outcomes}))}
+        used_roll = contact.roll if hasattr(contact, "roll") else contact.pose.roll
+        rot = rotation(used_roll, yaw)
+        wheels: dict[str, Any] = {}
+        for o in cycle.outcomes:
+            side = o.contact.split("_")[0]
+            w = wheels.setdefault(side, {"force": np.zeros(3), "patches": []})
+            if o.forces is None or o.frame is None:
+                continue
+            f = o.forces
+            w["force"] += rot @ np.asarray(o.frame.to_wheelset((f.fx, f.fy, f.n)))
+            normal_t = rot @ np.asarray(o.frame.axes[2])
+            angle = math.atan2(-normal_t[1] if side == "left" else normal_t[1], normal_t[2])
+            w["patches"].append({"name": o.contact, "N": f.n, "angle": angle})
+        return {"roll": used_roll, "seconds": seconds,
+                "wheels": {s: {"force": [float(v) for v in w["force"]],
+                               "patches": w["patches"]} for s, w in wheels.items()}}
+
+
+def _stamped(twist: StampedTwist, stamp: int) -> StampedTwist:
+    return StampedTwist(stamp, twist.frame_id, twist.linear, twist.angular)
+
+
+def _pct(a: list[float], b: list[float] | tuple[float, ...], n: float) -> float:
+    """Largest difference of Fx, Fy (track frame) in % of mu N."""
+    return 100.0 * max(abs(a[0] - b[0]), abs(a[1] - b[1])) / (benchmark.MU * n)
+
+
+def compute() -> dict[str, Any]:
+    runner = Runner()
+    results: dict[str, Any] = {"machine": _machine(), "table_seconds": runner.table_seconds,
+                               "nodes": len(runner.table.table.nodes) if runner.table.table
+                               else 0, "a22": [], "sweep": [], "loads": []}
+    profiles = json.loads(PROFILES.read_text()) if PROFILES.exists() else {"runs": []}
+    per_pose_a22 = {(r["side"], r["case"]): r for r in profiles["runs"]
+                    if r["method"] == "mae_calibrated" and "error" not in r}
+    # 1. A-2.2
+    for left, right in zip(benchmark.a22("left"), benchmark.a22("right")):
+        got = runner.serve(runner.table, left.dy, left.yaw, 0.0, speed=left.forward_speed,
+                           axle_spin=left.axle_spin)
+        for case in (left, right):
+            row: dict[str, Any] = {"case": case.number, "side": case.side, "dy": case.dy,
+                                   "yaw": case.yaw}
+            if "error" in got:
+                row["error"] = got["error"]
+            else:
+                wheel = got["wheels"][case.side]
+                n_ref = sum(p.n for p in case.patches)
+                row.update(roll=got["roll"], contact_roll=case.roll,
+                           vs_contact=_pct(wheel["force"], case.force_track, n_ref),
+                           n=sum(p["N"] for p in wheel["patches"]), n_ref=n_ref,
+                           patches=len(wheel["patches"]), patches_ref=len(case.patches),
+                           seconds=got["seconds"])
+                if len(case.patches) == 1 and len(wheel["patches"]) == 1:
+                    row["angle"] = wheel["patches"][0]["angle"]
+                    row["angle_ref"] = case.patches[0].angle
+                ref = per_pose_a22.get((case.side, case.number))
+                if ref is not None:
+                    row["vs_per_pose"] = _pct(wheel["force"], ref["force_track"], n_ref)
+            results["a22"].append(row)
+        print(f"A-2.2 pose {left.number}: done", flush=True)
+    # 2. between the nodes
+    grid = runner.table.table.grid if runner.table.table else None
+    assert grid is not None
+    step = grid.dys[1] - grid.dys[0]
+    for yaw in (0.0, 0.0137, -0.0212):
+        for dy in np.arange(-10e-3, 10.001e-3, 0.25e-3):
+            dy_off = float(dy + step / 3.0)
+            got = runner.serve(runner.table, dy_off, yaw, 0.0)
+            row = {"dy": dy_off, "yaw": yaw}
+            if "error" in got:
+                row["error"] = got["error"]
+            else:
+                ref = runner.serve(runner.per_pose, dy_off, yaw, got["roll"])
+                if "error" in ref:
+                    row["error"] = "per-pose: " + ref["error"]
+                else:
+                    for side in ("left", "right"):
+                        n = sum(p["N"] for p in ref["wheels"][side]["patches"])
+                        row[side] = _pct(got["wheels"][side]["force"],
+                                         ref["wheels"][side]["force"], n)
+                        row[f"{side}_patches"] = (len(got["wheels"][side]["patches"]),
+                                                  len(ref["wheels"][side]["patches"]))
+            results["sweep"].append(row)
+        print(f"sweep yaw {yaw}: done", flush=True)
+    # 3. loads by similarity
+    for load in (7e3, 13e3):
+        for case in benchmark.a22("left"):
+            got = runner.serve(runner.table, case.dy, case.yaw, 0.0, load=load)
+            row = {"case": case.number, "load": load}
+            if "error" in got:
+                row["error"] = got["error"]
+            else:
+                ref = runner.serve(runner.per_pose, case.dy, case.yaw, got["roll"], load=load)
+                for side in ("left", "right"):
+                    n = sum(p["N"] for p in ref["wheels"][side]["patches"])
+                    row[side] = _pct(got["wheels"][side]["force"], ref["wheels"][side]["force"],
+                                     n)
+            results["loads"].append(row)
+        print(f"load {load}: done", flush=True)
+    return results
+
+
+def _fmt(v: Any, spec: str = ".2f") -> str:
+    return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
+
+
+def report(r: dict[str, Any]) -> str:
+    a22 = [x for x in r["a22"] if "error" not in x]
+    worst_contact = max(x["vs_contact"] for x in a22)
+    worst_pose = max((x["vs_per_pose"] for x in a22 if "vs_per_pose" in x), default=math.nan)
+    angles = [abs(x["angle"] - x["angle_ref"]) for x in a22 if "angle" in x]
+    n_err = [abs(x["n"] / x["n_ref"] - 1.0) for x in a22 if x["patches"] == x["patches_ref"]]
+    lines = [
+        "# The contact table against CONTACT and the per-pose solve",
+        "",
+        "Generated by `scripts/validate_table.py` (the numbers: "
+        "`docs/data/validation_table.json`). The table of "
+        "`config/profiles_track_table.yaml`: S1002 on UIC60 1:40 in the Manchester "
+        f"placement, {r['nodes']} nodes (shift -12..12 mm by 0.1 mm, halved up to four times "
+        "to 6.25 um where neighbouring nodes differ; yaw -25..25 mrad by 5 mrad), solved at "
+        "10 kN per wheel with the kinematic roll "
+        "(`fastsim_ros/geometry/table.py` states the assumptions: levelled roll, Hertz "
+        "similarity in the load, blending by shape between nodes, mirror symmetry). "
+        "Every force below is the default method's (the calibrated MAE) through "
+        "`ProfilePipeline`, the node's code, with the vertical balance including the "
+        "creep forces. Machine: " + r["machine"] + ".",
+        "",
+        "## A-2.2 from the table",
+        "",
+        "Each wheel's force of the rail in the track frame, the largest of Fx, Fy errors in % "
+        "of mu N (N: CONTACT's), against CONTACT's published exact results and against the "
+        "per-pose path's default-method results (`docs/validation_profiles.md`); the table "
+        "uses its own levelled roll, CONTACT its loaded one.",
+        "",
+        f"- worst against CONTACT's exact: **{worst_contact:.2f}%** of mu N "
+        f"(target for the default method {TARGET['default']:.0f}%); against the per-pose "
+        f"solve: **{worst_pose:.2f}%**",
+        f"- contact angle (one-region poses): worst {max(angles):.4f} rad "
+        f"(target {TARGET['angle']}); N: worst {100 * max(n_err):.2f}% "
+        f"(target {100 * TARGET['n']:.0f}%)",
+        "",
+        "| pose | wheel | dy (mm) | yaw (mrad) | roll table / CONTACT (mrad) | patches | "
+        "vs CONTACT (% mu N) | vs per-pose (% mu N) | N error (%) |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for x in r["a22"]:
+        if "error" in x:
+            lines.append(f"| {x['case']} | {x['side']} | {1e3 * x['dy']:.1f} | "
+                         f"{1e3 * x['yaw']:.1f} | refused: {x['error']} | | | | |")
+            continue
+        lines.append(
+            f"| {x['case']} | {x['side']} | {1e3 * x['dy']:.1f} | {1e3 * x['yaw']:.1f} | "
+            f"{1e3 * x['roll']:.3f} / {1e3 * x['contact_roll']:.3f} | "
+            f"{x['patches']} / {x['patches_ref']} | {x['vs_contact']:.2f} | "
+            f"{_fmt(x.get('vs_per_pose'))} | {100 * (x['n'] / x['n_ref'] - 1):+.2f} |")
+    sweep = [x for x in r["sweep"] if "error" not in x]
+    errs = np.array([max(x["left"], x["right"]) for x in sweep])
+    lines += [
+        "",
+        "## Between the nodes",
+        "",
+        "Shifts a third of a step past a node, -10..10 mm every 0.25 mm, at yaw 0, 13.7 and "
+        "-21.2 mrad (between yaw nodes), 10 kN per wheel, V = 2 m/s rolling freely: the table "
+        "against the per-pose solve at the table's roll, the larger wheel's error in % of "
+        "mu N.",
+        "",
+        f"- {len(sweep)} poses served ({len(r['sweep']) - len(sweep)} refused by either): "
+        f"median {np.median(errs):.2f}%, 90th percentile {np.percentile(errs, 90):.2f}%, "
+        f"worst {errs.max():.2f}%; {int(np.sum(errs > 5.0))} poses above 5%",
+        "",
+        "| yaw (mrad) | dy (mm) | left (% mu N) | right (% mu N) | patches left, table / "
+        "per-pose |",
+        "| --- | --- | --- | --- | --- |"]
+    worst = sorted(sweep, key=lambda x: -max(x["left"], x["right"]))[:12]
+    for x in worst:
+        lines.append(f"| {1e3 * x['yaw']:.1f} | {1e3 * x['dy']:.3f} | {x['left']:.2f} | "
+                     f"{x['right']:.2f} | {x['left_patches'][0]} / {x['left_patches'][1]} |")
+    lines += ["", "(the 12 worst poses; all in the JSON)", ""]
+    loads = [x for x in r["loads"] if "error" not in x]
+    lines += [
+        "## Loads by similarity",
+        "",
+        "The A-2.2 poses at 7 kN and 13 kN per wheel (the table holds 10 kN), table against "
+        "per-pose at the table's roll, % of mu N:",
+        "",
+        "| load (kN) | median | worst | pose of the worst |",
+        "| --- | --- | --- | --- |"]
+    for load in (7e3, 13e3):
+        rows = [x for x in loads if x["load"] == load]
+        e = np.array([max(x["left"], x["right"]) for x in rows])
+        w = rows[int(np.argmax(e))]
+        lines.append(f"| {load / 1e3:.0f} | {np.median(e):.2f} | {e.max():.2f} | {w['case']} |")
+    lines += [
+        "",
+        "## Where the table errs, and why",
+        "",
+        "- At a node the table's patches are the per-pose path's at the levelled roll and "
+        "the reference load; its error there is the roll's (CONTACT's loaded roll differs by "
+        "micro-radians on the treads, 0.03-0.2 mrad with a flange) and, off 10 kN, the "
+        "similarity's.",
+        "- Between nodes the shape is interpolated, not solved. Where neighbouring shifts "
+        "differ (a gauge corner or flange contact taking over, the tread contact running "
+        "10 mm per mm of shift near the centre) the build looks at the midpoint and halves the "
+        "interval again while the blend of its ends misses the midpoint node (centroid 0.1 "
+        "mm, load, cells and extents 5%), down to 6.25 um: there a flange taking over is "
+        "blended over 6 um instead of 100 (the unrefined table's worst between nodes at zero "
+        "yaw was 85%, its 90th percentile 3.4%).",
+        "- In yaw the table is not refined: the shift at which the flange takes over moves "
+        "with the yaw, so between two yaw nodes (5 mrad apart) and within about 0.1 mm of "
+        "that shift one yaw node has the flange contact and the other the gauge corner, and "
+        "the blend fades one into the other: the worst pose above (yaw 13.7 mrad, -6.217 mm) "
+        "is such a one. A rig that dwells at flange onset under yaw wants a finer yaw step "
+        "(`table_yaw_step`) or the per-pose solve.",
+        "- Hertz similarity is exact for Hertzian patches; the conformal two-zone tread "
+        "patches near zero shift and the flange patches are not Hertzian, so a load far "
+        "from the reference load errs most there.",
+        ""]
+    return "\n".join(lines)
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--report-only", action="store_true")
+    args = parser.parse_args()
+    if args.report_only:
+        results = json.loads(DATA.read_text())
+    else:
+        results = compute()
+        DATA.parent.mkdir(parents=True, exist_ok=True)
+        DATA.write_text(json.dumps(results, indent=1))
+    REPORT.write_text(report(results))
+    print(f"wrote {REPORT}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

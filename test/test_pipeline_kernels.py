@@ -1,0 +1,212 @@
+"""The pipeline's compiled path gives every number of its Python path, to the bit.
+
+:func:`fastsim_ros.pipeline_kernels.solve_cloud` replaces, for a patch that
+is solved, the adapter's Python checks, the creepages, the solver's wrapper
+and the wheelset wrench: a pipeline with it and one without (the Python
+path alone) are fed the same messages and must give equal outcomes, field by
+field, on every layout, orientation and setting the compiled path takes,
+and the same rejections where it defers.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros import pipeline_kernels
+from fastsim_ros.contact import samples
+from fastsim_ros.pipeline import Pipeline, PipelineConfig
+from ros_messages import WHEEL_RADIUS as R
+from ros_messages import cdr, cloud_msg, contact_normal, rolling_twist, twist_msg
+
+MS = 1_000_000
+T0 = 1_700_000_000 * 1_000_000_000
+
+
+def egg():
+    return samples.semi_ellipses_patch(0.5, 2.0, cells=24, scale=8e-3, load=6e4)
+
+
+def python_solve(*args):
+    raise AssertionError("the compiled path deferred a patch that it solves")
+
+
+def pair(*, compiled_only=True, **values):
+    """Return a pipeline on the compiled path and one on the Python path alone.
+
+    ``compiled_only``: the first may not call the Python path's solve (a
+    patch it defers would fail the test).
+    """
+    values.setdefault("contacts", ["left"])
+    config = PipelineConfig.from_values(values)
+    fast, slow = Pipeline(config), Pipeline(config)
+    assert fast._compiled is not None
+    slow._compiled = None
+    if compiled_only:
+        fast._solve = python_solve
+    return fast, slow
+
+
+def same(a, b):
+    """Assert two outcomes equal field by field (floats to the bit, arrays equal)."""
+    assert (a.contact, a.stamp_ns, a.status, a.detail) == (b.contact, b.stamp_ns, b.status,
+                                                           b.detail)
+    assert a.frame == b.frame and a.frame_changed == b.frame_changed
+    assert a.creepage == b.creepage or (a.creepage is not None and all(
+        math.isnan(x) and math.isnan(y) for x, y in zip(
+            (a.creepage.xi, a.creepage.eta, a.creepage.phi),
+            (b.creepage.xi, b.creepage.eta, b.creepage.phi))))
+    if a.forces is None or b.forces is None:
+        assert a.forces is b.forces
+    else:  # (ContactForces compares by identity)
+        for name in ("fx", "fy", "mz", "n", "slip_fraction", "tau_x", "tau_y", "slip", "grid"):
+            assert getattr(a.forces, name) == getattr(b.forces, name), name
+    if a.patch is None or b.patch is None:
+        assert a.patch is b.patch
+    else:
+        for name in ("stamp_ns", "frame", "x0", "y0", "dx", "dy", "load", "cells",
+                     "row_order", "column_order"):
+            assert getattr(a.patch, name) == getattr(b.patch, name), name
+        assert a.patch.pressure.flags.c_contiguous and b.patch.pressure.flags.c_contiguous
+        assert np.array_equal(a.patch.pressure, b.patch.pressure)
+    assert a.wheelset == b.wheelset and a.markers == b.markers
+
+
+def feed(pipes, contact, msg):
+    return [p.on_patch(contact, cdr(msg)) for p in pipes]
+
+
+def twist(pipes, msg, rail=False):
+    for p in pipes:
+        assert (p.on_rail_twist if rail else p.on_wheel_twist)(cdr(msg)) == "ok"
+
+
+CLOUDS = {
+    "float32": {},
+    "float64": {"dtype": "<f8"},
+    "big endian": {"dtype": ">f8"},
+    "fields reordered, padded": {"field_order": ["pressure", "normal_x", "normal_y",
+                                                 "normal_z", "x", "y", "z"], "pad": 4},
+    "rows reversed": {"reverse_rows": True},
+    "columns reversed": {"reverse_columns": True},
+    "both reversed": {"reverse_rows": True, "reverse_columns": True},
+    "contact angle": {"normal": contact_normal(0.3), "dtype": "<f8"},
+}
+
+
+@pytest.mark.parametrize("cloud", sorted(CLOUDS))
+@pytest.mark.parametrize("method", ["mae_calibrated", "mae"])
+def test_solved_patches_equal_the_python_path(cloud, method):
+    fast, slow = pair(method=method, contacts=["left", "right"])
+    twist((fast, slow), rolling_twist(2e-3, stamp_ns=T0))
+    for k, (contact, xi) in enumerate((("left", 2e-3), ("right", 2e-3), ("left", 2e-3))):
+        a, b = feed((fast, slow), contact, cloud_msg(egg(), stamp_ns=T0 + (k + 1) * MS,
+                                                     **CLOUDS[cloud]))
+        assert a.status == "solved"
+        same(a, b)
+    assert fast.latest_wrench("left") == slow.latest_wrench("left")
+    p50, _ = fast.solve_time_percentiles("left")
+    assert p50 > 0.0
+
+
+@pytest.mark.parametrize("settings", [
+    {"traction_bound": "parabolic"},
+    {"friction_law": "exponential", "friction_limit_ratio": 0.4, "friction_decay": 0.6},
+    {"friction_coefficient": 0.15},
+])
+def test_settings_reach_the_compiled_solve(settings):
+    fast, slow = pair(**settings)
+    twist((fast, slow), rolling_twist(5e-3, stamp_ns=T0))
+    a, b = feed((fast, slow), "left", cloud_msg(egg(), stamp_ns=T0 + MS, dtype="<f8"))
+    assert a.status == "solved"
+    same(a, b)
+
+
+def test_reverse_running_and_a_moving_rail_equal_the_python_path():
+    fast, slow = pair(contacts=["left"])
+    # reverse running, yawed and spinning: every creepage nonzero
+    twist((fast, slow), twist_msg((-20.0, 0.05, 0.0), (0.01, -20.0 / R * 1.001, 0.02),
+                                  stamp_ns=T0))
+    msg = cloud_msg(egg(), stamp_ns=T0 + MS, dtype="<f8", normal=contact_normal(0.1))
+    a, b = feed((fast, slow), "left", msg)
+    assert a.status == "solved" and a.creepage.speed < 0.0
+    same(a, b)
+    # a roller rig: the rail moves under a wheelset at rest
+    twist((fast, slow), twist_msg(stamp_ns=T0 + 2 * MS))
+    twist((fast, slow), twist_msg((-20.0, 0.0, 0.0), (0.0, 0.0, 0.0), stamp_ns=T0 + 2 * MS),
+          rail=True)
+    a, b = feed((fast, slow), "left", cloud_msg(egg(), stamp_ns=T0 + 3 * MS))
+    assert a.status == "solved"
+    same(a, b)
+
+
+def test_where_the_python_path_rejects_both_say_the_same():
+    fast, slow = pair(contacts=["left"], max_patch_cells=10000, compiled_only=False)
+    area = egg()
+    bad = [cloud_msg(area, stamp_ns=T0 + MS)]  # no kinematics yet
+    twist((fast, slow), rolling_twist(1e-3, stamp_ns=T0 + 2 * MS))
+    stamp = T0 + 3 * MS
+    nan = area.pressure.copy()
+    nan[3, 3] = math.nan
+    negative = area.pressure.copy()
+    negative[5, 5] = -1.0
+    few = np.zeros_like(area.pressure)
+    few[10, 10:12] = 1e6
+    for kwargs in ({"pressure": nan}, {"pressure": negative}, {"pressure": few},
+                   {"pressure": np.zeros_like(area.pressure)}, {"frame_id": "base_link"}):
+        bad.append(cloud_msg(area, stamp_ns=stamp, **kwargs))
+        stamp += MS
+    bad.append(cloud_msg(area, stamp_ns=stamp + 200 * MS))  # stale kinematics
+    for msg in bad:
+        a, b = feed((fast, slow), "left", msg)
+        same(a, b)
+    twist((fast, slow), twist_msg((1e-4, 0.0, 0.0), (0.0, 1e-4 / R, 0.0),
+                                  stamp_ns=stamp + 300 * MS))
+    a, b = feed((fast, slow), "left", cloud_msg(area, stamp_ns=stamp + 301 * MS))
+    assert a.status == "standstill"
+    same(a, b)
+    assert fast.counts("left") == slow.counts("left")
+
+
+def test_tractions_and_the_equivalent_ellipse_stay_on_the_python_path():
+    for values in ({"publish_traction": True}, {"method": "fastsim_ellipse"}):
+        pipe = Pipeline(PipelineConfig.from_values({"contacts": ["left"], **values}))
+        assert pipe._compiled is None
+    pipe = Pipeline(PipelineConfig.from_values({"contacts": ["left"]}))
+    pipe.update({"publish_traction": True})
+    assert pipe._compiled is None
+    pipe.update({"publish_traction": False, "method": "mae"})
+    assert pipe._compiled is not None
+
+
+def test_warm_up_compiles_every_words_type():
+    pipeline_kernels.warm_up()
+    assert len(pipeline_kernels.solve_cloud.signatures) >= 4
+
+
+def test_the_fast_builders_make_the_dataclasses_own_instances():
+    import dataclasses
+
+    from fastsim_ros import pipeline
+    from fastsim_ros.contact.compiled import ContactForces
+    from msg_adapters.kinematics import Creepage
+    from msg_adapters.patch import ContactFrame, ContactPatch
+
+    frame = ContactFrame((0.0, 0.75, -R), ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
+    pressure = np.ones((2, 2))
+    cases = [(pipeline._new_frame, ContactFrame, (frame.origin, frame.axes)),
+             (pipeline._new_patch, ContactPatch,
+              (T0, frame, pressure, -1e-3, -2e-3, 1e-3, 2e-3, 6e4, 4, 1, -1)),
+             (pipeline._new_creepage, Creepage, (1e-3, -2e-3, 0.1, 20.0)),
+             (pipeline._new_forces, ContactForces,
+              (-1e3, 2e2, 3.0, 6e4, 0.25, None, None, None, None)),
+             (pipeline._new_outcome, pipeline.Outcome,
+              ("left", T0, "solved", "", frame, True, None, None, None, None, False))]
+    for build, cls, values in cases:
+        built, reference = build(*values), cls(*values)
+        assert type(built) is cls
+        for f in dataclasses.fields(cls):
+            assert getattr(built, f.name) is getattr(reference, f.name), f.name
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            setattr(built, dataclasses.fields(cls)[0].name, None)
+    assert pipeline._new_frame(*cases[0][2]) == frame  # frozen dataclasses compare by value
