@@ -8,6 +8,11 @@ wrench, or a rejection with its reason key (INTERFACE.md).  It never reads
 a clock for anything it outputs: stamps come from the messages, so a replay
 is deterministic (only the solve-time statistics use ``perf_counter``).
 No ``rclpy.node`` here: the node and ``fastsim_replay`` are thin front ends.
+A patch that is solved takes the compiled path
+(:func:`fastsim_ros.pipeline_kernels.solve_cloud`: the adapter's loop, the
+creepages, the MAE solve and the wheelset wrench in one call, equal to the
+bit to the Python path, which decides every rejection); its solve time is
+that call's.
 
 Physics (INTERFACE.md "Creepages", METHOD.md 1): the solvers roll towards
 ``+x``; when the rolling speed ``V`` is negative (reverse running) the patch
@@ -22,7 +27,7 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable, Container, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -247,6 +252,33 @@ class _Every:
 
 
 _EVERY = _Every()
+
+
+def _builder(cls: type) -> Callable[..., Any]:
+    """Return a constructor of a frozen, slotted dataclass taking every field in order.
+
+    The dataclass's own ``__init__`` sets each field through
+    ``object.__setattr__`` (what ``frozen`` costs); this one calls each slot's
+    setter directly: half the time, for the five results built per patch on
+    the compiled path.  No defaults, no ``__post_init__`` (none of them has
+    one); the instance equals the ``__init__``'s (test_pipeline_kernels.py).
+    """
+    names = [f.name for f in fields(cls)]
+    assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
+    args = ", ".join(names)
+    body = "".join(f"    set_{n}(o, {n})\n" for n in names)
+    scope: dict[str, Any] = {"new": object.__new__, "cls": cls}
+    scope.update({f"set_{n}": getattr(cls, n).__set__ for n in names})
+    exec(f"def build({args}):\n    o = new(cls)\n{body}    return o\n", scope)
+    build: Callable[..., Any] = scope["build"]
+    return build
+
+
+_new_frame = _builder(ContactFrame)
+_new_patch = _builder(ContactPatch)
+_new_creepage = _builder(Creepage)
+_new_forces = _builder(ContactForces)
+_new_outcome = _builder(Outcome)
 
 
 def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
@@ -492,8 +524,8 @@ class Pipeline:
         if changed:
             state.last_frame = patch.frame
         wheelset = self._add_wrench(state, stamp, f_ws, torque)
-        return Outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces, patch,
-                       wheelset, self._markers_due(state, stamp))
+        return _new_outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces,
+                            patch, wheelset, self._markers_due(state, stamp))
 
     def _twist_array(self, what: str, twist: StampedTwist) -> np.ndarray:
         """Return a twist's ``(v, w)`` as an array (built once per twist)."""
@@ -542,11 +574,12 @@ class Pipeline:
             patch_kernels.ORIGIN:patch_kernels.E_Z + 3].tolist()
         (x0, y0, dx, dy, load, cells, row_order, column_order, xi, eta, phi, speed, fx, fy,
          mz, n, slip_fraction, f0, f1, f2, t0, t1, t2) = result.tolist()
-        frame = ContactFrame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
-        patch = ContactPatch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, int(cells),
-                             int(row_order), int(column_order))
-        return (patch, Creepage(xi, eta, phi, speed),
-                ContactForces(fx, fy, mz, n, slip_fraction), (f0, f1, f2), (t0, t1, t2))
+        frame = _new_frame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
+        patch = _new_patch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, int(cells),
+                           int(row_order), int(column_order))
+        return (patch, _new_creepage(xi, eta, phi, speed),
+                _new_forces(fx, fy, mz, n, slip_fraction, None, None, None, None), (f0, f1, f2),
+                (t0, t1, t2))
 
     def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,
                     rail: StampedTwist = REST, *, method: str | None = None,

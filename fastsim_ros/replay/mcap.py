@@ -23,6 +23,7 @@ import os
 import re
 import struct
 import sys
+import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +31,7 @@ from typing import Any, BinaryIO
 from zlib import crc32
 
 import numpy as np
+import zstandard
 from numpy.typing import NDArray
 
 from fastsim_ros.replay import kernels
@@ -181,9 +183,26 @@ class IndexedMcap:
         return raw, records
 
 
+_THREAD = threading.local()
+
+
+def _zstd(data: bytes, size: int) -> bytes:
+    """Decompress a zstd chunk of ``size`` bytes into one buffer of that size.
+
+    (rosbags' decompressor grows its output block by block and joins the
+    blocks: a second copy of every chunk.)  One decompression context per
+    thread: a Dask worker may run tasks in several.
+    """
+    context = getattr(_THREAD, "zstd", None)
+    if context is None:
+        context = _THREAD.zstd = zstandard.ZstdDecompressor()
+    out: bytes = context.decompress(data, max_output_size=size)
+    return out
+
+
 def _decompress(data: bytes, compression: str, size: int) -> bytes:
-    from rosbags.rosbag2.storage_mcap import DECOMPRESSORS  # zstd, lz4, none: rosbags' own
-    decompress = DECOMPRESSORS.get(compression)
+    from rosbags.rosbag2.storage_mcap import DECOMPRESSORS  # lz4, none: rosbags' own
+    decompress = _zstd if compression == "zstd" else DECOMPRESSORS.get(compression)
     if decompress is None:
         raise McapError(f"chunk compression {compression!r} is not supported")
     try:

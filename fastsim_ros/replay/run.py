@@ -34,7 +34,7 @@ from rclpy.serialization import serialize_message
 from fastsim_ros.params import SPECS, ParameterError
 from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig
 from fastsim_ros.profile_pipeline import AnyPipeline, make_pipeline
-from fastsim_ros.replay import bagio, bulk, storage
+from fastsim_ros.replay import bagio, bulk, heap, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
 from fastsim_ros.replay.records import CSV_HEADER, Series, record
@@ -110,6 +110,7 @@ def run_task(task: Task, *, profile: bool = False) -> Result:
     that died while replaying it) is removed first and counted in
     ``Result.attempts``.
     """
+    heap.keep_freed_memory()   # once per process: chunk buffers reused, not faulted in anew
     if storage.is_url(task.source) or storage.is_url(task.out):
         return _run_fetched(task, profile)
     return _run_local(task, profile)
