@@ -31,7 +31,12 @@ Assumptions, each stated because the interpolation rests on it:
    contact plane and trimmed to the blended number of cells in contact.  A
    patch present at only some of the nodes fades in with their weights (a
    flange contact that starts between two nodes grows from zero load).
-4. **Mirror symmetry.**  With the right wheel and rail the mirror images of
+4. **Events aligned in yaw.**  The shift at which a flange or gauge corner
+   takes over moves with the yaw; between two yaw nodes each column is read
+   at the pose's distance from its own take-over (interpolated between the
+   columns), so that the two columns blend the same contact.  In the shift
+   the nodes are refined by bisection where neighbours differ instead.
+5. **Mirror symmetry.**  With the right wheel and rail the mirror images of
    the left ones and a grid symmetric about ``dy = 0`` and ``yaw = 0``, the
    right wheel's patches at ``(dy, yaw)`` are the left wheel's at ``(-dy,
    -yaw)`` mirrored in ``y``; only the left wheel is solved.
@@ -861,7 +866,7 @@ class ContactTable:
     def build(cls, wheelset: Wheelset, grid: TableGrid, load: float, *, workers: int = 1,
               refine: int = 0,
               progress: Callable[[int, int], None] | None = None) -> ContactTable:
-        """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 4).
+        """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 5).
 
         ``load``: the reference wheel load (N).  ``refine``: times the shift
         intervals whose nodes are inconsistent (:func:`_consistent`, any yaw)
