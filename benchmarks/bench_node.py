@@ -221,7 +221,8 @@ def startup(trials: int) -> None:
           f"({', '.join(f'{t:.2f}' for t in times)})")
 
 
-#: ["--native"]: py-spy samples C and C++ frames too (pausing the process at each sample)
+#: ["--native"] (environment BENCH_NATIVE=1): py-spy samples C and C++ frames too, pausing
+#: the target at each sample (it then drops most patches: shares, not rates)
 NATIVE: list[str] = ["--native"] if os.environ.get("BENCH_NATIVE") else []
 FLOOR = Path(__file__).resolve().parent / "dds_floor.py"
 #: the checkout whose node runs as the target "baseline" (--baseline)

@@ -338,3 +338,30 @@ def test_refinement_keeps_the_grid_symmetric_for_the_mirror(wheelset):
     assert len(left) == len(right)
     for p, q in zip(left, right):
         np.testing.assert_allclose(q.origin, p.origin * np.array([1.0, -1.0, 1.0]), atol=1e-12)
+
+
+def test_yaw_columns_are_aligned_on_the_flanges_take_over(wheelset):
+    # the right flange takes over at -6.222 mm at 10 mrad and -6.181 mm at 15 mrad; at 12.5
+    # mrad, around its own take-over (interpolated: -6.2015 mm), the two columns are read at
+    # the same distance from their own take-overs: the wheel's normal force (its size and
+    # direction, 0.55 rad on the gauge corner, 1.2 on the flange) comes out far closer to
+    # the wheel solved there than when both are read at the pose's own shift
+    grid = TableGrid((-6.4e-3, -6.3e-3, -6.2e-3, -6.1e-3, -6.0e-3), (10e-3, 15e-3))
+    table = ContactTable.build(wheelset, grid, LOAD, refine=4)
+    (e10,), (e15,) = table.events
+    assert e10 == pytest.approx(-6.222e-3, abs=0.01e-3)
+    assert e15 == pytest.approx(-6.181e-3, abs=0.01e-3)
+    plain = ContactTable(table.grid, table.load, table.nodes)
+    plain.events = [[], []]
+
+    def normal_force(patches):
+        return sum((p.load * p.normal for p in patches), np.zeros(3))
+
+    aligned_err, plain_err = [], []
+    for dy in np.linspace(-6.26e-3, -6.14e-3, 13):
+        exact = normal_force(solve_node(wheelset, LOAD, float(dy), 12.5e-3).patches[1])
+        for t, errs in ((table, aligned_err), (plain, plain_err)):
+            got = normal_force(t.lookup(float(dy), 12.5e-3).patches("right"))
+            errs.append(float(np.linalg.norm(got - exact) / np.linalg.norm(exact)))
+    assert max(aligned_err) < 0.5 * max(plain_err)
+    assert np.mean(aligned_err) < 0.5 * np.mean(plain_err)

@@ -207,3 +207,46 @@ def test_a_recorded_rig_replays_to_the_node_as_offline(node, tmp_path):
         g = got[key]
         assert (g.force.x, g.force.y, g.force.z, g.torque.z) == pytest.approx(
             (w.force.x, w.force.y, w.force.z, w.torque.z), rel=1e-12, abs=1e-9), key
+
+
+def test_the_node_with_the_contact_table_gives_the_pipelines_wrenches(node, tmp_path):
+    # a small table (shift -2..2 mm by 1 mm, yaw 0), built by the node at start into a cache
+    # of this test's own; the same pipeline in this process reads it from there
+    from fastsim_ros.params import load_params_file
+    from fastsim_ros.pipeline import PipelineConfig
+    from fastsim_ros.profile_pipeline import ProfilePipeline
+    from msg_adapters.cdr import StampedTwist
+    from msg_adapters.profile_msgs import StampedPose
+
+    table = {"profile_table": True, "table_dy_min": -2e-3, "table_dy_max": 2e-3,
+             "table_dy_step": 1e-3, "table_yaw_max": 0.0, "table_refine": 0,
+             "table_cache": str(tmp_path / "tables")}
+    args = [a for k, v in table.items()
+            for a in ("-p", f"{k}:={str(v).lower() if isinstance(v, bool) else v}")]
+    _, client, pose, _ = node(*args)
+    client.send_twist(_twist(T0, 0.0, 0.0))
+    got = client.send_pose(pose, _pose(T0, 0.6e-3, 0.0, 0.0, 0.0), CONTACTS)
+    assert list((tmp_path / "tables").glob("contact_table_*.npz"))
+    here = ProfilePipeline(PipelineConfig.from_values({**load_params_file(CONFIG), **table}))
+    v = rotation(0.0, 0.0).T @ np.array([SPEED, 0.0, 0.0])
+    here.on_wheel_twist(StampedTwist(T0 * 1_000_000_000, "wheelset", tuple(float(c) for c in v),
+                                     (0.0, SPEED / R0, 0.0)))
+    cycle = here.on_pose(StampedPose(T0 * 1_000_000_000 + 2_500_000, "track",
+                                     (0.0, 0.6e-3, 0.0), quaternion(0.0, 0.0)))
+    for outcome in cycle.outcomes:
+        (w,) = got[outcome.contact]
+        if outcome.forces is None:
+            assert outcome.status == "no_contact"
+            assert (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z) == (0.0, 0.0, 0.0)
+            continue
+        f = outcome.forces
+        assert (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z, w.wrench.torque.z) == \
+            pytest.approx((f.fx, f.fy, f.n, f.mz), rel=1e-9), outcome.contact
+    # outside the table: counted, nothing published; the next pose inside served
+    client.send_twist(_twist(T0 + 1, 0.0, 0.0))
+    got = client.send_pose(pose, _pose(T0 + 1, 3e-3, 0.0, 0.0, 0.0), CONTACTS)
+    assert all(ws == [] for ws in got.values())
+    assert client.diagnostic_values("left")["rejected/out_of_table"] == "1"
+    client.send_twist(_twist(T0 + 2, 0.0, 0.0))
+    got = client.send_pose(pose, _pose(T0 + 2, -1.5e-3, 0.0, 0.0, 0.0), CONTACTS)
+    assert len(got["left"]) == 1 and len(got["right"]) == 1

@@ -31,7 +31,12 @@ Assumptions, each stated because the interpolation rests on it:
    contact plane and trimmed to the blended number of cells in contact.  A
    patch present at only some of the nodes fades in with their weights (a
    flange contact that starts between two nodes grows from zero load).
-4. **Mirror symmetry.**  With the right wheel and rail the mirror images of
+4. **Events aligned in yaw.**  The shift at which a flange or gauge corner
+   takes over moves with the yaw; between two yaw nodes each column is read
+   at the pose's distance from its own take-over (interpolated between the
+   columns), so that the two columns blend the same contact.  In the shift
+   the nodes are refined by bisection where neighbours differ instead.
+5. **Mirror symmetry.**  With the right wheel and rail the mirror images of
    the left ones and a grid symmetric about ``dy = 0`` and ``yaw = 0``, the
    right wheel's patches at ``(dy, yaw)`` are the left wheel's at ``(-dy,
    -yaw)`` mirrored in ``y``; only the left wheel is solved.
@@ -88,6 +93,11 @@ REFINE_LOAD = 0.1
 #: midpoint node: centroid within this (m), load, cells and RMS extents within this share
 REFINE_MIDPOINT = 0.1e-3
 REFINE_SHAPE = 0.05
+#: jumps of one yaw column this close (m) are one event; events of neighbouring yaw columns
+#: this close (m) are the same event (the flange takes over 0.2 mm further out at 25 mrad
+#: than at 0)
+EVENT_CLUSTER = 0.05e-3
+EVENT_MATCH = 0.5e-3
 #: a pose this close to a node (in units of the step) takes that node alone
 NODE_SNAP = 1e-9
 #: the roll that levels both rigid wheels is solved to this height difference (m)
@@ -585,6 +595,26 @@ def _axis_weights(nodes: tuple[float, ...], value: float, name: str) -> list[tup
     return [(k, 1.0 - t), (k + 1, t)]
 
 
+def _event_pairs(a: list[float], b: list[float]) -> list[tuple[float, float]]:
+    """Return the events of two yaw columns that are one event (nearest, within EVENT_MATCH).
+
+    In order along the shift: a gauge corner taking over at one yaw and not at
+    the next is left out, the flange's take-over at both is paired.
+    """
+    out = []
+    i = k = 0
+    while i < len(a) and k < len(b):
+        if abs(a[i] - b[k]) <= EVENT_MATCH:
+            out.append((a[i], b[k]))
+            i += 1
+            k += 1
+        elif a[i] < b[k]:
+            i += 1
+        else:
+            k += 1
+    return out
+
+
 def _pairs(a: TableNode, b: TableNode) -> list[tuple[TablePatch, TablePatch]] | None:
     """Return the matching patch pairs of two nodes (both wheels), or ``None`` if any is unmatched.
 
@@ -779,12 +809,64 @@ class ContactTable:
         self.grid = grid
         self.load = float(load)
         self.nodes = tuple(nodes)
+        # each yaw column's events: where its contact jumps (a flange or gauge corner taking
+        # over), i.e. where the refinement went down to its finest step and the nodes still
+        # differ; the jumps within EVENT_CLUSTER of one another are one event, at their mean
+        dys = np.asarray(grid.dys)
+        finest = 1.5 * float(np.diff(dys).min()) if dys.size > 1 else 0.0
+        self.events: list[list[float]] = []
+        for j in range(len(grid.yaws)):
+            column = [self.nodes[i * len(grid.yaws) + j] for i in range(len(grid.dys))]
+            jumps = [0.5 * (grid.dys[i] + grid.dys[i + 1]) for i in range(len(column) - 1)
+                     if grid.dys[i + 1] - grid.dys[i] < finest
+                     and _differ(column[i], column[i + 1])]
+            clusters: list[list[float]] = []
+            for e in jumps:
+                if clusters and e - clusters[-1][-1] < EVENT_CLUSTER:
+                    clusters[-1].append(e)
+                else:
+                    clusters.append([e])
+            self.events.append([sum(c) / len(c) for c in clusters])
+
+    def weights(self, dy: float, yaw: float) -> list[tuple[int, int, float]]:
+        """Return the weights ``(i_dy, i_yaw, w)`` of a pose's nodes, largest first.
+
+        Bilinear, but aligned on the events in yaw (assumption 3): where both
+        yaw columns have the same number of events (say a flange taking over,
+        at a shift that moves with the yaw), the pose's shift is placed on
+        each column at the same distance from its events as from the events
+        interpolated at the pose's yaw (piecewise linear between them), so
+        that both columns give the contact the pose has, not one each.
+        """
+        for_yaw = _axis_weights(self.grid.yaws, yaw, "yaw")
+        _axis_weights(self.grid.dys, dy, "dy")   # the range check on the shift itself
+        knots = (_event_pairs(self.events[for_yaw[0][0]], self.events[for_yaw[1][0]])
+                 if len(for_yaw) == 2 else [])
+        if knots:
+            (j0, w0), (j1, w1) = for_yaw
+            ends = (self.grid.dys[0], self.grid.dys[-1])
+            e0 = [ends[0], *(a for a, _ in knots), ends[1]]
+            e1 = [ends[0], *(b for _, b in knots), ends[1]]
+            at = [w0 * a + w1 * b for a, b in zip(e0, e1)]
+            k = min(max(bisect.bisect_right(at, dy) - 1, 0), len(at) - 2)
+            t = (dy - at[k]) / (at[k + 1] - at[k]) if at[k + 1] > at[k] else 0.0
+            shifted = [(j0, w0, e0[k] + t * (e0[k + 1] - e0[k])),
+                       (j1, w1, e1[k] + t * (e1[k + 1] - e1[k]))]
+        else:
+            shifted = [(j, wj, dy) for j, wj in for_yaw]
+        out: list[tuple[int, int, float]] = []
+        for j, wj, d in shifted:
+            for i, wi in _axis_weights(self.grid.dys, d, "dy"):
+                if wi * wj > 0.0:
+                    out.append((i, j, wi * wj))
+        out.sort(key=lambda t: -t[2])
+        return out
 
     @classmethod
     def build(cls, wheelset: Wheelset, grid: TableGrid, load: float, *, workers: int = 1,
               refine: int = 0,
               progress: Callable[[int, int], None] | None = None) -> ContactTable:
-        """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 4).
+        """Solve every node (in ``workers`` processes); the mirror halves the work (assumption 5).
 
         ``load``: the reference wheel load (N).  ``refine``: times the shift
         intervals whose nodes are inconsistent (:func:`_consistent`, any yaw)
@@ -870,7 +952,7 @@ class ContactTable:
         :class:`~fastsim_ros.geometry.errors.DerailmentError` next to a
         derailed node.
         """
-        weights = self.grid.weights(dy, yaw)
+        weights = self.weights(dy, yaw)
         nodes = [(w, self.node(i, j)) for i, j, w in weights]
         if any(n.derailed for _, n in nodes):
             raise DerailmentError(f"the wheelset derails near dy={dy:.6g} m, yaw={yaw:.6g} rad "
