@@ -91,7 +91,10 @@ def test_a_corrupt_bag_among_good_ones_is_reported_once(tmp_path, cluster):
 def test_a_killed_worker_leaves_every_output_once_and_whole(tmp_path, cluster):
     src = tmp_path / "in"
     src.mkdir()
-    for k in range(8):
+    # 24 bags: each replays in about 25 ms, so the workers stay busy long enough for the
+    # test to see both at work before the run ends, even on a loaded machine
+    bags = 24
+    for k in range(bags):
         (src / f"f{k}").symlink_to(BAGS / "flange_shift", target_is_directory=True)
     out = tmp_path / "out"
     proc = subprocess.Popen(
@@ -109,8 +112,8 @@ def test_a_killed_worker_leaves_every_output_once_and_whole(tmp_path, cluster):
     assert proc.returncode == 0, stderr
     assert "retried: replayed 2 times" in stdout
     names = sorted(p.name for p in out.iterdir())
-    assert names == sorted([f"f{k}" for k in range(8)] + [f"f{k}.csv" for k in range(8)])
-    for k in range(8):
+    assert names == sorted([f"f{k}" for k in range(bags)] + [f"f{k}.csv" for k in range(bags)])
+    for k in range(bags):
         with Reader(out / f"f{k}") as reader:
             assert sum(1 for _ in reader.messages()) == reader.message_count > 4000
         assert (out / f"f{k}.csv").read_text() == (out / "f0.csv").read_text()
