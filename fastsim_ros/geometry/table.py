@@ -563,18 +563,6 @@ class TableGrid:
         """Return every node ``(dy, yaw)``, yaw fastest."""
         return [(d, y) for d in self.dys for y in self.yaws]
 
-    def weights(self, dy: float, yaw: float) -> list[tuple[int, int, float]]:
-        """Return the bilinear weights ``(i_dy, i_yaw, w)`` of a pose, largest first."""
-        out: list[tuple[int, int, float]] = []
-        for_dy = _axis_weights(self.dys, dy, "dy")
-        for_yaw = _axis_weights(self.yaws, yaw, "yaw")
-        for i, wi in for_dy:
-            for j, wj in for_yaw:
-                if wi * wj > 0.0:
-                    out.append((i, j, wi * wj))
-        out.sort(key=lambda t: -t[2])
-        return out
-
 
 def _axis_weights(nodes: tuple[float, ...], value: float, name: str) -> list[tuple[int, float]]:
     """Return the linear weights of ``value`` on increasing ``nodes`` (refined: not uniform)."""
