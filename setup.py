@@ -33,6 +33,7 @@ setup(
         'console_scripts': [
             'fastsim_contact = fastsim_ros.cli:main',
             'fastsim_node = fastsim_ros.node:main',
+            'fastsim_lifecycle_node = fastsim_ros.node:main_lifecycle',
             'fastsim_replay = fastsim_ros.replay:main',
         ],
     },

@@ -34,6 +34,7 @@ from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterVal
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.experimental import EventsExecutor
 from rclpy.impl.implementation_singleton import rclpy_implementation as _rclpy
+from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
 from rclpy.node import Node
 from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.parameter import Parameter
@@ -54,7 +55,7 @@ from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
                                   InputTopic, Outcome, PipelineConfig, patch_topic)
-from fastsim_ros.profile_pipeline import ProfilePipeline, make_pipeline
+from fastsim_ros.profile_pipeline import AnyPipeline, ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
 _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
@@ -104,11 +105,15 @@ class StartupError(Exception):
     """A configuration the node cannot start with: reported in one line, exit 2."""
 
 
-def descriptor(spec: parameters.ParameterSpec) -> ParameterDescriptor:
-    """Return the ROS parameter descriptor of a parameter spec."""
+def descriptor(spec: parameters.ParameterSpec, *,
+               read_only: bool | None = None) -> ParameterDescriptor:
+    """Return the ROS parameter descriptor of a parameter spec.
+
+    ``read_only``: default, the start-only parameters (``not spec.dynamic``).
+    """
     d = ParameterDescriptor(type=_TYPES[spec.kind], description=spec.description,
                             additional_constraints=spec.allowed(),
-                            read_only=not spec.dynamic)
+                            read_only=(not spec.dynamic) if read_only is None else read_only)
     if spec.low is not None and spec.high is not None:
         if spec.kind == "double":
             d.floating_point_range = [FloatingPointRange(
@@ -125,30 +130,93 @@ def _qos(reliability: str, depth: int) -> QoSProfile:
                                    else ReliabilityPolicy.RELIABLE))
 
 
-class FastsimNode(Node):
-    """Creep forces for every contact patch received (INTERFACE.md)."""
+class _FrontEnd:
+    """The wiring the plain and the managed node share (a mixin of an rclpy node).
 
-    def __init__(self, **kwargs: Any) -> None:
-        super().__init__(NODE_NAME, **kwargs)
-        values = {}
+    Three steps, which the plain node takes in its constructor and the
+    managed node in its transitions: :meth:`_declare` (every parameter with
+    its descriptor), :meth:`_configure` (check the values, warm the kernels,
+    build the pipeline: profiles read and placed, a contact table loaded or
+    built) and :meth:`_open` (publishers, subscriptions, the diagnostics
+    timer); :meth:`_close` undoes :meth:`_open`.  While ``_active`` is
+    false every input is dropped and counted, and nothing is published.
+    """
+
+    pipeline: AnyPipeline
+    _active: bool = True
+    _dropped_inactive: int = 0
+    _contacts_given: bool = False
+    _warm: float = 0.0
+    _diagnostics: Publisher | None = None
+    _timer: Any = None
+
+    # --- the three steps --------------------------------------------------------------
+    def _declare(self, *, start_only_read_only: bool = True) -> None:
+        """Declare every parameter; ``contacts`` defaults to the profiles' four in that mode.
+
+        ``start_only_read_only``: start-only parameters get a read-only
+        descriptor (the plain node; a managed node re-reads them at each
+        ``configure`` and refuses their change while configured instead).
+        """
+        node: Node = self  # type: ignore[assignment]
+        # given at launch (a ROS argument or a params file): then checked as given
+        self._contacts_given = "contacts" in getattr(node, "_parameter_overrides", {})
+        source_spec = parameters.SPECS["patch_source"]
+        try:
+            source = node.declare_parameter(
+                source_spec.name, source_spec.default,
+                descriptor(source_spec, read_only=start_only_read_only)).value
+        except (InvalidParameterValueException, InvalidParameterTypeException,
+                ParameterException) as e:
+            raise StartupError(_one_line(e, source_spec)) from None
+        spec = source_spec
         try:
             for spec in parameters.PARAMETERS:
-                default = list(spec.default) if spec.kind == "string_array" else spec.default
-                value = self.declare_parameter(spec.name, default, descriptor(spec)).value
-                values[spec.name] = spec.check(value)
+                if spec is source_spec:
+                    continue
+                default: Any = spec.default
+                if spec.name == "contacts":
+                    # INTERFACE.md: in profiles mode the contacts are fixed per wheel, so
+                    # they are the default there and any other value is refused
+                    default = list(parameters.PROFILE_CONTACTS if source == "profiles"
+                                   else spec.default)
+                elif spec.kind == "string_array":
+                    default = list(spec.default)
+                node.declare_parameter(spec.name, default, descriptor(
+                    spec, read_only=start_only_read_only and not spec.dynamic))
         except (InvalidParameterValueException, InvalidParameterTypeException,
-                ParameterException, parameters.ParameterError) as e:
+                ParameterException) as e:
             raise StartupError(_one_line(e, spec)) from None
-        config = PipelineConfig.from_values(values)
+
+    def _configure(self, log: Callable[[str], None]) -> PipelineConfig:
+        """Check the declared values, warm the kernels and build the pipeline."""
+        node: Node = self  # type: ignore[assignment]
+        values = {}
+        spec = parameters.PARAMETERS[0]
+        try:
+            for spec in parameters.PARAMETERS:
+                values[spec.name] = spec.check(node.get_parameter(spec.name).value)
+            if not self._contacts_given:
+                # the mode's own contacts (profiles: fixed per wheel), not a declared default
+                del values["contacts"]
+            config = PipelineConfig.from_values(values)
+        except parameters.ParameterError as e:
+            raise StartupError(str(e)) from None
         warm = compiled.warm_up()
         start = time.perf_counter()
         patch_adapter.warm_up()
         pipeline_kernels.warm_up()
-        warm += time.perf_counter() - start
-        try:  # profiles mode reads and places its profiles here
-            self.pipeline = make_pipeline(config, log=self.get_logger().info)
+        self._warm = warm + time.perf_counter() - start
+        try:  # profiles mode reads and places its profiles here (and builds its table)
+            self.pipeline = make_pipeline(config, log=log)
         except parameters.ParameterError as e:  # a profile file or placement: one line
             raise StartupError(str(e)) from None
+        return config
+
+    def _open(self) -> None:
+        """Create the publishers, the subscriptions and the diagnostics timer."""
+        node: Node = self  # type: ignore[assignment]
+        config = self.pipeline.config
         depth = int(config["qos_depth"])
         qos_in = _qos(config["patch_reliability"], depth)
         qos_out = _qos(config["output_reliability"], depth)
@@ -159,7 +227,7 @@ class FastsimNode(Node):
         # the outputs somebody subscribes to, kept by DDS's matched events: only
         # those are encoded and published (a message to nobody is work for nothing)
         self._wanted: set[str] = set()
-        self._rejections = ThrottledLog(self.get_logger())
+        self._rejections = ThrottledLog(node.get_logger())
         outputs = {f"contact/{c}/{kind}": msgtype for c in config.contacts
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
@@ -169,26 +237,42 @@ class FastsimNode(Node):
             # replays in either mode (INTERFACE.md)
             outputs.update({patch_topic(c): PointCloud2 for c in config.contacts})
         for topic, msgtype in outputs.items():
-            self._pubs[topic] = self.create_publisher(
+            self._pubs[topic] = node.create_publisher(
                 msgtype, topic, qos_out,
                 event_callbacks=PublisherEventCallbacks(matched=self._matched(topic)))
-        self._diagnostics = self.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
+        self._diagnostics = node.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
         # the pipeline's one table of inputs: each topic raw to its handler
         for entry in self.pipeline.inputs():
-            self._subs[entry.topic] = self.create_subscription(
+            self._subs[entry.topic] = node.create_subscription(
                 message_type(entry.msgtype), entry.topic, self._input_callback(entry), qos_in,
                 raw=True)
-        self.create_timer(float(config["diagnostics_period"]), self._publish_diagnostics)
-        self.add_on_set_parameters_callback(self._on_set_parameters)
+        self._timer = node.create_timer(float(config["diagnostics_period"]),
+                                        self._publish_diagnostics)
         source = (f"patches from the profiles {config['wheel_profile']} on "
                   f"{config['rail_profile']} at each wheelset/pose"
                   if isinstance(self.pipeline, ProfilePipeline)
                   else "patches from contact/<name>/patch")
-        self.get_logger().info(
+        node.get_logger().info(
             f"{source}; solving {', '.join(config.contacts)} with {config['method']} "
             f"(mu {config['friction_coefficient']:g}, bound {config['traction_bound']}); "
-            f"kernels ready in {warm:.2f} s")
+            f"kernels ready in {self._warm:.2f} s")
 
+    def _close(self) -> None:
+        """Destroy what :meth:`_open` created (a managed node's cleanup and shutdown)."""
+        node: Node = self  # type: ignore[assignment]
+        for sub in getattr(self, "_subs", {}).values():
+            node.destroy_subscription(sub)
+        for pub in getattr(self, "_pubs", {}).values():
+            node.destroy_publisher(pub)
+        if self._diagnostics is not None:
+            node.destroy_publisher(self._diagnostics)
+            self._diagnostics = None
+        if self._timer is not None:
+            node.destroy_timer(self._timer)
+            self._timer = None
+        self._subs, self._pubs, self._wanted = {}, {}, set()
+
+    # --- what the open node does -------------------------------------------------------
     def connections(self) -> dict[str, list[tuple[str, str]]]:
         """Return each contact's matched peers as diagnostic key-values.
 
@@ -202,6 +286,8 @@ class FastsimNode(Node):
         shared += [(f"subscribers/{t}", str(p.get_subscription_count()))
                    for t, p in self._pubs.items() if not t.startswith("contact/")
                    or t == MARKERS_TOPIC]
+        if self._dropped_inactive:
+            shared.append(("dropped/inactive", str(self._dropped_inactive)))
         out: dict[str, list[tuple[str, str]]] = {}
         for c in self.pipeline.config.contacts:
             own = f"contact/{c}/"
@@ -223,13 +309,17 @@ class FastsimNode(Node):
 
     def _input_callback(self, spec: InputTopic) -> Callable[[bytes], None]:
         """Return the subscription callback of an input: its handler, then the outputs."""
+        node: Node = self  # type: ignore[assignment]
         if spec.kind in ("wheel_twist", "rail_twist"):
             on = (self.pipeline.on_wheel_twist if spec.kind == "wheel_twist"
                   else self.pipeline.on_rail_twist)
             what = "wheelset" if spec.kind == "wheel_twist" else "rail"
-            log = ThrottledLog(self.get_logger())
+            log = ThrottledLog(node.get_logger())
 
             def kinematics(raw: bytes) -> None:
+                if not self._active:
+                    self._dropped_inactive += 1
+                    return
                 verdict = on(raw)
                 if verdict != "ok" and log.due():
                     log.warning(f"{what} twist dropped: {verdict}")
@@ -237,6 +327,9 @@ class FastsimNode(Node):
         take, publish = spec.take, self._publish
 
         def callback(raw: bytes) -> None:
+            if not self._active:
+                self._dropped_inactive += 1
+                return
             for outcome in take(raw):
                 publish(outcome)
         return callback
@@ -253,10 +346,15 @@ class FastsimNode(Node):
             pubs[topic].publish(data)
 
     def _publish_diagnostics(self) -> None:
+        if not self._active or self._diagnostics is None:
+            return
+        node: Node = self  # type: ignore[assignment]
         self._diagnostics.publish(self.pipeline.diagnostics(
-            self.get_clock().now().nanoseconds, self.connections()))
+            node.get_clock().now().nanoseconds, self.connections()))
 
-    def _on_set_parameters(self, changes: list[Parameter]) -> SetParametersResult:
+    def _set_running(self, changes: list[Parameter]) -> SetParametersResult:
+        """Check and apply parameter changes to the running pipeline."""
+        node: Node = self  # type: ignore[assignment]
         values = {}
         for p in changes:
             spec = parameters.SPECS.get(p.name)
@@ -274,8 +372,109 @@ class FastsimNode(Node):
             self.pipeline.update(values)
         except parameters.ParameterError as e:
             return SetParametersResult(successful=False, reason=str(e))
-        self.get_logger().info("parameters set: " + ", ".join(
+        node.get_logger().info("parameters set: " + ", ".join(
             f"{k} = {v!r}" for k, v in values.items()))
+        return SetParametersResult(successful=True)
+
+
+class FastsimNode(_FrontEnd, Node):
+    """Creep forces for every contact patch received (INTERFACE.md)."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self._declare()
+        self._configure(log=self.get_logger().info)
+        self._open()
+        self.add_on_set_parameters_callback(self._set_running)
+
+
+class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
+    """The node as a ROS 2 managed (lifecycle) node: ``fastsim_lifecycle_node``.
+
+    Transitions (``lifecycle_msgs``' services ``~/change_state``, ``~/get_state``):
+
+    - ``configure``: check the parameters, warm the kernels, read and place
+      the profiles and load or build the contact table (its progress logged
+      with the time left); a bad value fails the transition with one line
+      naming the parameter, and the node stays ``unconfigured``;
+    - ``activate``: create the publishers and subscriptions (the first
+      time) and serve; ``deactivate``: publish nothing, every input dropped
+      and counted (``dropped/inactive`` in the diagnostics once active again);
+    - ``cleanup`` and ``shutdown``: release the topics and the pipeline.
+
+    Start-only parameters may change while ``unconfigured`` (the next
+    ``configure`` reads them); the dynamic ones at any time.
+    """
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self._active = False
+        self._configured = False
+        self._declare(start_only_read_only=False)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Check the parameters and build the pipeline (profiles, contact table)."""
+        try:
+            self._configure(log=self.get_logger().info)
+        except StartupError as e:
+            self.get_logger().error(f"configure failed: {e}")
+            return TransitionCallbackReturn.FAILURE
+        self._configured = True
+        self.get_logger().info(f"configured in {self._warm:.2f} s of kernel warm-up")
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Open the topics (the first time after configure) and serve."""
+        if not self._subs:
+            self._open()
+        if self._dropped_inactive:
+            self.get_logger().info(f"{self._dropped_inactive} inputs dropped while inactive")
+        self._active = True
+        return super().on_activate(state)
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Stop publishing; inputs are dropped and counted until the next activate."""
+        self._active = False
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Release the topics and the pipeline (back to ``unconfigured``)."""
+        self._release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Release everything (``finalized`` follows)."""
+        self._release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
+        """Release everything after an error in a transition; back to ``unconfigured``."""
+        self._release()
+        return TransitionCallbackReturn.SUCCESS
+
+    def _release(self) -> None:
+        self._active = False
+        self._close()
+        self._configured = False
+        self._dropped_inactive = 0
+        if hasattr(self, "pipeline"):
+            del self.pipeline
+
+    def _on_set_parameters(self, changes: list[Parameter]) -> SetParametersResult:
+        if self._configured:
+            return self._set_running(changes)
+        for p in changes:  # unconfigured: each value checked now, used at configure
+            spec = parameters.SPECS.get(p.name)
+            if spec is None:
+                return SetParametersResult(successful=False,
+                                           reason=f"unknown parameter {p.name!r}")
+            try:
+                spec.check(p.value)
+            except parameters.ParameterError as e:
+                return SetParametersResult(successful=False, reason=str(e))
+            if p.name == "contacts":
+                self._contacts_given = True
         return SetParametersResult(successful=True)
 
 
@@ -308,12 +507,27 @@ def make_executor(kind: str) -> Executor:
 
 def main(args: Sequence[str] | None = None) -> int:
     """Run the node until SIGINT or SIGTERM; return the exit status (2: bad parameters)."""
-    rclpy.init(args=list(args) if args is not None else None)
-    node = None
+    return _run(FastsimNode, "fastsim_node", args)
+
+
+def main_lifecycle(args: Sequence[str] | None = None) -> int:
+    """Run the managed node (unconfigured until told) until SIGINT or SIGTERM."""
+    return _run(FastsimLifecycleNode, "fastsim_lifecycle_node", args)
+
+
+def _run(make: Callable[[], Node], program: str, args: Sequence[str] | None) -> int:
+    """Build a node, spin it until a signal, always destroy it and shut down."""
+    try:
+        rclpy.init(args=list(args) if args is not None else None)
+    except _rclpy.RCLError as e:  # malformed --ros-args: rcl says why
+        print(f"{program}: {str(e).splitlines()[0]}", file=sys.stderr)
+        return 2
+    node: Node | None = None
     status = 0
     try:
-        node = FastsimNode()
-        executor = make_executor(node.pipeline.config["executor"])
+        node = make()
+        kind = node.get_parameter("executor").value  # checked at configure, else events
+        executor = make_executor(kind if kind in ("events", "single_threaded") else "events")
         executor.add_node(node)
         # everything built so far lives as long as the node: out of the cyclic
         # collector's sight, so that its full passes stay short at kHz rates
@@ -330,7 +544,7 @@ def main(args: Sequence[str] | None = None) -> int:
         if rclpy.ok():  # not a signal arriving while the node was being built
             raise
     except StartupError as e:
-        print(f"fastsim_node: {e}", file=sys.stderr)
+        print(f"{program}: {e}", file=sys.stderr)
         status = 2
     finally:
         if node is not None:

@@ -44,14 +44,14 @@ from collections import deque
 from collections.abc import Callable, Container, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Literal, Protocol
 
 import numpy as np
 
 from fastsim_ros.contact.errors import ContactError
 from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
 from fastsim_ros.geometry.placement import Placement, Pose, rotation
-from fastsim_ros.geometry.profiles import read_profile
+from fastsim_ros.geometry.profiles import Profile, read_profile
 from fastsim_ros.geometry.table import (ContactTable, TableError, TableGrid, TablePatch,
                                         TableRangeError, cached_table)
 from fastsim_ros.geometry.table import warm_up as table_warm_up
@@ -151,13 +151,21 @@ def table_contact_patch(patch: TablePatch, stamp_ns: int, *, max_cells: int) -> 
 def wheelset_of(config: PipelineConfig) -> Wheelset:
     """Read the profiles and place them; a bad file or value raises ParameterError (one line)."""
     smooth = float(config["profile_smoothing"])
+
+    def profile(name: str, kind: Literal["wheel", "rail"]) -> Profile | None:
+        if not config[name]:
+            return None
+        try:
+            return read_profile(config[name], kind=kind, smooth=smooth)
+        except ContactError as e:  # the file's problem, under the parameter that named it
+            raise ParameterError(f"parameter {name!r}: {e}") from None
+
+    wheel, rail = profile("wheel_profile", "wheel"), profile("rail_profile", "rail")
+    right_wheel = profile("right_wheel_profile", "wheel")
+    right_rail = profile("right_rail_profile", "rail")
+    if wheel is None or rail is None:
+        raise ParameterError("parameters 'wheel_profile' and 'rail_profile' must name files")
     try:
-        wheel = read_profile(config["wheel_profile"], kind="wheel", smooth=smooth)
-        rail = read_profile(config["rail_profile"], kind="rail", smooth=smooth)
-        right_wheel = (read_profile(config["right_wheel_profile"], kind="wheel", smooth=smooth)
-                       if config["right_wheel_profile"] else None)
-        right_rail = (read_profile(config["right_rail_profile"], kind="rail", smooth=smooth)
-                      if config["right_rail_profile"] else None)
         d_sep, d_comb = float(config["separation_distance"]), float(config["combination_distance"])
         if d_comb > d_sep:
             raise ParameterError(f"parameter 'combination_distance' ({d_comb:g} m) must be at "

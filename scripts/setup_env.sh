@@ -35,7 +35,7 @@ colcon build \
 site="$("$venv/bin/python" -c 'import sysconfig; print(sysconfig.get_path("purelib"))')"
 installed=(install/fastsim_ros/lib/python3.*/site-packages)
 echo "$root/${installed[0]}" > "$site/fastsim_ros_install.pth"
-for script in fastsim_node fastsim_replay fastsim_contact; do
+for script in fastsim_node fastsim_lifecycle_node fastsim_replay fastsim_contact; do
     ln -sf "$root/install/fastsim_ros/lib/fastsim_ros/$script" "$venv/bin/$script"
 done
 

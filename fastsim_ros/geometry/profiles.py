@@ -74,6 +74,10 @@ PACKAGE_ROOT = Path(__file__).resolve().parents[1]
 #: the Manchester benchmark profiles shipped with the package
 S1002 = PACKAGE_PREFIX + "data/profiles/MBench_S1002_v3.prw"
 UIC60 = PACKAGE_PREFIX + "data/profiles/MBench_UIC60_v3.prr"
+#: bare names a user types for the shipped profiles (the Manchester benchmark's are the
+#: standard S1002 wheel and UIC60 rail), looked up when no such file exists where named
+SHIPPED_NAMES = {"s1002.prw": S1002, "uic60.prr": UIC60,
+                 "mbench_s1002_v3.prw": S1002, "mbench_uic60_v3.prr": UIC60}
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,11 +113,21 @@ class Profile:
 
 
 def resolve_path(name: str | Path) -> Path:
-    """Return the file a profile name points to (``package://fastsim_ros/...`` or a path)."""
+    """Return the file a profile name points to (``package://fastsim_ros/...`` or a path).
+
+    A bare name of a shipped profile (:data:`SHIPPED_NAMES`, any case) that is
+    not a file in the working directory names the shipped file.
+    """
     text = str(name)
     if text.startswith(PACKAGE_PREFIX):
         return PACKAGE_ROOT / text[len(PACKAGE_PREFIX):]
-    return Path(text).expanduser()
+    path = Path(text).expanduser()
+    # a bare file name that is not a file here: one of the shipped profiles by its name
+    # (``S1002.prw``, ``UIC60.prr``), so that a first start needs no path into the package
+    shipped = SHIPPED_NAMES.get(text.lower()) if path.name == text else None
+    if shipped is not None and not path.exists():
+        return resolve_path(shipped)
+    return path
 
 
 def read_profile(name: str | Path, *, kind: Kind | None = None,

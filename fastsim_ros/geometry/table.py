@@ -57,6 +57,7 @@ import hashlib
 import math
 import os
 import tempfile
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -1039,6 +1040,37 @@ def table_key(wheelset: Wheelset, grid: TableGrid, load: float, refine: int = 0)
     return h.hexdigest()[:32]
 
 
+class BuildProgress:
+    """``progress(done, total)`` of a table build as log lines with the time left.
+
+    A line at most every ``period`` seconds (and at the end of each pass),
+    the time left extrapolated from the pass's own rate: the refinement's
+    passes solve fewer, costlier nodes (the flange's), so each pass starts
+    its own clock.
+    """
+
+    def __init__(self, log: Callable[[str], None], period: float = 5.0) -> None:
+        self._log = log
+        self._period = period
+        self._start = time.monotonic()
+        self._last = self._start
+        self._total = -1
+
+    def __call__(self, done: int, total: int) -> None:
+        """Log the share of the pass done and the estimate of the time left."""
+        now = time.monotonic()
+        if total != self._total or done < 1:
+            self._start, self._last, self._total = now, now, total
+        if done < total and now - self._last < self._period:
+            return
+        self._last = now
+        elapsed = now - self._start
+        left = elapsed * (total - done) / max(done, 1)
+        share = 100.0 * done / max(total, 1)
+        self._log(f"contact table: {done} of {total} nodes solved ({share:.0f}%), "
+                  f"about {left:.0f} s left in this pass")
+
+
 def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Path | None, *,
                  refine: int = 0, workers: int | None = None,
                  log: Callable[[str], None] | None = None) -> ContactTable:
@@ -1061,7 +1093,8 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
     if log:
         log(f"contact table: solving {n} nodes ({len(grid.dys)} shifts x {len(grid.yaws)} yaws) "
             f"in {workers} process(es); cached in {path}" if path else "")
-    table = ContactTable.build(wheelset, grid, load, workers=workers, refine=refine)
+    table = ContactTable.build(wheelset, grid, load, workers=workers, refine=refine,
+                               progress=BuildProgress(log) if log else None)
     if log and refine:
         log(f"contact table: {len(table.grid.dys) - len(grid.dys)} shifts added where "
             f"neighbouring nodes differed ({len(table.nodes)} nodes in all)")
@@ -1074,7 +1107,7 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
     return table
 
 
-__all__ = ["ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION", "TableError",
-           "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
+__all__ = ["BuildProgress", "ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION",
+           "TableError", "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
            "cached_table", "levelled_roll", "match", "solve_node", "table_key", "warm_up",
            "BlendPlan"]
