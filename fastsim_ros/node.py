@@ -410,6 +410,7 @@ class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
         super().__init__(NODE_NAME, **kwargs)
         self._active = False
         self._configured = False
+        self._subs, self._pubs, self._wanted = {}, {}, set()
         self._declare(start_only_read_only=False)
         self.add_on_set_parameters_callback(self._on_set_parameters)
 

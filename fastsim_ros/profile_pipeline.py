@@ -104,12 +104,16 @@ def placement_of(values: Any) -> Placement:
 
 def table_grid_of(config: PipelineConfig) -> TableGrid:
     """Return the contact table's grid from the ``table_*`` parameters (ParameterError if bad)."""
+    dy_min, dy_max = float(config["table_dy_min"]), float(config["table_dy_max"])
+    if dy_min > dy_max:
+        raise ParameterError(f"parameters 'table_dy_min' ({dy_min:g} m) and 'table_dy_max' "
+                             f"({dy_max:g} m): the smallest shift must not exceed the largest")
     try:
-        return TableGrid.regular(float(config["table_dy_min"]), float(config["table_dy_max"]),
-                                 float(config["table_dy_step"]), float(config["table_yaw_max"]),
-                                 float(config["table_yaw_step"]))
+        return TableGrid.regular(dy_min, dy_max, float(config["table_dy_step"]),
+                                 float(config["table_yaw_max"]), float(config["table_yaw_step"]))
     except TableError as e:
-        raise ParameterError(f"contact table parameters: {e}") from None
+        raise ParameterError("contact table parameters 'table_dy_min', 'table_dy_max', "
+                             f"'table_dy_step', 'table_yaw_max', 'table_yaw_step': {e}") from None
 
 
 def table_of(config: PipelineConfig, wheelset: Wheelset,

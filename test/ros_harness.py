@@ -42,6 +42,7 @@ from sensor_msgs.msg import PointCloud2
 
 PACKAGE_ROOT = Path(__file__).resolve().parents[1]
 NODE_SCRIPT = PACKAGE_ROOT / "install" / "fastsim_ros" / "lib" / "fastsim_ros" / "fastsim_node"
+LIFECYCLE_SCRIPT = NODE_SCRIPT.with_name("fastsim_lifecycle_node")
 DOMAIN_ID = str(1 + os.getpid() % 200)
 os.environ["ROS_DOMAIN_ID"] = DOMAIN_ID
 os.environ["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
@@ -65,12 +66,13 @@ class NodeProcess:
     """
 
     def __init__(self, *ros_args: str, log_dir: Path,
-                 diagnostics_period: float = DIAGNOSTICS_PERIOD) -> None:
+                 diagnostics_period: float = DIAGNOSTICS_PERIOD,
+                 script: Path = NODE_SCRIPT) -> None:
         self.log = log_dir / "node.log"
         self._out = open(self.log, "w")
         env = dict(os.environ, PYTHONUNBUFFERED="1")
         self.proc = subprocess.Popen(
-            [str(NODE_SCRIPT), "--ros-args", *ros_args,
+            [str(script), "--ros-args", *ros_args,
              "-p", f"diagnostics_period:={diagnostics_period}"],
             stdout=self._out, stderr=subprocess.STDOUT, env=env)
 

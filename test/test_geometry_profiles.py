@@ -214,3 +214,16 @@ def test_profiles_of_the_wrong_kind_are_refused(wheel, rail):
         place_rail(wheel, Placement())
     with pytest.raises(PlacementError, match="not a wheel"):
         place_wheel(rail, Placement())
+
+
+@pytest.mark.parametrize("name, shipped", [("S1002.prw", "MBench_S1002_v3.prw"),
+                                           ("uic60.prr", "MBench_UIC60_v3.prr")])
+def test_a_bare_name_of_a_shipped_profile_reads_the_shipped_file(tmp_path, monkeypatch,
+                                                                 name, shipped):
+    from fastsim_ros.geometry.profiles import PACKAGE_ROOT, resolve_path
+    monkeypatch.chdir(tmp_path)
+    assert resolve_path(name) == PACKAGE_ROOT / "data" / "profiles" / shipped
+    # a file of that name where the user is wins, and a path is never looked up elsewhere
+    (tmp_path / name).write_text("0 0\n")
+    assert resolve_path(name) == Path(name)
+    assert resolve_path("sub/" + name) == Path("sub/" + name)

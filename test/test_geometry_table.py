@@ -365,3 +365,18 @@ def test_yaw_columns_are_aligned_on_the_flanges_take_over(wheelset):
             errs.append(float(np.linalg.norm(got - exact) / np.linalg.norm(exact)))
     assert max(aligned_err) < 0.5 * max(plain_err)
     assert np.mean(aligned_err) < 0.5 * np.mean(plain_err)
+
+
+def test_build_progress_logs_the_time_left_of_each_pass(monkeypatch):
+    from fastsim_ros.geometry import table as table_module
+    clock = iter([0.0, 10.0, 20.0, 20.0, 25.0, 30.0])
+    monkeypatch.setattr(table_module.time, "monotonic", lambda: next(clock))
+    lines = []
+    progress = table_module.BuildProgress(lines.append, period=5.0)  # starts its clock at 0
+    progress(100, 400)   # 10 s for 100 of 400: 30 s left
+    progress(400, 400)   # the end of the pass is always logged: 0 s left
+    progress(5, 50)      # a refinement pass: its own clock from 20 s (too early to log)
+    progress(10, 50)     # 5 s for 10 of 50 in this pass: 20 s left
+    assert lines == ["contact table: 100 of 400 nodes solved (25%), about 30 s left in this pass",
+                     "contact table: 400 of 400 nodes solved (100%), about 0 s left in this pass",
+                     "contact table: 10 of 50 nodes solved (20%), about 20 s left in this pass"]

@@ -109,6 +109,36 @@ def test_a_pose_gives_the_command_lines_wrenches(node):
     assert cloud.header.frame_id == "wheelset" and cloud.height * cloud.width >= 4
 
 
+def test_the_first_start_needs_neither_contacts_nor_profile_paths(tmp_path):
+    # INTERFACE.md's profiles mode as a new user starts it (issue 27): no params file, the
+    # shipped profiles by their bare names, the contacts the mode's own four by default
+    expected = _cli("--wheel", "S1002.prw", "--rail", "UIC60.prr", "--dy", "5e-3",
+                    "--yaw", "12e-3", "--load", "1e4", "--speed", "2")
+    roll, dz = expected["roll"], expected["dz"]
+    proc = NodeProcess("-p", "patch_source:=profiles", "-p", "wheel_profile:=S1002.prw",
+                       "-p", "rail_profile:=UIC60.prr", "-p", "wheel_load:=1e4",
+                       log_dir=tmp_path)
+    client = Client(CONTACTS, patches=False)
+    try:
+        pose = client.publisher(PoseStamped, "wheelset/pose")
+        client.wait_connected(proc)
+        client.send_twist(_twist(T0, roll, 12e-3))
+        got = client.send_pose(pose, _pose(T0, 5e-3, dz, roll, 12e-3), CONTACTS)
+    finally:
+        client.close()
+        assert proc.stop() == 0
+    sides = set()
+    for wheel in expected["wheels"]:
+        sides.add(wheel["side"])
+        for p in wheel["patches"]:
+            (w,) = got[p["name"]]
+            f = w.wrench
+            assert (f.force.x, f.force.y, f.force.z, f.torque.z) == pytest.approx(
+                (p["Fx"], p["Fy"], p["N"], p["Mz"]), rel=1e-9), p["name"]
+    assert sides == {"left", "right"} and all(len(got[c]) == 1 for c in CONTACTS)
+    assert got["left"][0].wrench.force.z > 0 and got["right"][0].wrench.force.z > 0
+
+
 def test_a_lifted_wheelset_publishes_zero_wrenches(node):
     # no load: the pose's height as given, 1 mm above the rails
     _, client, pose, _ = node("-p", "wheel_load:=0.0")

@@ -1053,14 +1053,16 @@ class BuildProgress:
         self._log = log
         self._period = period
         self._start = time.monotonic()
-        self._last = self._start
-        self._total = -1
+        self._last = self._start  # the last line logged
+        self._called = self._start  # the last call: where a new pass's clock starts
+        self._total: int | None = None
 
     def __call__(self, done: int, total: int) -> None:
         """Log the share of the pass done and the estimate of the time left."""
         now = time.monotonic()
-        if total != self._total or done < 1:
-            self._start, self._last, self._total = now, now, total
+        if self._total is not None and total != self._total:  # the next pass began
+            self._start = self._last = self._called
+        self._total, self._called = total, now
         if done < total and now - self._last < self._period:
             return
         self._last = now
@@ -1108,6 +1110,6 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
 
 
 __all__ = ["BuildProgress", "ContactTable", "MATCH_ANGLE", "MATCH_DISTANCE", "TABLE_VERSION",
-           "TableError", "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError", "blend",
-           "cached_table", "levelled_roll", "match", "solve_node", "table_key", "warm_up",
+           "TableError", "TableGrid", "TableLookup", "TableNode", "TablePatch", "TableRangeError",
+           "blend", "cached_table", "levelled_roll", "match", "solve_node", "table_key", "warm_up",
            "BlendPlan"]

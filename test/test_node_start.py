@@ -1,0 +1,118 @@
+"""Every bad start of the installed ``fastsim_node``: one line naming the parameter, exit 2.
+
+Table-driven over :data:`fastsim_ros.params.PARAMETERS` (issue 27): each
+parameter with a value out of its range or its choices, each kind with a
+value of the wrong type, every profile parameter with a missing file and an
+unreadable one, and the combinations the table cannot state alone
+(``combination_distance`` above ``separation_distance``, a contact table
+without its reference load or with an empty shift range, explicit contacts
+in profiles mode).  The starts run two at a time (each is a process of its
+own: about half a second to the refusal), once for the whole module.
+"""
+
+from __future__ import annotations
+
+import subprocess
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+from fastsim_ros.params import PARAMETERS, ParameterSpec
+from ros_harness import NODE_SCRIPT
+
+pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
+                                reason="fastsim_node is not installed (run colcon build)")
+
+PROFILES = ["-p", "patch_source:=profiles"]
+#: a file that is no profile: bytes that are not text
+GARBAGE = Path("/tmp") / "fastsim_test_node_start_garbage.prw"
+
+
+def _value_out_of(spec: ParameterSpec) -> str | None:
+    """Return a ROS argument value outside ``spec``'s range or choices (None: it has none)."""
+    if spec.choices:
+        return "no_such_choice"
+    if spec.low is None or spec.high is None:
+        return None
+    if spec.kind == "integer":
+        return str(int(spec.high) + 1)
+    return repr(float(spec.high) * 10.0 + 1.0)
+
+
+def _cases() -> list[tuple[str, str, list[str]]]:
+    """Return (id, the parameter the line must name, ROS arguments) for every bad start."""
+    cases = []
+    for spec in PARAMETERS:
+        bad = _value_out_of(spec)
+        if bad is not None:
+            cases.append((f"{spec.name}-range", spec.name, ["-p", f"{spec.name}:={bad}"]))
+    wrong_type = {"double": "'a word'", "integer": "2.5", "bool": "'maybe'",
+                  "string": "[1, 2]", "string_array": "3"}
+    for kind, bad in wrong_type.items():
+        spec = next(s for s in PARAMETERS if s.kind == kind)
+        cases.append((f"{spec.name}-type", spec.name, ["-p", f"{spec.name}:={bad}"]))
+    cases.append(("wheelset_frame-empty", "wheelset_frame", ["-p", "wheelset_frame:=''"]))
+    cases.append(("contacts-duplicate", "contacts", ["-p", 'contacts:=["left", "left"]']))
+    cases.append(("contacts-bad-name", "contacts", ["-p", 'contacts:=["left", "9x"]']))
+    for name in ("wheel_profile", "rail_profile", "right_wheel_profile", "right_rail_profile"):
+        suffix = ".prw" if "wheel" in name else ".prr"
+        cases.append((f"{name}-missing", name,
+                      PROFILES + ["-p", f"{name}:=/nonexistent/profile{suffix}"]))
+        cases.append((f"{name}-unreadable", name,
+                      PROFILES + ["-p", f"{name}:={GARBAGE.with_suffix(suffix)}"]))
+    cases += [
+        ("combination-above-separation", "combination_distance",
+         PROFILES + ["-p", "separation_distance:=0.002", "-p", "combination_distance:=0.004"]),
+        ("table-without-load", "wheel_load",
+         PROFILES + ["-p", "profile_table:=true", "-p", "wheel_load:=0.0"]),
+        ("table-step-not-dividing", "table_dy_step",
+         PROFILES + ["-p", "profile_table:=true", "-p", "wheel_load:=1e4",
+                     "-p", "table_dy_step:=0.007"]),
+        ("table-empty-range", "table_dy_min",
+         PROFILES + ["-p", "profile_table:=true", "-p", "wheel_load:=1e4",
+                     "-p", "table_dy_min:=0.01", "-p", "table_dy_max:=-0.01"]),
+        ("profiles-explicit-contacts", "contacts",
+         PROFILES + ["-p", 'contacts:=["left", "right"]']),
+        ("unknown-executor", "executor", ["-p", "executor:=threads"]),
+    ]
+    return cases
+
+
+CASES = _cases()
+
+
+@pytest.fixture(scope="module")
+def refusals() -> dict[str, subprocess.CompletedProcess[str]]:
+    """Start the node once per case, two at a time; return each case's process."""
+    for suffix in (".prw", ".prr"):
+        GARBAGE.with_suffix(suffix).write_bytes(bytes(range(256)) * 8)
+
+    def start(case: tuple[str, str, list[str]]) -> subprocess.CompletedProcess[str]:
+        return subprocess.run([str(NODE_SCRIPT), "--ros-args", *case[2]],
+                              capture_output=True, text=True, timeout=120)
+    try:
+        with ThreadPoolExecutor(2) as pool:
+            done = list(pool.map(start, CASES))
+    finally:
+        for suffix in (".prw", ".prr"):
+            GARBAGE.with_suffix(suffix).unlink(missing_ok=True)
+    return {case[0]: proc for case, proc in zip(CASES, done)}
+
+
+def test_every_parameter_has_a_bad_start_here():
+    named = {name for _, name, _ in CASES}
+    ranged = {s.name for s in PARAMETERS if _value_out_of(s) is not None}
+    # every parameter with a range or choices, and every kind, is refused at least once
+    assert ranged <= named
+    assert {s.kind for s in PARAMETERS} <= {s.kind for s in PARAMETERS if s.name in named}
+
+
+@pytest.mark.parametrize("case, name, args", CASES, ids=[c[0] for c in CASES])
+def test_a_bad_start_is_one_line_naming_the_parameter_exit_2(refusals, case, name, args):
+    done = refusals[case]
+    assert done.returncode == 2, done.stderr
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("fastsim_node: ") and name in lines[0], lines[0]
+    assert "Traceback" not in done.stderr and done.stdout == ""
