@@ -1,14 +1,17 @@
 """MCAP (rosbag2's storage) read and written by the chunk, not by the message.
 
 The format is the official ``mcap`` library's (https://mcap.dev/spec): the
-summary, the chunk records and their decompression come from
-:mod:`mcap.reader` and :mod:`mcap.stream_reader`, and every record written
-(header, schemas, channels, chunks, message indexes, chunk indexes,
-metadata, statistics, summary offsets, footer) is a :mod:`mcap.records`
-record.  What the library does one message at a time is done here in bulk:
-the message records of a decompressed chunk are found with one compiled
-pass (:mod:`~fastsim_ros.replay.kernels`), and the records and message
-indexes of the node's outputs are built from arrays.
+summary comes from :mod:`mcap.reader`, the chunk records are parsed by
+:mod:`mcap.records` (and, but for zstd, decompressed by
+:mod:`mcap.stream_reader`), and every record written (header, schemas,
+channels, chunks, message indexes, chunk indexes, metadata, statistics,
+summary offsets, footer) is a :mod:`mcap.records` record.  What the library
+does one message at a time is done here in bulk: the message records of a
+decompressed chunk are found with one compiled pass
+(:mod:`~fastsim_ros.replay.kernels`), and the records and message indexes
+of the node's outputs are built from arrays.  zstd chunks are decompressed
+with one context per thread, kept (the library makes one per chunk: about
+a third slower on the bundled bags' 1 MiB chunks).
 
 The replay reads an input's chunks, decompresses each once and yields its
 messages in the order ``rosbags`` gives them (log time; ties by the chunk's
