@@ -5,6 +5,7 @@ Usage (from the package root)::
 
     .venv/bin/python benchmarks/bench_replay.py [--repeats R] [--copies K] [--bags NAME ...]
     .venv/bin/python benchmarks/bench_replay.py --scheduler [--small N]
+    .venv/bin/python benchmarks/bench_replay.py --mcap-only [--rounds N] [--mcap-before REV]
 
 Prints, with the machine line:
 
@@ -27,7 +28,13 @@ Prints, with the machine line:
    of the wall time and microseconds per input message;
 3. many bags: ``K`` copies of each bag that uses the default contacts,
    replayed through ``fastsim_replay.main`` with ``--jobs 1`` and
-   ``--jobs 2``: patches per second and the speed-up.
+   ``--jobs 2``: patches per second and the speed-up;
+4. the MCAP layer before and after issue 30, side by side in this run:
+   the batched replay of each bag with the hand-written MCAP module of
+   ``--mcap-before`` (its ``fastsim_ros/replay/mcap.py``, loaded from git)
+   and with today's (the ``mcap`` library's records and reader), in
+   alternating order, ``--rounds`` times each: median patches per second
+   and the ratio (``--mcap-only``: this section alone).
 
 With ``--scheduler``, instead: ``N`` small bags (generated: the first
 0.5 s of ``hertz_ramp``, 200 by default) replayed by two local worker
@@ -45,8 +52,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib.util
 import io
 import os
+import subprocess
 import sys
 import tempfile
 import time
@@ -75,6 +84,8 @@ NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_
 SAME_CONTACTS = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
 PHASES = ("read", "copy", "decode", "kinematics", "solve", "state", "encode", "write",
           "diagnostics")
+#: the last commit whose fastsim_ros/replay/mcap.py wrote and parsed MCAP by hand
+MCAP_BEFORE = "ddc07d7"
 SOLVERS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
            "fastsim_ellipse": EquivalentEllipseSolver}
 
@@ -164,6 +175,59 @@ def many_bags(copies: int, jobs: int, out: Path) -> tuple[float, int, float]:
     return wall, patches, log_s
 
 
+def mcap_module(rev: str) -> Any:
+    """Return ``fastsim_ros/replay/mcap.py`` of git revision ``rev`` as a module."""
+    text = subprocess.run(["git", "-C", str(ROOT), "show", f"{rev}:fastsim_ros/replay/mcap.py"],
+                          check=True, capture_output=True, text=True).stdout
+    name = "fastsim_ros.replay.mcap_before"
+    spec = importlib.util.spec_from_loader(name, loader=None)
+    assert spec is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module      # dataclasses look their module up
+    exec(compile(text, f"{rev}:fastsim_ros/replay/mcap.py", "exec"), module.__dict__)
+    return module
+
+
+def mcap_layers(names: list[str], rounds: int, out: Path, rev: str) -> None:
+    """Print section 4: the batched replay with the MCAP module of ``rev`` and today's."""
+    from fastsim_ros.replay import bulk
+    now = bulk.mcap
+    layers = {f"before ({rev}, by hand)": mcap_module(rev), "now (mcap library)": now}
+    rates: dict[str, dict[str, list[float]]] = {k: {n: [] for n in names} for k in layers}
+    walls: dict[str, list[float]] = {k: [] for k in layers}
+    print(f"4. the MCAP layer: median of {rounds} alternating replays of each bag, "
+          f"patches/s (whole replay, batched path)")
+    try:
+        for k in range(rounds):
+            order = list(layers) if k % 2 == 0 else list(layers)[::-1]
+            for layer in order:
+                bulk.mcap = layers[layer]   # type: ignore[assignment]
+                total = 0.0
+                for name in names:
+                    values = load_params_file(BAGS / f"{name}.params.yaml")
+                    r = replay.replay_bag(BAGS / name, f"{name}_mcap{k}_{order.index(layer)}",
+                                          out, values, progress=False, path="auto")
+                    if not r.ok:
+                        raise SystemExit(f"replay of {name} ({layer}) failed: {r.error}")
+                    rates[layer][name].append(patches_of(name) / r.wall_s)
+                    total += r.wall_s
+                walls[layer].append(total)
+    finally:
+        bulk.mcap = now
+    patches = sum(patches_of(n) for n in names)
+    heads = list(layers)
+    print(f"{'bag':20s} {heads[0]:>26s} {heads[1]:>20s} {'now/before':>10s}")
+    for name in names + ["all, in turn"]:
+        if name in rates[heads[0]]:
+            a, b = (float(np.median(rates[h][name])) for h in heads)
+        else:
+            a, b = (patches / float(np.median(walls[h])) for h in heads)
+        print(f"{name:20s} {a:26.0f} {b:20.0f} {b / a:10.2f}")
+    print(f"  (ranges, all in turn: before {patches / max(walls[heads[0]]):.0f}-"
+          f"{patches / min(walls[heads[0]]):.0f}, now {patches / max(walls[heads[1]]):.0f}-"
+          f"{patches / min(walls[heads[1]]):.0f} patches/s)")
+
+
 def _spin(n: int) -> int:
     total = 0
     for k in range(n):
@@ -203,7 +267,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="small bags on a local Dask cluster (two workers) against --jobs 2")
     ap.add_argument("--small", type=int, default=200, help="small bags for --scheduler")
     ap.add_argument("--rounds", type=int, default=3,
-                    help="alternating timed runs of each executor (--scheduler, the many bags)")
+                    help="alternating timed runs of each executor (--scheduler, the many bags, "
+                    "the MCAP layers: at least 5 there)")
+    ap.add_argument("--mcap-only", action="store_true",
+                    help="section 4 alone: the MCAP module of --mcap-before against today's")
+    ap.add_argument("--mcap-before", default=MCAP_BEFORE,
+                    help="git revision of the hand-written MCAP module (default %(default)s)")
     args = ap.parse_args(argv)
     if args.scheduler:
         return cluster_main(args.small, args.rounds)
@@ -216,6 +285,13 @@ def main(argv: list[str] | None = None) -> int:
 
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
+        mcap_rounds = max(5, args.rounds)
+        if args.mcap_only:
+            for name in args.bags:  # one untimed replay each: first-call costs out of the figures
+                one_bag(name, 1, out, "auto", "_warm")
+            mcap_layers(list(args.bags), mcap_rounds, out, args.mcap_before)
+            print(f"\nmachine: {machine()}")
+            return 0
         for name in args.bags:  # one untimed replay each: first-call costs out of the figures
             one_bag(name, 1, out, "auto", "_warm")
         results = {name: one_bag(name, args.repeats, out, "auto") for name in args.bags}
@@ -274,7 +350,8 @@ def main(argv: list[str] | None = None) -> int:
                   f" s): {patches / wall:.0f} patches/s, {log_s / wall:.1f}x real time")
         print(f"  speed-up --jobs 2 / --jobs 1: {min(walls[1]) / min(walls[2]):.2f}x (best of "
               f"each); the machine's own, two processes of pure Python against one in turn: "
-              f"{parallel_capacity():.2f}x")
+              f"{parallel_capacity():.2f}x\n")
+        mcap_layers(list(args.bags), mcap_rounds, out, args.mcap_before)
     print(f"\nmachine: {machine()}")
     return 0
 

@@ -1,14 +1,23 @@
 """MCAP (rosbag2's storage) read and written by the chunk, not by the message.
 
-The replay reads an input's chunks, decompresses each once and finds its
-message records with one compiled pass (:mod:`~fastsim_ros.replay.kernels`),
-and yields them in the order ``rosbags`` gives them (log time; ties by the
-chunk's place in the file, then by place in the chunk) in windows of bounded
-size.  It writes an output whose copied inputs are the input's own chunks,
-byte for byte (no second compression), beside chunks of the new messages,
-which are built in bulk.  The MCAP format: https://mcap.dev/spec (records:
-opcode u8, length u64, fields little-endian; strings and byte arrays with a
-u32 length; maps with a u32 byte length).
+The format is the official ``mcap`` library's (https://mcap.dev/spec): the
+summary comes from :mod:`mcap.reader`, the chunk records are parsed by
+:mod:`mcap.records` (and, but for zstd, decompressed by
+:mod:`mcap.stream_reader`), and every record written (header, schemas,
+channels, chunks, message indexes, chunk indexes, metadata, statistics,
+summary offsets, footer) is a :mod:`mcap.records` record.  What the library
+does one message at a time is done here in bulk: the message records of a
+decompressed chunk are found with one compiled pass
+(:mod:`~fastsim_ros.replay.kernels`), and the records and message indexes
+of the node's outputs are built from arrays.  zstd chunks are decompressed
+with one context per thread, kept (the library makes one per chunk: about
+a third slower on the bundled bags' 1 MiB chunks).
+
+The replay reads an input's chunks, decompresses each once and yields its
+messages in the order ``rosbags`` gives them (log time; ties by the chunk's
+place in the file, then by place in the chunk) in windows of bounded size.
+It writes an output whose copied inputs are the input's own chunks, byte
+for byte (no second compression), beside chunks of the new messages.
 
 Only what rosbag2 and rosbags write is needed: an indexed file (a summary
 with schemas, channels and chunk indexes) with every message in a chunk.
@@ -18,11 +27,11 @@ reads it with ``rosbags`` instead.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import re
 import struct
-import sys
 import threading
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -32,25 +41,24 @@ from zlib import crc32
 
 import numpy as np
 import zstandard
+from mcap import records as rec
+from mcap.data_stream import ReadDataStream, RecordBuilder
+from mcap.exceptions import McapError as LibraryError
+from mcap.opcode import Opcode
+from mcap.reader import SeekingReader
+from mcap.stream_reader import CRCValidationError, get_chunk_data_stream
+from mcap.writer import MCAP0_MAGIC
 from numpy.typing import NDArray
 
 from fastsim_ros.replay import kernels
 
-if sys.version_info >= (3, 14):
-    from compression import zstd
-else:  # the backport rosbags depends on
-    from backports import zstd
-
-MAGIC = b"\x89MCAP0\r\n"
-OP_HEADER, OP_FOOTER, OP_SCHEMA, OP_CHANNEL, OP_MESSAGE, OP_CHUNK = 0x01, 0x02, 0x03, 0x04, \
-    0x05, 0x06
-OP_MESSAGE_INDEX, OP_CHUNK_INDEX, OP_STATISTICS, OP_METADATA = 0x07, 0x08, 0x0B, 0x0C
-OP_METADATA_INDEX, OP_SUMMARY_OFFSET, OP_DATA_END = 0x0D, 0x0E, 0x0F
+MAGIC = MCAP0_MAGIC
 #: uncompressed bytes of new messages after which a chunk is written (rosbags: 1 MiB)
 CHUNK_BYTES = 1 << 20
-
-_U16, _U32, _U64 = struct.Struct("<H"), struct.Struct("<I"), struct.Struct("<Q")
-_CHUNK_HEAD = struct.Struct("<QQQI")     # start, end, uncompressed size, crc
+#: bytes of the footer record and the closing magic at the end of every MCAP file
+_TAIL = 9 + 20 + 8
+#: what a file's bytes or the library's parsers raise on a malformed file
+_MALFORMED = (LibraryError, ValueError, struct.error, EOFError)
 
 
 class McapError(Exception):
@@ -66,16 +74,26 @@ class Schema:
     encoding: str
     data: bytes
 
+    def record(self) -> rec.Schema:
+        """Return it as the library's record."""
+        return rec.Schema(id=self.id, name=self.name, encoding=self.encoding, data=self.data)
+
 
 @dataclass(frozen=True)
 class Channel:
-    """A channel record: ``id``, ``schema_id``, ``topic``, encoding, metadata (raw map)."""
+    """A channel record: ``id``, ``schema_id``, ``topic``, encoding, metadata."""
 
     id: int
     schema_id: int
     topic: str
     message_encoding: str
-    metadata: bytes
+    metadata: dict[str, str]
+
+    def record(self) -> rec.Channel:
+        """Return it as the library's record."""
+        return rec.Channel(id=self.id, schema_id=self.schema_id, topic=self.topic,
+                           message_encoding=self.message_encoding,
+                           metadata=dict(self.metadata))
 
 
 @dataclass(frozen=True)
@@ -92,55 +110,73 @@ class ChunkIndex:
     compressed_size: int
     uncompressed_size: int
 
+    @staticmethod
+    def of(r: rec.ChunkIndex) -> ChunkIndex:
+        """Return the library's chunk index record in this form."""
+        return ChunkIndex(int(r.message_start_time), int(r.message_end_time),
+                          int(r.chunk_start_offset), int(r.chunk_length),
+                          {int(c): int(o) for c, o in r.message_index_offsets.items()},
+                          int(r.message_index_length), str(r.compression),
+                          int(r.compressed_size), int(r.uncompressed_size))
 
-class _Fields:
-    """A cursor over one record's fields."""
-
-    __slots__ = ("data", "pos")
-
-    def __init__(self, data: bytes) -> None:
-        self.data = data
-        self.pos = 0
-
-    def take(self, size: int) -> bytes:
-        end = self.pos + size
-        if end > len(self.data):
-            raise McapError("a record ends inside a field")
-        out = self.data[self.pos:end]
-        self.pos = end
-        return out
-
-    def u16(self) -> int:
-        return int(_U16.unpack(self.take(2))[0])
-
-    def u32(self) -> int:
-        return int(_U32.unpack(self.take(4))[0])
-
-    def u64(self) -> int:
-        return int(_U64.unpack(self.take(8))[0])
-
-    def string(self) -> str:
-        try:
-            return self.take(self.u32()).decode("utf-8")
-        except UnicodeDecodeError:
-            raise McapError("a string that is not UTF-8") from None
-
-    def sized(self) -> bytes:
-        return self.take(self.u32())
+    def record(self) -> rec.ChunkIndex:
+        """Return it as the library's record."""
+        return rec.ChunkIndex(
+            message_start_time=self.start_time, message_end_time=self.end_time,
+            chunk_start_offset=self.offset, chunk_length=self.length,
+            message_index_offsets=dict(self.index_offsets),
+            message_index_length=self.index_length, compression=self.compression,
+            compressed_size=self.compressed_size, uncompressed_size=self.uncompressed_size)
 
 
-def _read_record(f: BinaryIO) -> tuple[int, bytes]:
-    head = f.read(9)
-    if len(head) != 9:
-        raise McapError("truncated record")
-    op, size = head[0], int(_U64.unpack_from(head, 1)[0])
-    data = f.read(size)
-    if len(data) != size:
-        raise McapError("truncated record")
-    return op, data
+def metadata_map(entries: dict[str, str]) -> dict[str, str]:
+    """Return a channel's metadata (an MCAP ``map<string, string>``)."""
+    return dict(entries)
 
 
 # ------------------------------------------------------------------------ reading
+
+_THREAD = threading.local()
+
+
+def _zstd(data: bytes, size: int) -> bytes:
+    """Decompress a zstd chunk of ``size`` bytes into one buffer of that size.
+
+    One decompression context per thread (a Dask worker may run tasks in
+    several), kept between chunks.
+    """
+    context = getattr(_THREAD, "zstd", None)
+    if context is None:
+        context = _THREAD.zstd = zstandard.ZstdDecompressor()
+    out: bytes = context.decompress(data, max_output_size=size)
+    return out
+
+
+#: chunk compressions the library decompresses ("": none)
+_COMPRESSIONS = ("", "zstd", "lz4")
+
+
+def _chunk_records(chunk: rec.Chunk, offset: int) -> bytes:
+    """Return the decompressed records of a chunk, its size and checksum checked."""
+    if chunk.compression not in _COMPRESSIONS:
+        raise McapError(f"chunk compression {chunk.compression!r} is not supported")
+    try:
+        if chunk.compression == "zstd":
+            records = _zstd(chunk.data, chunk.uncompressed_size)
+            if chunk.uncompressed_crc and crc32(records) != chunk.uncompressed_crc:
+                raise CRCValidationError(chunk.uncompressed_crc, crc32(records), chunk)
+        else:
+            stream, size = get_chunk_data_stream(chunk, validate_crc=True)
+            records = stream.read(size)   # the stream's own buffer (read whole: no copy)
+    except CRCValidationError:
+        raise McapError(f"chunk at byte {offset}: checksum mismatch") from None
+    except Exception as e:  # the decompressors' own errors: a corrupt chunk
+        raise McapError(f"a chunk does not decompress ({type(e).__name__}: {e})") from None
+    if len(records) != chunk.uncompressed_size:
+        raise McapError(f"chunk at byte {offset}: {len(records)} bytes "
+                        f"decompressed, {chunk.uncompressed_size} expected")
+    return records
+
 
 @dataclass
 class IndexedMcap:
@@ -165,51 +201,20 @@ class IndexedMcap:
         f = self.file
         f.seek(chunk.offset)
         raw = f.read(chunk.length + chunk.index_length)
-        if len(raw) != chunk.length + chunk.index_length or raw[0] != OP_CHUNK:
+        if len(raw) != chunk.length + chunk.index_length or raw[0] != Opcode.CHUNK:
             raise McapError(f"no chunk at byte {chunk.offset}")
-        size = int(_U64.unpack_from(raw, 1)[0])
+        size = int.from_bytes(raw[1:9], "little")
         if 9 + size != chunk.length:
             raise McapError(f"the chunk at byte {chunk.offset} is not as long as its index says")
-        fields = _Fields(raw[9:9 + size])
-        start, end, uncompressed, crc = _CHUNK_HEAD.unpack(fields.take(28))
-        compression = fields.string()
-        compressed = fields.take(fields.u64())
-        records = _decompress(compressed, compression, uncompressed)
-        if len(records) != uncompressed:
-            raise McapError(f"chunk at byte {chunk.offset}: {len(records)} bytes "
-                            f"decompressed, {uncompressed} expected")
-        if crc and crc32(records) != crc:
-            raise McapError(f"chunk at byte {chunk.offset}: checksum mismatch")
-        return raw, records
-
-
-_THREAD = threading.local()
-
-
-def _zstd(data: bytes, size: int) -> bytes:
-    """Decompress a zstd chunk of ``size`` bytes into one buffer of that size.
-
-    (rosbags' decompressor grows its output block by block and joins the
-    blocks: a second copy of every chunk.)  One decompression context per
-    thread: a Dask worker may run tasks in several.
-    """
-    context = getattr(_THREAD, "zstd", None)
-    if context is None:
-        context = _THREAD.zstd = zstandard.ZstdDecompressor()
-    out: bytes = context.decompress(data, max_output_size=size)
-    return out
-
-
-def _decompress(data: bytes, compression: str, size: int) -> bytes:
-    from rosbags.rosbag2.storage_mcap import DECOMPRESSORS  # lz4, none: rosbags' own
-    decompress = _zstd if compression == "zstd" else DECOMPRESSORS.get(compression)
-    if decompress is None:
-        raise McapError(f"chunk compression {compression!r} is not supported")
-    try:
-        out = decompress(data, size)
-        return out if isinstance(out, bytes) else bytes(out)
-    except Exception as e:  # the decompressors' own errors: a corrupt chunk
-        raise McapError(f"a chunk does not decompress ({type(e).__name__}: {e})") from None
+        stream = ReadDataStream(io.BytesIO(raw))
+        stream.read(9)
+        try:
+            record = rec.Chunk.read(stream)
+        except _MALFORMED:
+            record = None
+        if record is None or stream.count > chunk.length:
+            raise McapError(f"the chunk at byte {chunk.offset} ends inside a field")
+        return raw, _chunk_records(record, chunk.offset)
 
 
 def open_indexed(path: Path) -> IndexedMcap | None:
@@ -220,46 +225,30 @@ def open_indexed(path: Path) -> IndexedMcap | None:
     """
     f = open(path, "rb")
     try:
+        size = os.fstat(f.fileno()).st_size
         if f.read(8) != MAGIC:
             raise McapError("not an MCAP file (magic)")
-        size = os.fstat(f.fileno()).st_size
-        if size < 8 + 9 + 29 + 8:
+        if size < 8 + 9 + _TAIL:
             raise McapError("too short for an MCAP file")
-        f.seek(size - 37)
-        footer = f.read(37)
-        if footer[-8:] != MAGIC or footer[0] != OP_FOOTER:
+        f.seek(size - 8)
+        if f.read(8) != MAGIC:
             raise McapError("no MCAP footer")
-        summary_start = int(_U64.unpack_from(footer, 9)[0])
-        if summary_start == 0:
+        f.seek(0)
+        try:
+            summary = SeekingReader(f, record_size_limit=size).get_summary()
+        except _MALFORMED as e:
+            raise McapError(f"malformed summary ({type(e).__name__}: {e})") from None
+        if summary is None:
             f.close()
             return None
-        if not 8 < summary_start < size - 37:
-            raise McapError("summary offset outside the file")
-        f.seek(summary_start)
-        schemas: dict[int, Schema] = {}
-        channels: dict[int, Channel] = {}
-        chunks: list[ChunkIndex] = []
-        while f.tell() < size - 37:
-            op, data = _read_record(f)
-            r = _Fields(data)
-            if op == OP_SCHEMA:
-                sid = r.u16()
-                schemas[sid] = Schema(sid, r.string(), r.string(), r.sized())
-            elif op == OP_CHANNEL:
-                cid = r.u16()
-                channels[cid] = Channel(cid, r.u16(), r.string(), r.string(), r.sized())
-            elif op == OP_CHUNK_INDEX:
-                start, end, offset, length = (r.u64() for _ in range(4))
-                index = r.sized()
-                if len(index) % 10:
-                    raise McapError("malformed chunk index")
-                offsets = {int(c): int(o) for c, o in struct.iter_unpack("<HQ", index)}
-                chunks.append(ChunkIndex(start, end, offset, length, offsets, r.u64(),
-                                         r.string(), r.u64(), r.u64()))
-            elif op in (OP_SUMMARY_OFFSET, OP_FOOTER):
-                break
+        schemas = {int(s.id): Schema(int(s.id), str(s.name), str(s.encoding), bytes(s.data))
+                   for s in summary.schemas.values()}
+        channels = {int(c.id): Channel(int(c.id), int(c.schema_id), str(c.topic),
+                                       str(c.message_encoding), dict(c.metadata))
+                    for c in summary.channels.values()}
+        chunks = [ChunkIndex.of(c) for c in summary.chunk_indexes]
         for c in chunks:
-            if not 8 <= c.offset < summary_start or c.offset + c.length > summary_start:
+            if not 8 <= c.offset or c.offset + c.length + c.index_length > size - _TAIL:
                 raise McapError(f"a chunk index points outside the data (byte {c.offset})")
         if not chunks and not channels:
             f.close()
@@ -410,31 +399,20 @@ def _flat(loaded: list[_Loaded], which: NDArray[np.int64],
 
 # ------------------------------------------------------------------------ writing
 
-def _string(text: str) -> bytes:
-    data = text.encode("utf-8")
-    return _U32.pack(len(data)) + data
+class _MessageIndex(rec.MessageIndex):
+    """A message index record whose ``(log time, offset)`` entries are one array."""
 
+    def __init__(self, channel_id: int, entries: NDArray[Any]) -> None:
+        super().__init__(channel_id=channel_id, records=[])
+        self.entries = entries       # (k, 2) little-endian u64
 
-def _record(op: int, body: bytes) -> bytes:
-    return bytes((op,)) + _U64.pack(len(body)) + body
-
-
-def schema_record(schema: Schema) -> bytes:
-    """Return the bytes of a schema record."""
-    return _record(OP_SCHEMA, _U16.pack(schema.id) + _string(schema.name)
-                   + _string(schema.encoding) + _U32.pack(len(schema.data)) + schema.data)
-
-
-def channel_record(channel: Channel) -> bytes:
-    """Return the bytes of a channel record."""
-    return _record(OP_CHANNEL, _U16.pack(channel.id) + _U16.pack(channel.schema_id)
-                   + _string(channel.topic) + _string(channel.message_encoding)
-                   + _U32.pack(len(channel.metadata)) + channel.metadata)
-
-
-def metadata_map(entries: dict[str, str]) -> bytes:
-    """Return an MCAP ``map<string, string>`` body (without its byte length)."""
-    return b"".join(_string(k) + _string(v) for k, v in entries.items())
+    def write(self, stream: RecordBuilder) -> None:
+        """Write the record, its entries in one piece (the library's: one by one)."""
+        stream.start_record(Opcode.MESSAGE_INDEX)
+        stream.write2(self.channel_id)
+        stream.write4(self.entries.nbytes)
+        stream.write(self.entries.tobytes())
+        stream.finish_record()
 
 
 @dataclass
@@ -458,13 +436,15 @@ class McapWriter:
     byte for byte), :meth:`write` (one message) and :meth:`write_records`
     (message records built in bulk); :meth:`close` writes the summary
     (schemas, channels, chunk indexes, statistics, the rosbag2 metadata)
-    and the footer.
+    and the footer.  Every record is the ``mcap`` library's.
     """
 
     def __init__(self, path: Path, *, library: str = "fastsim_replay") -> None:
         self.path = path
         self.file: BinaryIO = open(path, "xb")
-        self.file.write(MAGIC + _record(OP_HEADER, _string("ros2") + _string(library)))
+        self._builder = RecordBuilder()
+        self.file.write(MAGIC)
+        self._put(rec.Header(profile="ros2", library=library))
         self.schemas: dict[int, Schema] = {}
         self.channels: dict[int, Channel] = {}
         self.chunks: list[ChunkIndex] = []
@@ -472,18 +452,24 @@ class McapWriter:
         self.start = (1 << 63) - 1
         self.end = 0
         self._pending = _Pending()
-        self._sequence = 0
+
+    def _put(self, record: rec.McapRecord) -> int:
+        """Write one record at the end of the file; return its length (bytes)."""
+        record.write(self._builder)
+        data = self._builder.end()
+        self.file.write(data)
+        return len(data)
 
     def add_schema(self, schema: Schema) -> None:
         """Declare a schema (its id unique in the file)."""
         self.schemas[schema.id] = schema
-        self.file.write(schema_record(schema))
+        self._put(schema.record())
 
     def add_channel(self, channel: Channel) -> None:
         """Declare a channel (its id unique in the file, its schema declared)."""
         self.channels[channel.id] = channel
         self.counts.setdefault(channel.id, 0)
-        self.file.write(channel_record(channel))
+        self._put(channel.record())
 
     def copy_chunk(self, chunk: ChunkIndex, raw: bytes, counts: dict[int, int]) -> None:
         """Copy an input's chunk record and its message indexes (``raw``) as they are.
@@ -506,9 +492,9 @@ class McapWriter:
 
     def write(self, channel: int, log_time: int, data: bytes | bytearray | memoryview) -> None:
         """Add one message (log time ns) to the pending chunk."""
-        head = struct.pack("<BQHIQQ", OP_MESSAGE, 22 + len(data), channel, 0, log_time,
-                           log_time)
-        self.write_records(head + bytes(data), np.array([channel], dtype=np.int64),
+        rec.Message(channel_id=channel, sequence=0, log_time=log_time, publish_time=log_time,
+                    data=bytes(data)).write(self._builder)
+        self.write_records(self._builder.end(), np.array([channel], dtype=np.int64),
                            np.array([log_time], dtype=np.int64),
                            np.array([0], dtype=np.int64))
 
@@ -540,22 +526,19 @@ class McapWriter:
         if p.size == 0 or (p.size < limit and limit > 0):
             return
         records = b"".join(p.parts)
-        compressed = zstd.compress(records)
-        body = (_CHUNK_HEAD.pack(p.start, p.end, len(records), 0) + _string("zstd")
-                + _U64.pack(len(compressed)) + compressed)
+        compressed = zstandard.compress(records)
         offset = self.file.tell()
-        self.file.write(_record(OP_CHUNK, body))
-        length = self.file.tell() - offset
+        length = self._put(rec.Chunk(
+            compression="zstd", data=compressed, message_start_time=p.start,
+            message_end_time=p.end, uncompressed_crc=crc32(records),
+            uncompressed_size=len(records)))
         index_offsets = {}
         for c, pieces in sorted(p.index.items()):
-            times = np.concatenate([t for t, _ in pieces])
-            offsets = np.concatenate([o for _, o in pieces])
-            pairs = np.empty((times.size, 2), dtype="<u8")
-            pairs[:, 0] = times
-            pairs[:, 1] = offsets
+            entries = np.empty((sum(t.size for t, _ in pieces), 2), dtype="<u8")
+            entries[:, 0] = np.concatenate([t for t, _ in pieces])
+            entries[:, 1] = np.concatenate([o for _, o in pieces])
             index_offsets[c] = self.file.tell()
-            self.file.write(_record(OP_MESSAGE_INDEX, _U16.pack(c) + _U32.pack(pairs.nbytes)
-                                    + pairs.tobytes()))
+            self._put(_MessageIndex(c, entries))
         self.chunks.append(ChunkIndex(p.start, p.end, offset, length, index_offsets,
                                       self.file.tell() - offset - length, "zstd",
                                       len(compressed), len(records)))
@@ -570,45 +553,46 @@ class McapWriter:
         self._flush_if(0)
         f = self.file
         metadata_start = f.tell()
-        body = _string("serialized_metadata") + _string(rosbag2_metadata)
-        f.write(_record(OP_METADATA, _string("rosbag2") + _U32.pack(len(body)) + body))
-        metadata_end = f.tell()
-        f.write(_record(OP_DATA_END, _U32.pack(0)))
+        metadata_length = self._put(rec.Metadata(
+            name="rosbag2", metadata={"serialized_metadata": rosbag2_metadata}))
+        self._put(rec.DataEnd(data_section_crc=0))
         summary_start = f.tell()
-        for schema in self.schemas.values():
-            f.write(schema_record(schema))
-        channel_start = f.tell()
-        for channel in self.channels.values():
-            f.write(channel_record(channel))
-        chunk_start = f.tell()
-        for c in self.chunks:
-            offsets = b"".join(_U16.pack(k) + _U64.pack(o) for k, o in c.index_offsets.items())
-            f.write(_record(OP_CHUNK_INDEX, struct.pack("<QQQQ", c.start_time, c.end_time,
-                                                        c.offset, c.length)
-                            + _U32.pack(len(offsets)) + offsets + _U64.pack(c.index_length)
-                            + _string(c.compression)
-                            + _U64.pack(c.compressed_size) + _U64.pack(c.uncompressed_size)))
-        metadata_index_start = f.tell()
-        f.write(_record(OP_METADATA_INDEX, _U64.pack(metadata_start)
-                        + _U64.pack(metadata_end - metadata_start) + _string("rosbag2")))
-        statistics_start = f.tell()
-        counts = b"".join(_U16.pack(c) + _U64.pack(n) for c, n in sorted(self.counts.items()))
         total = sum(self.counts.values())
-        f.write(_record(OP_STATISTICS, struct.pack(
-            "<QHIIIIQQ", total, len(self.schemas), len(self.channels), 0, 1, len(self.chunks),
-            self.start if total else 0, self.end if total else 0)
-            + _U32.pack(len(counts)) + counts))
-        offsets_start = f.tell()
-        for op, start, end in ((OP_SCHEMA, summary_start, channel_start),
-                               (OP_CHANNEL, channel_start, chunk_start),
-                               (OP_CHUNK_INDEX, chunk_start, metadata_index_start),
-                               (OP_METADATA_INDEX, metadata_index_start, statistics_start),
-                               (OP_STATISTICS, statistics_start, offsets_start)):
-            if end > start:
-                f.write(_record(OP_SUMMARY_OFFSET, bytes((op,)) + _U64.pack(start)
-                                + _U64.pack(end - start)))
-        f.write(_record(OP_FOOTER, _U64.pack(summary_start) + _U64.pack(offsets_start)
-                        + _U32.pack(0)) + MAGIC)
+        groups: list[tuple[int, list[rec.McapRecord]]] = [
+            (Opcode.SCHEMA, [s.record() for s in self.schemas.values()]),
+            (Opcode.CHANNEL, [c.record() for c in self.channels.values()]),
+            (Opcode.CHUNK_INDEX, [c.record() for c in self.chunks]),
+            (Opcode.METADATA_INDEX, [rec.MetadataIndex(
+                offset=metadata_start, length=metadata_length, name="rosbag2")]),
+            (Opcode.STATISTICS, [rec.Statistics(
+                message_count=total, schema_count=len(self.schemas),
+                channel_count=len(self.channels), attachment_count=0, metadata_count=1,
+                chunk_count=len(self.chunks),
+                message_start_time=self.start if total else 0,
+                message_end_time=self.end if total else 0,
+                channel_message_counts=dict(sorted(self.counts.items())))]),
+        ]
+        summary = RecordBuilder()
+        offsets: list[rec.McapRecord] = []
+        for opcode, records in groups:
+            group_start = summary.count
+            for r in records:
+                r.write(summary)
+            if summary.count > group_start:
+                offsets.append(rec.SummaryOffset(group_opcode=opcode,
+                                                 group_start=summary_start + group_start,
+                                                 group_length=summary.count - group_start))
+        offsets_start = summary_start + summary.count
+        for r in offsets:
+            r.write(summary)
+        data = summary.end()
+        f.write(data)
+        # the summary's checksum covers the footer's fields before it (as the library's)
+        footer_crc = crc32(struct.pack("<BQQQ", Opcode.FOOTER, 20, summary_start,
+                                       offsets_start), crc32(data))
+        self._put(rec.Footer(summary_start=summary_start, summary_offset_start=offsets_start,
+                             summary_crc=footer_crc))
+        f.write(MAGIC)
         f.close()
 
     def abort(self) -> None:
@@ -618,10 +602,14 @@ class McapWriter:
 
 def message_records(channel: NDArray[np.int64], log_time: NDArray[np.int64],
                     payloads: NDArray[np.uint8]) -> NDArray[np.uint8]:
-    """Return message records of fixed-size payloads ``(k, L)`` as a ``(k, 31 + L)`` array."""
+    """Return message records of fixed-size payloads ``(k, L)`` as a ``(k, 31 + L)`` array.
+
+    The bytes :class:`mcap.records.Message` writes (sequence 0, publish time
+    = log time), built for all ``k`` at once.
+    """
     k, size = payloads.shape
     out = np.empty((k, 31 + size), dtype=np.uint8)
-    out[:, 0] = OP_MESSAGE
+    out[:, 0] = Opcode.MESSAGE
     out[:, 1:9] = np.full(k, 22 + size, dtype="<u8").view(np.uint8).reshape(k, 8)
     out[:, 9:11] = channel.astype("<u2").view(np.uint8).reshape(k, 2)
     out[:, 11:15] = 0
@@ -725,13 +713,3 @@ def _inline(value: Any) -> str:
     if isinstance(value, list):
         return "[]"
     return _scalar(value)
-
-
-def read_map(data: bytes) -> dict[str, str]:
-    """Return the entries of an MCAP ``map<string, string>`` body."""
-    r = _Fields(data)
-    out = {}
-    while r.pos < len(data):
-        key = r.string()
-        out[key] = r.string()
-    return out
