@@ -32,7 +32,10 @@ from fastsim_ros.contact.errors import InvalidInputError
 #: the most samples a measured file may hold
 MAX_SAMPLES = 100_000
 #: the solvers the fit may use (compiled batches: one call per model evaluation)
-METHODS = ("mae_calibrated", "mae", "fastsim_ellipse")
+METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact")
+#: the most samples ``--method exact`` takes (about 10 ms a solve at 20 x 20 cells, a few
+#: dozen evaluations of the curve)
+MAX_EXACT_SAMPLES = 200
 HEADERS = (["xi", "eta", "phi", "Fx"], ["xi", "eta", "phi", "Fx", "Fy"])
 
 
@@ -56,8 +59,8 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--shear-modulus", type=finite, default=8.0e10, help="combined G (Pa)")
     p.add_argument("--nu", type=finite, default=0.28, help="Poisson ratio (default 0.28)")
     p.add_argument("--method", choices=METHODS, default="mae_calibrated",
-                   help="the measurement model: mae_calibrated (default), mae or "
-                   "fastsim_ellipse")
+                   help="the measurement model: mae_calibrated (default), mae, "
+                   "fastsim_ellipse or exact (Kalker's exact theory: the reference, slow)")
     p.add_argument("--bound", choices=BOUNDS, default="given",
                    help="traction bound: mu p as given, or parabolic")
 
@@ -125,7 +128,18 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
                                     f"{args.friction_decay:g}")
     creepages, measured = read_measured(args.measured)
     patch = cli._force_area(args)
-    solver = solver_for(args.method, args.nu, args.shear_modulus)
+    solver: Any
+    if args.method == "exact":
+        from fastsim_ros.estimation.model import ExactSolver
+        if args.bound != "given":
+            raise cli.UsageError("--method exact takes the pressure as given (--bound given)")
+        if creepages.shape[0] > MAX_EXACT_SAMPLES:
+            raise InvalidInputError(f"--method exact takes at most {MAX_EXACT_SAMPLES} "
+                                    f"samples, got {creepages.shape[0]}")
+        cli._check_exact_grid(patch, forces=True)
+        solver = ExactSolver(args.nu, args.shear_modulus)
+    else:
+        solver = solver_for(args.method, args.nu, args.shear_modulus)
     fit = fit_friction(solver, patch, creepages, measured, law=args.friction_law,
                        speed=args.speed, bound=args.bound, mu0=args.mu,
                        limit_ratio0=args.friction_limit_ratio, decay0=args.friction_decay)

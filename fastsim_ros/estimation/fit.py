@@ -26,7 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import friction_law
-from fastsim_ros.estimation.model import Solver
+from fastsim_ros.estimation.model import ExactSolver, Solver
 
 FloatArray = NDArray[np.float64]
 #: bounds of the fitted parameters: mu_s, A (1), B (s/m)
@@ -60,7 +60,7 @@ class FrictionFit:
     evaluations: int
 
 
-def fit_friction(solver: Solver, area: GridArea, creepages: ArrayLike, measured: ArrayLike,
+def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayLike, measured: ArrayLike,
                  *, law: str = "constant", speed: float | None = None, bound: str = "given",
                  mu0: float = 0.3, limit_ratio0: float = 0.5,
                  decay0: float = 1.0) -> FrictionFit:

@@ -44,6 +44,38 @@ def solver_for(method: str, nu: float, shear_modulus: float) -> Solver:
     raise InvalidInputError(f"unknown method {method!r}: one of {', '.join(METHODS)}")
 
 
+class ExactSolver:
+    """Kalker's exact theory (:func:`fastsim_ros.contact.exact.coulomb`) with the batch call.
+
+    ``solve_batch`` as the compiled solvers' (one patch, ``(B, 3)``
+    creepages; ``bound`` must be ``"given"``): the batch fit's reference
+    model (about 10 ms a solve at 20 x 20 cells), never the node's.  ``nu``, ``shear_modulus`` (Pa).
+    """
+
+    def __init__(self, nu: float, shear_modulus: float) -> None:
+        self.nu, self.shear_modulus = float(nu), float(shear_modulus)
+
+    def solve_batch(self, pressure: FloatArray, x0: float, y0: float, dx: float, dy: float,
+                    creepages: FloatArray, *, bound: str = "given",
+                    friction: FrictionLaw | None = None,
+                    speed: float | None = None) -> FloatArray:
+        """Return ``(B, 3)``: ``Fx, Fy`` (N), ``Mz`` (N m) at each row ``xi, eta, phi``."""
+        from fastsim_ros.contact import exact
+        from fastsim_ros.contact.area import GridArea
+
+        if bound != "given":
+            raise InvalidInputError("the exact solver takes the pressure as given "
+                                    "(bound given)")
+        area = GridArea(float(x0), float(y0), float(dx), float(dy), np.asarray(pressure))
+        out = np.empty((len(creepages), 3))
+        for k, (xi, eta, phi) in enumerate(np.asarray(creepages, dtype=np.float64)):
+            sol = exact.coulomb(area, float(xi), float(eta), float(phi), nu=self.nu,
+                                shear_modulus=self.shear_modulus, friction=friction,
+                                speed=speed)
+            out[k] = sol.fx, sol.fy, sol.mz
+        return out
+
+
 @dataclass(frozen=True, eq=False)
 class ContactSample:
     """One contact of one cycle: grid, creepages, speed and the force's projection.
