@@ -286,3 +286,90 @@ def test_cli_bad_bytes_and_missing_file_exit_2(capsys, tmp_path):
     assert code == 2 and err.count("\n") == 1
     code, _, err = estimate(capsys, write_curve(tmp_path / "one.csv", curve(1), np.ones((1, 1))))
     assert code == 2 and "samples" in err
+
+
+# ---------------------------------------------------------------- the pipeline
+
+
+def wrench_msg(force, stamp_ns, frame_id="wheelset"):
+    from geometry_msgs.msg import WrenchStamped
+    w = WrenchStamped()
+    w.header.stamp.sec, w.header.stamp.nanosec = divmod(int(stamp_ns), 1_000_000_000)
+    w.header.frame_id = frame_id
+    w.wrench.force.x, w.wrench.force.y, w.wrench.force.z = map(float, force)
+    return w
+
+
+def test_pipeline_estimates_mu_and_solves_with_it(hertz):
+    """A rig cycle: twist, measured wrench (the truth's wheelset force + noise), patch."""
+    from rclpy.serialization import deserialize_message
+    from geometry_msgs.msg import Vector3Stamped
+    from fastsim_ros.pipeline import (FRICTION_ESTIMATE_TOPIC, MEASURED_WRENCH_TOPIC, Pipeline,
+                                      PipelineConfig)
+    from ros_messages import cdr, cloud_msg, rolling_twist
+
+    def make(**values):
+        return Pipeline(PipelineConfig.from_values(dict(contacts=["left"], **values)))
+
+    truth = make(friction_coefficient=0.35)
+    pipe = make(friction_coefficient=0.2, friction_estimation="on",
+                friction_measurement_noise=NOISE, friction_estimate_sigma=0.15)
+    assert MEASURED_WRENCH_TOPIC in [i.topic for i in pipe.inputs()]
+    assert MEASURED_WRENCH_TOPIC not in [i.topic for i in truth.inputs()]  # off: no input
+    assert FRICTION_ESTIMATE_TOPIC in pipe.outputs()
+    rng = np.random.default_rng(7)
+    t0 = 1_700_000_000 * 1_000_000_000
+    estimates = []
+    for k, xi in enumerate(rng.uniform(2.5e-3, 8e-3, 60)):
+        stamp = t0 + k * round(DT * 1e9)
+        twist = cdr(rolling_twist(float(xi), stamp_ns=stamp))
+        patch = cdr(cloud_msg(hertz, stamp_ns=stamp, dtype="<f8"))
+        truth.on_wheel_twist(twist)
+        measured = truth.on_patch("left", patch).wheelset.force
+        noisy = (measured[0] + rng.normal(0.0, NOISE), measured[1], measured[2])
+        assert pipe.on_wheel_twist(twist) == "ok"
+        assert pipe.on_measured_wrench(cdr(wrench_msg(noisy, stamp))) == "ok"
+        mu_before = pipe._mu
+        out = pipe.on_patch("left", patch)
+        # the published wrench is solved with the estimate as it stood (the prior)
+        ref = truth._solver.solve_arrays(out.patch.pressure, out.patch.x0, out.patch.y0,
+                                         out.patch.dx, out.patch.dy, out.creepage.xi,
+                                         out.creepage.eta, out.creepage.phi, mu_before)
+        assert out.forces.fx == pytest.approx(ref.fx, rel=1e-12)
+        assert out.friction is not None and out.friction.status == "updated"
+        estimates.append(out.friction)
+        (topic, raw), = [m for m in pipe.messages(out) if m[0] == FRICTION_ESTIMATE_TOPIC]
+        msg = deserialize_message(raw, Vector3Stamped)
+        assert (msg.vector.x, msg.vector.y) == (out.friction.mu, out.friction.sigma)
+        assert msg.header.frame_id == "wheelset"
+    last = estimates[-1]
+    assert abs(last.mu - 0.35) < 0.01 * 0.35 and last.sigma < 0.01
+    assert 0.0 < last.utilisation <= 1.0
+    # the next cycle's wrench uses the estimate
+    assert pipe._mu == last.mu
+    values = {v.key: v.value for v in pipe.diagnostics(t0).status[0].values}
+    assert float(values["friction_estimation/mu"]) == pytest.approx(last.mu, rel=1e-5)
+    assert values["friction_estimation/updated"] == "60"
+
+
+def test_pipeline_holds_without_a_fresh_measurement(hertz):
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from ros_messages import cdr, cloud_msg, rolling_twist
+
+    pipe = Pipeline(PipelineConfig.from_values(dict(contacts=["left"], friction_estimation="on",
+                                                    friction_coefficient=0.3)))
+    t0 = 1_700_000_000 * 1_000_000_000
+    # one measurement, then cycles without: it is used once, by the first cycle only
+    pipe.on_measured_wrench(cdr(wrench_msg((-1.5e4, 0.0, 0.0), t0)))
+    statuses = []
+    for k in range(3):
+        stamp = t0 + k * 5_000_000
+        pipe.on_wheel_twist(cdr(rolling_twist(6e-3, stamp_ns=stamp)))
+        statuses.append(pipe.on_patch("left", cdr(cloud_msg(hertz, stamp_ns=stamp,
+                                                            dtype="<f8"))).friction.status)
+    assert statuses == ["updated", "no_measurement", "no_measurement"]
+    # another frame, or NaN: dropped and counted
+    assert pipe.on_measured_wrench(cdr(wrench_msg((1.0, 0.0, 0.0), t0 + 1, "base"))) \
+        == "wrong_frame"
+    assert pipe.on_measured_wrench(cdr(wrench_msg((math.nan, 0.0, 0.0), t0 + 2))) == "nonfinite"
+    assert pipe.estimation_counts["dropped"] == 2
