@@ -406,15 +406,15 @@ class Pipeline:
         if config["friction_estimation"] != "on":
             self._ekf = None
             return
-        settings = dict(process_noise=float(config["friction_process_noise"]),
-                        measurement_noise=float(config["friction_measurement_noise"]),
-                        min_sensitivity=float(config["friction_min_sensitivity"]))
+        q, r = float(config["friction_process_noise"]), float(config["friction_measurement_noise"])
+        gate = float(config["friction_min_sensitivity"])
         if self._ekf is None:
             self._ekf = FrictionEkf(float(config["friction_coefficient"]),
-                                    float(config["friction_estimate_sigma"]), **settings)
+                                    float(config["friction_estimate_sigma"]), process_noise=q,
+                                    measurement_noise=r, min_sensitivity=gate)
         else:  # the state carries on; only how it moves changes
-            for name, value in settings.items():
-                setattr(self._ekf, name, value)
+            self._ekf.process_noise, self._ekf.measurement_noise = q, r
+            self._ekf.min_sensitivity = gate
 
     def update(self, changes: Mapping[str, Any]) -> None:
         """Apply new values of parameters (checked; the material and contacts stay)."""

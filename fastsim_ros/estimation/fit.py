@@ -60,7 +60,8 @@ class FrictionFit:
     evaluations: int
 
 
-def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayLike, measured: ArrayLike,
+def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayLike,
+                 measured: ArrayLike,
                  *, law: str = "constant", speed: float | None = None, bound: str = "given",
                  mu0: float = 0.3, limit_ratio0: float = 0.5,
                  decay0: float = 1.0) -> FrictionFit:

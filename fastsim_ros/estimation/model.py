@@ -49,7 +49,8 @@ class ExactSolver:
 
     ``solve_batch`` as the compiled solvers' (one patch, ``(B, 3)``
     creepages; ``bound`` must be ``"given"``): the batch fit's reference
-    model (about 10 ms a solve at 20 x 20 cells), never the node's.  ``nu``, ``shear_modulus`` (Pa).
+    model (about 10 ms a solve at 20 x 20 cells), never the node's.  ``nu``,
+    ``shear_modulus`` (Pa).
     """
 
     def __init__(self, nu: float, shear_modulus: float) -> None:
@@ -120,7 +121,7 @@ class CreepModel:
 
     def friction(self, mu_s: float, limit_ratio: float | None = None,
                  decay: float | None = None) -> FrictionLaw:
-        """Return the law at static coefficient ``mu_s`` (the shape's ``A``, ``B`` unless given)."""
+        """Return the law at static coefficient ``mu_s`` (``A``, ``B``: the shape's by default)."""
         return friction_law(self.law, float(mu_s),
                             limit_ratio=self.limit_ratio if limit_ratio is None else limit_ratio,
                             decay=self.decay if decay is None else decay)
