@@ -158,18 +158,19 @@ class FrictionEkf:
                            innovation)
         r = self.measurement_noise ** 2
         h2 = float(slope @ slope)
+        hv = float(slope @ innovation)
         # the innovation's size in its predicted standard deviations (along H)
-        nis = float(slope @ innovation) ** 2 / h2 / (var0 * h2 + r)
+        nis = hv * hv / h2 / (var0 * h2 + r)
         step_seen = nis > self.step_gate ** 2
         if step_seen:  # the rail changed: what the innovation implies of mu is unknown
-            var0 = min(var0 + float(slope @ innovation) ** 2 / h2 ** 2, self.sigma_max ** 2)
+            var0 = min(var0 + hv * hv / (h2 * h2), self.sigma_max ** 2)
             self.steps += 1
-        # scalar state: S = H P H^T + R I, K = P H^T S^-1; Joseph form for the variance
-        s = var0 * np.outer(slope, slope) + r * np.eye(z.size)
-        gain = var0 * np.linalg.solve(s, slope)
-        kh = float(gain @ slope)
-        mu = mu0 + float(gain @ innovation)
-        self.variance = (1.0 - kh) ** 2 * var0 + r * float(gain @ gain)
+        # scalar state, isotropic R = r I: S = P H H^T + r I, so S^-1 H = H / (P |H|^2 + r)
+        # (Sherman-Morrison) and K = P H / (P |H|^2 + r); Joseph form for the variance
+        denominator = var0 * h2 + r
+        kh = var0 * h2 / denominator
+        mu = mu0 + var0 * hv / denominator
+        self.variance = (1.0 - kh) ** 2 * var0 + r * var0 * var0 * h2 / denominator ** 2
         self.mu = min(max(mu, self.mu_bounds[0]), self.mu_bounds[1])
         self.updates += 1
         return EkfStep(UPDATED, mu0, sigma0, self.mu, self.sigma, slope, sensitivity,
