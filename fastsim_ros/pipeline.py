@@ -379,6 +379,11 @@ class Pipeline:
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
         self._apply_estimation(config)
+        # the estimator's measurement model: the configured solver, law shape and bound
+        self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
+                                       str(config["friction_law"]),
+                                       float(config["friction_limit_ratio"]),
+                                       float(config["friction_decay"]), str(self._bound))
         mu = self._ekf.mu if self._ekf is not None else float(config["friction_coefficient"])
         self._use_mu(mu, config)
 
@@ -561,7 +566,7 @@ class Pipeline:
             ex, ey, ez = patch.frame.axes
             samples.append(ContactSample(patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy,
                                          creep.xi, creep.eta, creep.phi, creep.speed,
-                                         np.array([[ex[0], ey[0]]])))
+                                         ((ex[0], ey[0]),)))
             normal_x += ez[0] * f.n
             predicted += ex[0] * f.fx + ey[0] * f.fy
             load += f.n
@@ -570,9 +575,7 @@ class Pipeline:
         measured = self._measurement(cycle.stamp_ns)
         status = "no_measurement"
         if measured is not None and samples and load > 0.0:
-            model = CreepModel(self._solver, str(self.config["friction_law"]),  # type: ignore
-                               float(self.config["friction_limit_ratio"]),
-                               float(self.config["friction_decay"]), str(self._bound))
+            model = self._creep_model
             try:
                 step = ekf.update([measured[0] - normal_x],
                                   lambda m: model.predict(samples, m), load, [predicted])

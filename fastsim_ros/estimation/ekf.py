@@ -69,10 +69,17 @@ class EkfStep:
     sigma_prior: float
     mu: float
     sigma: float
-    slope: FloatArray
+    slope: tuple[float, ...]
     sensitivity: float
-    innovation: FloatArray
+    innovation: tuple[float, ...]
     step_seen: bool = False
+
+
+def _floats(values: ArrayLike) -> tuple[float, ...]:
+    """Return a scalar or a 1-D sequence of numbers as a tuple of floats."""
+    if isinstance(values, (list, tuple)):
+        return tuple(float(v) for v in values)
+    return tuple(np.asarray(values, dtype=np.float64).ravel().tolist())
 
 
 def _positive(name: str, value: float, *, zero_ok: bool = False) -> float:
@@ -128,37 +135,36 @@ class FrictionEkf:
         dt = _positive("dt", dt, zero_ok=True)
         self.variance = min(self.variance + self.process_noise * dt, self.sigma_max ** 2)
 
-    def update(self, measured: ArrayLike, model: Callable[[float], FloatArray], load: float,
+    def update(self, measured: ArrayLike, model: Callable[[float], ArrayLike], load: float,
                predicted: ArrayLike | None = None) -> EkfStep:
         """Take one measurement ``measured`` (N, ``(m,)``) of the model ``model(mu_s)`` (N).
 
         ``load``: the cycle's total normal load (N, for the sensitivity);
         ``predicted``: ``model(self.mu)`` if already known (saves a solve).
         """
-        z = np.atleast_1d(np.asarray(measured, dtype=np.float64))
+        z = _floats(measured)
         load = _positive("load", load)
-        if not np.all(np.isfinite(z)):
+        if not all(math.isfinite(v) for v in z):
             raise InvalidInputError("measured forces must be finite")
         mu0, var0 = self.mu, self.variance
         sigma0 = math.sqrt(var0)
-        h0 = np.atleast_1d(np.asarray(model(mu0) if predicted is None else predicted,
-                                      dtype=np.float64))
-        if h0.shape != z.shape:
-            raise InvalidInputError(f"model gives {h0.shape[0]} components, measured "
-                                    f"{z.shape[0]}")
+        h0 = _floats(model(mu0) if predicted is None else predicted)
+        if len(h0) != len(z):
+            raise InvalidInputError(f"model gives {len(h0)} components, measured {len(z)}")
         step = self.relative_step * mu0
         if mu0 + step > self.mu_bounds[1]:
             step = -step  # stay inside the range the solver is asked about
-        slope = (np.atleast_1d(np.asarray(model(mu0 + step), dtype=np.float64)) - h0) / step
-        sensitivity = float(np.linalg.norm(slope)) / load
-        innovation = z - h0
+        h1 = _floats(model(mu0 + step))
+        slope = tuple((b - a) / step for a, b in zip(h0, h1))
+        innovation = tuple(a - b for a, b in zip(z, h0))
+        h2 = math.fsum(v * v for v in slope)
+        sensitivity = math.sqrt(h2) / load
         if not sensitivity >= self.min_sensitivity:
             self.skipped += 1
             return EkfStep(UNOBSERVABLE, mu0, sigma0, mu0, sigma0, slope, sensitivity,
                            innovation)
         r = self.measurement_noise ** 2
-        h2 = float(slope @ slope)
-        hv = float(slope @ innovation)
+        hv = math.fsum(a * b for a, b in zip(slope, innovation))
         # the innovation's size in its predicted standard deviations (along H)
         nis = hv * hv / h2 / (var0 * h2 + r)
         step_seen = nis > self.step_gate ** 2

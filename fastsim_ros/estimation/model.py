@@ -96,7 +96,7 @@ class ContactSample:
     eta: float
     phi: float
     speed: float
-    projection: FloatArray
+    projection: FloatArray | tuple[tuple[float, float], ...]
 
     @property
     def load(self) -> float:
@@ -143,10 +143,11 @@ class CreepModel:
 
     def predict(self, samples: Sequence[ContactSample], mu_s: float) -> FloatArray:
         """Return the measured components' model values (N): ``sum projection @ (Fx, Fy)``."""
-        total: FloatArray | None = None
-        for s in samples:
-            term = s.projection @ np.array(self.contact_forces(s, mu_s))
-            total = term if total is None else total + term
-        if total is None:
+        if not samples:
             raise InvalidInputError("no contact sample to predict")
-        return total
+        total = [0.0] * len(samples[0].projection)
+        for s in samples:
+            fx, fy = self.contact_forces(s, mu_s)
+            for i, (px, py) in enumerate(s.projection):
+                total[i] += float(px) * fx + float(py) * fy
+        return np.array(total)
