@@ -11,7 +11,7 @@ setup(
     name=package_name,
     version='0.1.0',
     packages=[package_name, package_name + '.contact', package_name + '.geometry',
-              package_name + '.replay', 'msg_adapters'],
+              package_name + '.replay', package_name + '.estimation', 'msg_adapters'],
     package_data={package_name: ['data/*.csv', 'data/profiles/*', 'data/mbench/*']},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),

@@ -3,7 +3,8 @@
 Three commands (INTERFACE.md): ``coefficients`` prints an area's generalised
 creepage coefficients, ``forces`` the creep forces at given creepages,
 ``wheelset`` a wheelset's patches and creep forces from wheel and rail profiles
-(:mod:`fastsim_ros.cli_wheelset`).  SI
+(:mod:`fastsim_ros.cli_wheelset`), and ``estimate`` fits the friction law to
+measured creep forces (:mod:`fastsim_ros.cli_estimate`).  SI
 units throughout.  ``--json`` prints exactly one JSON object on stdout.  Bad
 input gives one line on stderr and exit status 2, never a traceback, and no
 non-finite number is ever printed as a result.
@@ -181,6 +182,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "(Kalker's on a Hertzian patch)")
     from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
     cli_wheelset.add_parser(sub, _finite)
+    from fastsim_ros import cli_estimate  # the friction fit too (issue 28)
+    cli_estimate.add_parser(sub, _finite)
     return parser
 
 
@@ -562,6 +565,10 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
         from fastsim_ros import cli_wheelset
         cli_wheelset.print_table(result)
         return
+    if command == "estimate":
+        from fastsim_ros import cli_estimate
+        cli_estimate.print_table(result)
+        return
     if command == "coefficients":
         print(f"{result['area_description']}, nu = {result['nu']:g}, method {result['method']}"
               + (f", extrapolated from grids {result['cells']}" if result.get("extrapolated")
@@ -585,6 +592,9 @@ def _run(argv: Sequence[str] | None) -> tuple[argparse.Namespace, dict[str, Any]
         if args.command == "wheelset":
             from fastsim_ros import cli_wheelset
             return args, cli_wheelset.run(args)
+        if args.command == "estimate":
+            from fastsim_ros import cli_estimate
+            return args, cli_estimate.run(args)
         result = coefficients(args) if args.command == "coefficients" else forces(args)
     return args, result
 

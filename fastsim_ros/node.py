@@ -53,8 +53,9 @@ from fastsim_ros import params as parameters
 from fastsim_ros import pipeline_kernels
 from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
-from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
-                                  InputTopic, Outcome, PipelineConfig, patch_topic)
+from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
+                                  WHEELSET_WRENCH_TOPIC, InputTopic, Outcome, PipelineConfig,
+                                  patch_topic)
 from fastsim_ros.profile_pipeline import AnyPipeline, ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
@@ -232,6 +233,8 @@ class _FrontEnd:
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
         outputs[MARKERS_TOPIC] = MarkerArray
+        if FRICTION_ESTIMATE_TOPIC in self.pipeline.outputs():  # friction_estimation on
+            outputs[FRICTION_ESTIMATE_TOPIC] = Vector3Stamped
         if isinstance(self.pipeline, ProfilePipeline):
             # profiles mode computes the patches and publishes them, so that a recording
             # replays in either mode (INTERFACE.md)

@@ -148,6 +148,25 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_decay", "double", 0.0,
                   "B (s/m) of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
                   low=0.0, high=1.0e4, dynamic=True),
+    # --- online friction estimation (issue 28; fastsim_ros/estimation/ekf.py)
+    ParameterSpec("friction_estimation", "string", "off",
+                  "estimate mu_s online from wheelset/measured_wrench (force.x, wheelset "
+                  "frame) with an extended Kalman filter whose measurement model is the "
+                  "solver; on: friction/estimate is published and every wrench uses the "
+                  "estimate (friction_coefficient is its start)",
+                  choices=("off", "on")),
+    ParameterSpec("friction_process_noise", "double", 2.0e-5,
+                  "q (1/s): variance of mu_s added per second (how fast mu may change)",
+                  low=0.0, high=10.0, dynamic=True),
+    ParameterSpec("friction_measurement_noise", "double", 250.0,
+                  "standard deviation of the measured longitudinal force (N, the load cell's)",
+                  low=1.0e-6, high=1.0e9, dynamic=True),
+    ParameterSpec("friction_estimate_sigma", "double", 0.1,
+                  "standard deviation of mu_s at the start of the estimation",
+                  low=1.0e-6, high=1.0, dynamic=True),
+    ParameterSpec("friction_min_sensitivity", "double", 0.02,
+                  "observability threshold on |dF/dmu_s| / N: below it (the linear range) "
+                  "the estimate holds and its sigma grows", low=0.0, high=1.0, dynamic=True),
     ParameterSpec("publish_markers", "bool", True,
                   "publish contact/markers (one creep-force arrow per contact)", dynamic=True),
     ParameterSpec("marker_scale", "double", 1.0e-5,

@@ -27,7 +27,7 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable, Container, Mapping, Sequence
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -40,9 +40,10 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
+from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
-from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist,
+from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist, stamped_doubles,
                               stamped_doubles_template)
 from msg_adapters.errors import REJECTION_REASONS, MalformedMessageError, RejectedInput
 from msg_adapters.kinematics import REST, Creepage, creepages, twist_is_finite
@@ -67,6 +68,9 @@ def patch_topic(contact: str) -> str:
 WHEEL_TWIST_TOPIC, RAIL_TWIST_TOPIC = "wheelset/twist", "rail/twist"
 WHEELSET_WRENCH_TOPIC, MARKERS_TOPIC = "wheelset/wrench", "contact/markers"
 DIAGNOSTICS_TOPIC = "/diagnostics"
+#: online friction estimation (parameter friction_estimation): the measured wrench in, the
+#: estimate out (Vector3Stamped: x = mu_s, y = its standard deviation, z = adhesion utilisation)
+MEASURED_WRENCH_TOPIC, FRICTION_ESTIMATE_TOPIC = "wheelset/measured_wrench", "friction/estimate"
 #: output topics of a contact: relative name -> message type
 CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "creepage": "geometry_msgs/msg/Vector3Stamped",
@@ -122,6 +126,25 @@ class WheelsetWrench:
     torque: tuple[float, float, float]
 
 
+@dataclass(frozen=True, slots=True)
+class FrictionEstimate:
+    """The friction estimate after a rig cycle (``friction/estimate``).
+
+    ``mu``: the estimated static coefficient ``mu_s`` (what the next cycle's
+    wrenches use); ``sigma``: its standard deviation; ``utilisation``: the
+    cycle's creep forces over the friction available, ``sum |(Fx, Fy)| /
+    (mu sum N)`` at the mu they were solved with; ``status``: ``updated``,
+    ``unobservable`` (the linear range: held, sigma grown) or
+    ``no_measurement`` (no fresh ``wheelset/measured_wrench``: held).
+    """
+
+    stamp_ns: int
+    mu: float
+    sigma: float
+    utilisation: float
+    status: str
+
+
 @dataclass(frozen=True, slots=True, eq=False)
 class Outcome:
     """What one patch gave.
@@ -132,7 +155,8 @@ class Outcome:
     whether it moved since it was last published), ``creepage``, ``forces``
     (``fx, fy`` (N), ``mz`` (N m) about the contact origin, ``n`` (N)) and
     the ``patch``.  ``wheelset``: the wheelset wrench when this patch
-    completed a rig cycle; ``markers``: whether markers are due.
+    completed a rig cycle; ``markers``: whether markers are due;
+    ``friction``: the friction estimate after that cycle (estimation on).
     """
 
     contact: str
@@ -146,6 +170,7 @@ class Outcome:
     patch: ContactPatch | None = None
     wheelset: WheelsetWrench | None = None
     markers: bool = False
+    friction: FrictionEstimate | None = None
 
     @property
     def has_wrench(self) -> bool:
@@ -214,7 +239,7 @@ class ContactReport:
 
 class _ContactState:
     __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
-                 "wrench_fresh", "stats", "reader", "frame_out", "result")
+                 "wrench_fresh", "stats", "reader", "frame_out", "result", "solved")
 
     def __init__(self) -> None:
         self.reader = CloudReader()  # the topic's header parsed once
@@ -229,6 +254,8 @@ class _ContactState:
         self.wrench = None
         self.wrench_fresh = False
         self.stats = ContactStats()
+        # the latest solve (friction estimation's measurement model): patch, creepages, forces
+        self.solved: tuple[ContactPatch, Creepage, ContactForces] | None = None
 
 
 class _ContactTopics:
@@ -260,14 +287,17 @@ def _builder(cls: type) -> Callable[..., Any]:
     The dataclass's own ``__init__`` sets each field through
     ``object.__setattr__`` (what ``frozen`` costs); this one calls each slot's
     setter directly: half the time, for the five results built per patch on
-    the compiled path.  No defaults, no ``__post_init__`` (none of them has
-    one); the instance equals the ``__init__``'s (test_pipeline_kernels.py).
+    the compiled path.  Plain defaults (no factories), no ``__post_init__``
+    (none of them has one); the instance equals the ``__init__``'s (test_pipeline_kernels.py).
     """
     names = [f.name for f in fields(cls)]
     assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
-    args = ", ".join(names)
+    # a field with a plain default may be left out (Outcome.friction, added later)
+    defaults = {f.name: f.default for f in fields(cls) if f.default is not MISSING}
+    args = ", ".join(f"{n}=default_{n}" if n in defaults else n for n in names)
     body = "".join(f"    set_{n}(o, {n})\n" for n in names)
     scope: dict[str, Any] = {"new": object.__new__, "cls": cls}
+    scope.update({f"default_{n}": v for n, v in defaults.items()})
     scope.update({f"set_{n}": getattr(cls, n).__set__ for n in names})
     exec(f"def build({args}):\n    o = new(cls)\n{body}    return o\n", scope)
     build: Callable[..., Any] = scope["build"]
@@ -325,17 +355,19 @@ class Pipeline:
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
+        # online friction estimation (None: off); the measured wrenches (stamp, force)
+        self._ekf: FrictionEkf | None = None
+        self._measured: deque[tuple[int, tuple[float, float, float]]] = deque(
+            maxlen=TWIST_HISTORY)
+        self._measured_used_ns: int | None = None
+        self._last_cycle_ns: int | None = None
+        self.estimation_counts = {"measured": 0, "dropped": 0, "updated": 0,
+                                  "unobservable": 0, "no_measurement": 0, "steps": 0}
         self._apply(config)
 
     def _apply(self, config: PipelineConfig) -> None:
         self.config = config
         self._solver = self._override or self._solvers[config["method"]]
-        self._mu = float(config["friction_coefficient"])
-        # None: constant friction, the call of old (speed unused); else the law, run at |V|
-        law = friction_law(str(config["friction_law"]), self._mu,
-                           limit_ratio=float(config["friction_limit_ratio"]),
-                           decay=float(config["friction_decay"]))
-        self._law: FrictionLaw | None = law if law.slip_dependent else None
         self._bound = config["traction_bound"]
         self._frame_id = config["wheelset_frame"]
         self._max_cells = int(config["max_patch_cells"])
@@ -346,6 +378,23 @@ class Pipeline:
         rate = float(config["marker_rate"])
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
+        self._apply_estimation(config)
+        # the estimator's measurement model: the configured solver, law shape and bound
+        self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
+                                       str(config["friction_law"]),
+                                       float(config["friction_limit_ratio"]),
+                                       float(config["friction_decay"]), str(self._bound))
+        mu = self._ekf.mu if self._ekf is not None else float(config["friction_coefficient"])
+        self._use_mu(mu, config)
+
+    def _use_mu(self, mu: float, config: PipelineConfig) -> None:
+        """Solve with the static coefficient ``mu`` (the parameter's, or the estimate)."""
+        self._mu = mu
+        # None: constant friction, the call of old (speed unused); else the law, run at |V|
+        law = friction_law(str(config["friction_law"]), self._mu,
+                           limit_ratio=float(config["friction_limit_ratio"]),
+                           decay=float(config["friction_decay"]))
+        self._law: FrictionLaw | None = law if law.slip_dependent else None
         # the compiled path (pipeline_kernels.solve_cloud): the MAE methods without
         # tractions; the solver's arguments as its solve_arrays passes them
         self._compiled: tuple[Any, ...] | None = None
@@ -357,19 +406,38 @@ class Pipeline:
                               self._law is not None, solver._calibrated, solver._pair_knots,
                               solver._pair_values)
 
+    def _apply_estimation(self, config: PipelineConfig) -> None:
+        """Start the friction estimator (estimation on), or retune the running one."""
+        if config["friction_estimation"] != "on":
+            self._ekf = None
+            return
+        q, r = float(config["friction_process_noise"]), float(config["friction_measurement_noise"])
+        gate = float(config["friction_min_sensitivity"])
+        if self._ekf is None:
+            self._ekf = FrictionEkf(float(config["friction_coefficient"]),
+                                    float(config["friction_estimate_sigma"]), process_noise=q,
+                                    measurement_noise=r, min_sensitivity=gate)
+        else:  # the state carries on; only how it moves changes
+            self._ekf.process_noise, self._ekf.measurement_noise = q, r
+            self._ekf.min_sensitivity = gate
+
     def update(self, changes: Mapping[str, Any]) -> None:
         """Apply new values of parameters (checked; the material and contacts stay)."""
         values = dict(self.config.values)
         values.update(changes)
         config = PipelineConfig.from_values(values)
-        for name in ("contacts", "wheelset_frame", "shear_modulus", "poisson_ratio"):
+        for name in ("contacts", "wheelset_frame", "shear_modulus", "poisson_ratio",
+                     "friction_estimation"):
             if config[name] != self.config[name]:
                 raise parameters.ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config)
 
     def outputs(self) -> dict[str, str]:
         """Return every topic the pipeline publishes (relative, but /diagnostics) with its type."""
-        return output_topics(self.config.contacts)
+        topics = output_topics(self.config.contacts)
+        if self._ekf is not None:
+            topics[FRICTION_ESTIMATE_TOPIC] = "geometry_msgs/msg/Vector3Stamped"
+        return topics
 
     def inputs(self) -> tuple[InputTopic, ...]:
         """Return every input topic the pipeline takes, with its handler, in this order.
@@ -389,10 +457,14 @@ class Pipeline:
             return take
 
         twist = "geometry_msgs/msg/TwistStamped"
+        measured = ((InputTopic(MEASURED_WRENCH_TOPIC, "geometry_msgs/msg/WrenchStamped",
+                                "measured_wrench", None, kinematics(self.on_measured_wrench)),)
+                    if self._ekf is not None else ())
         return ((InputTopic(WHEEL_TWIST_TOPIC, twist, "wheel_twist", None,
                             kinematics(self.on_wheel_twist)),
                  InputTopic(RAIL_TWIST_TOPIC, twist, "rail_twist", None,
                             kinematics(self.on_rail_twist)))
+                + measured
                 + tuple(InputTopic(patch_topic(c), "sensor_msgs/msg/PointCloud2", "patch", c,
                                    patch(c)) for c in self.config.contacts))
 
@@ -426,6 +498,95 @@ class Pipeline:
     def on_rail_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
         """Take a rail twist (roller, moving rail); return ``"ok"`` or why it was dropped."""
         return self._twist(self._rail, twist, "rail")
+
+    def on_measured_wrench(self, wrench: StampedTwist | bytes | memoryview) -> str:
+        """Take a measured wheelset wrench (``WrenchStamped``, CDR or decoded as a twist).
+
+        The rig's measured force of the rails on the wheelset in the wheelset
+        frame (``linear`` = force, N).  Dropped (counted in
+        ``estimation_counts["dropped"]``) as a twist is: malformed, another
+        frame, non-finite, older than the last.
+        """
+        if not isinstance(wrench, StampedTwist):
+            try:
+                wrench = read_twist(wrench)  # the layout of a WrenchStamped
+            except MalformedMessageError:
+                self.estimation_counts["dropped"] += 1
+                return "malformed"
+        if wrench.frame_id != self._frame_id:
+            reason = "wrong_frame"
+        elif not twist_is_finite(wrench):
+            reason = "nonfinite"
+        elif self._measured and wrench.stamp_ns < self._measured[-1][0]:
+            reason = "old_stamp"
+        else:
+            f = wrench.linear
+            self._measured.append((wrench.stamp_ns, (f[0], f[1], f[2])))
+            self.estimation_counts["measured"] += 1
+            return "ok"
+        self.estimation_counts["dropped"] += 1
+        return reason
+
+    def _measurement(self, stamp_ns: int) -> tuple[float, float, float] | None:
+        """Return the measured force of the cycle stamped ``stamp_ns``, by the kinematics' rules.
+
+        The newest measured wrench not after the cycle and at most
+        ``max_kinematics_age`` before it, and not used by an earlier cycle.
+        """
+        for stamp, force in reversed(self._measured):
+            if stamp <= stamp_ns:
+                if stamp_ns - stamp > self._max_age_ns or (
+                        self._measured_used_ns is not None and stamp <= self._measured_used_ns):
+                    return None
+                self._measured_used_ns = stamp
+                return force
+        return None
+
+    def _estimate(self, cycle: WheelsetWrench) -> FrictionEstimate:
+        """Update the friction estimate with the cycle's measured force.x; use it from now on.
+
+        Measurement model (:mod:`fastsim_ros.estimation`): the wheelset
+        frame's ``x`` component of the contacts' wrenches, ``sum_c e_x,c[0]
+        Fx_c + e_y,c[0] Fy_c + e_z,c[0] N_c``, the creep forces solved at
+        ``mu_s`` (the published ones are those at the prior: one more solve
+        per contact gives the slope).
+        """
+        ekf = self._ekf
+        assert ekf is not None
+        if self._last_cycle_ns is not None and cycle.stamp_ns > self._last_cycle_ns:
+            ekf.predict((cycle.stamp_ns - self._last_cycle_ns) * 1e-9)
+        self._last_cycle_ns = cycle.stamp_ns
+        mu = self._mu
+        samples: list[ContactSample] = []
+        normal_x = predicted = load = used = 0.0
+        for state in self._contacts.values():
+            if state.solved is None:
+                continue
+            patch, creep, f = state.solved
+            ex, ey, ez = patch.frame.axes
+            samples.append(ContactSample(patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy,
+                                         creep.xi, creep.eta, creep.phi, creep.speed,
+                                         ((ex[0], ey[0]),)))
+            normal_x += ez[0] * f.n
+            predicted += ex[0] * f.fx + ey[0] * f.fy
+            load += f.n
+            used += math.hypot(f.fx, f.fy)
+        utilisation = used / (mu * load) if load > 0.0 else 0.0
+        measured = self._measurement(cycle.stamp_ns)
+        status = "no_measurement"
+        if measured is not None and samples and load > 0.0:
+            model = self._creep_model
+            try:
+                step = ekf.update([measured[0] - normal_x],
+                                  lambda m: model.predict(samples, m), load, [predicted])
+                status = step.status
+                self.estimation_counts["steps"] += int(step.step_seen)
+            except ContactError:  # the solver refused the perturbed mu: hold
+                status = "unobservable"
+        self.estimation_counts[status] += 1
+        if ekf.mu != mu:
+            self._use_mu(ekf.mu, self.config)
+        return FrictionEstimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
         """Return the wheel and rail twists a patch stamped ``stamp_ns`` is solved with.
@@ -523,9 +684,12 @@ class Pipeline:
         changed = _frame_moved(state.last_frame, patch.frame)
         if changed:
             state.last_frame = patch.frame
+        state.solved = (patch, creep, forces)
         wheelset = self._add_wrench(state, stamp, f_ws, torque)
+        friction = (self._estimate(wheelset) if wheelset is not None and self._ekf is not None
+                    else None)
         return _new_outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces,
-                            patch, wheelset, self._markers_due(state, stamp))
+                            patch, wheelset, self._markers_due(state, stamp), friction)
 
     def _twist_array(self, what: str, twist: StampedTwist) -> np.ndarray:
         """Return a twist's ``(v, w)`` as an array (built once per twist)."""
@@ -620,9 +784,13 @@ class Pipeline:
 
     def _no_contact(self, contact: str, state: _ContactState, stamp: int) -> Outcome:
         state.stats.counts[NO_CONTACT] += 1
+        state.solved = None
         wheelset = self._add_wrench(state, stamp, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        friction = (self._estimate(wheelset) if wheelset is not None and self._ekf is not None
+                    else None)
         return Outcome(contact, stamp, NO_CONTACT, "no cell with positive pressure",
-                       wheelset=wheelset, markers=self._markers_due(state, stamp))
+                       wheelset=wheelset, markers=self._markers_due(state, stamp),
+                       friction=friction)
 
     def _solve(self, patch: ContactPatch, creep: Creepage, stats: ContactStats) -> ContactForces:
         p, x0, y0, dx, dy = patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy
@@ -740,6 +908,10 @@ class Pipeline:
         if w is not None and WHEELSET_WRENCH_TOPIC in wanted:
             msgs.append((WHEELSET_WRENCH_TOPIC, out.wrench_cdr(w.stamp_ns, frame_id, w.force,
                                                                w.torque)))
+        e = outcome.friction
+        if e is not None and FRICTION_ESTIMATE_TOPIC in wanted:
+            msgs.append((FRICTION_ESTIMATE_TOPIC, stamped_doubles(
+                e.stamp_ns, frame_id, (e.mu, e.sigma, e.utilisation))))
         return msgs
 
     def diagnostics(self, stamp_ns: int,
@@ -751,6 +923,11 @@ class Pipeline:
         then the key-values ``extra[contact]`` if given (the node's connections).
         """
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
+        if self._ekf is not None:  # the estimator's state, shared by the contacts
+            twists += (("friction_estimation/mu", f"{self._ekf.mu:.6g}"),
+                       ("friction_estimation/sigma", f"{self._ekf.sigma:.3g}")) + tuple(
+                (f"friction_estimation/{key}", str(v))
+                for key, v in self.estimation_counts.items())
         statuses: list[tuple[str, int, str, Sequence[tuple[str, str]]]] = []
         for c in self.config.contacts:
             r = self.report(c)

@@ -1,0 +1,104 @@
+"""Online friction estimation: its cost per rig cycle beside the cycle's solves, same run.
+
+Issue 28's target: the estimator costs at most one extra solve's time per
+cycle.  Two pipelines (``fastsim_ros.pipeline.Pipeline``), two contacts
+(``left``, ``right``) of the 30-cell flange-root patch, the default method,
+constant friction: one with ``friction_estimation: off``, one ``on`` (fed a
+measured wrench each cycle, creepage beyond the linear range so every cycle
+updates).  One timed call is one rig cycle: the wheelset twist, (the measured
+wrench,) both patches, as CDR bytes, through the pipeline's handlers.  The
+two are interleaved in rounds (``bench_fastsim.per_call``).  Also timed: one
+``solve_arrays`` of that patch (what "one solve" costs).  Prints medians and
+p99 (us) and the machine line.  About 10 s.
+
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_estimation.py [--calls 5000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import struct
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
+
+from bench_fastsim import machine, per_call  # noqa: E402
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
+from ros_messages import cdr, cloud_msg, rolling_twist  # noqa: E402
+
+from fastsim_ros.contact import samples  # noqa: E402
+from fastsim_ros.contact.compiled import CalibratedMaeSolver, warm_up  # noqa: E402
+from fastsim_ros.pipeline import Pipeline, PipelineConfig  # noqa: E402
+
+T0 = 1_700_000_000 * 1_000_000_000
+PERIOD_NS = 1_000_000  # a 1 kHz rig
+LEFT, RIGHT = (0.0, 0.75, -0.46), (0.0, -0.75, -0.46)
+
+
+def wrench(force_x: float) -> bytes:
+    w = WrenchStamped()
+    w.header.frame_id = "wheelset"
+    w.wrench.force.x = force_x
+    return cdr(w)
+
+
+def stamped(raw: bytes, stamp_ns: int) -> bytearray:
+    """Return the CDR message ``raw`` with its header stamp set (after the 4-byte prefix)."""
+    b = bytearray(raw)
+    struct.pack_into("<iI", b, 4, *divmod(stamp_ns, 1_000_000_000))
+    return b
+
+
+def cycle_runner(estimation: str):
+    """Return a function that runs the next rig cycle through a pipeline."""
+    pipe = Pipeline(PipelineConfig.from_values(
+        {"contacts": ["left", "right"], "friction_estimation": estimation}))
+    area = samples.flange_root_patch(cells=30)
+    twist = cdr(rolling_twist(4e-3))
+    measured = wrench(-2.0e4)
+    left = cdr(cloud_msg(area, origin=LEFT, dtype="<f8"))
+    right = cdr(cloud_msg(area, origin=RIGHT, dtype="<f8"))
+    stamp = [T0]
+
+    def run() -> None:
+        stamp[0] += PERIOD_NS
+        t = stamp[0]
+        pipe.on_wheel_twist(stamped(twist, t))
+        if estimation == "on":
+            pipe.on_measured_wrench(stamped(measured, t))
+        pipe.on_patch("left", stamped(left, t))
+        pipe.on_patch("right", stamped(right, t))
+    return run, pipe
+
+
+def main() -> None:
+    """Time the cycles with estimation off and on, and one solve."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--calls", type=int, default=5000)
+    args = parser.parse_args()
+    warm_up()
+    off, _ = cycle_runner("off")
+    on, pipe_on = cycle_runner("on")
+    area = samples.flange_root_patch(cells=30)
+    solver = CalibratedMaeSolver(0.28, 8e10)
+
+    def solve() -> None:
+        solver.solve_arrays(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0,
+                            0.3)
+    times = per_call({"cycle, estimation off": off, "cycle, estimation on": on,
+                      "one solve_arrays": solve}, args.calls)
+    print(f"machine: {machine()}")
+    for name, (p50, p99) in times.items():
+        print(f"{name:24s} median {p50:8.1f} us   p99 {p99:8.1f} us")
+    extra = times["cycle, estimation on"][0] - times["cycle, estimation off"][0]
+    print(f"estimator per cycle (difference of medians): {extra:.1f} us = "
+          f"{extra / times['one solve_arrays'][0]:.2f} solves; "
+          f"updates {pipe_on.estimation_counts['updated']}, "
+          f"unobservable {pipe_on.estimation_counts['unobservable']}")
+
+
+if __name__ == "__main__":
+    main()

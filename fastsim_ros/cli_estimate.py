@@ -1,0 +1,180 @@
+"""``fastsim_contact estimate``: fit a friction law to a measured creep curve (issue 28).
+
+``--measured FILE.csv`` (header ``xi,eta,phi,Fx`` or ``xi,eta,phi,Fx,Fy``;
+creepages in 1, 1, 1/m about the area's origin, forces of the rail on the
+wheel in N, METHOD.md's signs) on the area of ``forces`` (``--shape ellipse
+--a --b --load`` or ``--patch FILE``, ``--nu``, ``--shear-modulus``,
+``--bound``, ``--cells``): the batch fit of
+:func:`fastsim_ros.estimation.fit.fit_friction` with the compiled solver of
+``--method`` (default ``mae_calibrated``) under ``--friction-law``
+(``constant``: ``mu_s``; ``exponential``: ``mu_s``, ``A``, ``B``, with
+``--speed`` the rolling speed in m/s).  ``--mu``, ``--friction-limit-ratio``
+and ``--friction-decay`` give the starting point.  ``--json`` prints
+``mu_s``, the law's parameters, their standard deviations (null where the
+data do not determine them) and the fitted curve's worst and rms errors in
+% of ``mu_s N``.  Bad files and flags: one line on stderr, exit status 2
+(the checks and messages of :mod:`fastsim_ros.cli`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from fastsim_ros import cli
+from fastsim_ros.contact.checks import BOUNDS
+from fastsim_ros.contact.errors import InvalidInputError
+
+#: the most samples a measured file may hold
+MAX_SAMPLES = 100_000
+#: the solvers the fit may use (compiled batches: one call per model evaluation)
+METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact")
+#: the most samples ``--method exact`` takes (about 10 ms a solve at 20 x 20 cells, a few
+#: dozen evaluations of the curve)
+MAX_EXACT_SAMPLES = 200
+HEADERS = (["xi", "eta", "phi", "Fx"], ["xi", "eta", "phi", "Fx", "Fy"])
+
+
+def add_parser(sub: Any, finite: Any) -> None:
+    """Add ``estimate`` to the subcommands of ``fastsim_contact``."""
+    p = sub.add_parser("estimate", help="fit the friction law to measured creep forces")
+    cli._add_area(p, forces=True)
+    p.add_argument("--measured", type=Path, required=True,
+                   help="CSV with header xi,eta,phi,Fx[,Fy] (1, 1, 1/m, N, N)")
+    p.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
+                   help="constant (fit mu_s) or exponential (fit mu_s, A, B of mu(v) = "
+                   "mu_s ((1 - A) exp(-B v) + A))")
+    p.add_argument("--mu", type=finite, default=0.3, help="starting mu_s (default 0.3)")
+    p.add_argument("--friction-limit-ratio", type=finite, default=0.5, metavar="A",
+                   help="starting A of the exponential law (default 0.5)")
+    p.add_argument("--friction-decay", type=finite, default=1.0, metavar="B",
+                   help="starting B (s/m) of the exponential law (default 1)")
+    p.add_argument("--speed", type=finite, metavar="V",
+                   help="rolling speed V (m/s; its magnitude is used), for the exponential law")
+    p.add_argument("--load", type=finite, help="normal load N (N)")
+    p.add_argument("--shear-modulus", type=finite, default=8.0e10, help="combined G (Pa)")
+    p.add_argument("--nu", type=finite, default=0.28, help="Poisson ratio (default 0.28)")
+    p.add_argument("--method", choices=METHODS, default="mae_calibrated",
+                   help="the measurement model: mae_calibrated (default), mae, "
+                   "fastsim_ellipse or exact (Kalker's exact theory: the reference, slow)")
+    p.add_argument("--bound", choices=BOUNDS, default="given",
+                   help="traction bound: mu p as given, or parabolic")
+
+
+def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """Read the measured samples: ``(n, 3)`` creepages and ``(n, 1 or 2)`` forces (N).
+
+    Refused (:class:`InvalidInputError`, one line naming the file and the
+    line): what :func:`fastsim_ros.cli.read_patch` refuses of a text file,
+    a header other than :data:`HEADERS`, a row of the wrong length, a value
+    that is not a finite number, a creepage beyond the command line's limits,
+    more than :data:`MAX_SAMPLES` rows, no row.
+    """
+    rows = cli._rows(path, cli._patch_lines(path))
+    first = next(rows, None)
+    if first is None:
+        raise InvalidInputError(f"{path}: empty (no header xi,eta,phi,Fx[,Fy])")
+    header = [c.strip() for c in first[1]]
+    if header not in HEADERS:
+        shown = ",".join(first[1])[:40]
+        raise InvalidInputError(f"{path}, line {first[0]}: the header must be xi,eta,phi,Fx "
+                                f"or xi,eta,phi,Fx,Fy, not {shown!r}")
+    width = len(header)
+    values: list[list[float]] = []
+    creep_max, spin_max = cli.LIMITS["creepage"][1], cli.LIMITS["spin"][1]
+    for line, fields in rows:
+        if len(fields) != width:
+            raise InvalidInputError(f"{path}, line {line}: {len(fields)} values where "
+                                    f"{','.join(header)} needs {width}")
+        row = [cli._value(path, line, name, text) for name, text in zip(header, fields)]
+        if max(abs(row[0]), abs(row[1])) > creep_max or abs(row[2]) > spin_max:
+            raise InvalidInputError(f"{path}, line {line}: creepages beyond the command line's "
+                                    f"limits (|xi|, |eta| <= {creep_max:g}, |phi| <= "
+                                    f"{spin_max:g} 1/m)")
+        if max(abs(v) for v in row[3:]) > 1e12:
+            raise InvalidInputError(f"{path}, line {line}: a force beyond 1e12 N")
+        values.append(row)
+        if len(values) > MAX_SAMPLES:
+            raise InvalidInputError(f"{path}: more than {MAX_SAMPLES:,} samples")
+    if not values:
+        raise InvalidInputError(f"{path}: no samples")
+    data = np.array(values)
+    return np.ascontiguousarray(data[:, :3]), np.ascontiguousarray(data[:, 3:])
+
+
+def run(args: argparse.Namespace) -> dict[str, Any]:
+    """Run ``estimate``: a dict of the results."""
+    from fastsim_ros.estimation.fit import fit_friction
+    from fastsim_ros.estimation.model import solver_for
+
+    cli._check_material(args.nu, args.shear_modulus)
+    cli._in_range("--mu", args.mu, "mu", open_low=True)
+    if args.load is not None and not args.load > 0.0:
+        raise InvalidInputError(f"--load must be positive, got {args.load:g}")
+    exponential = args.friction_law == "exponential"
+    if exponential:
+        if args.speed is None:
+            raise cli.UsageError("--friction-law exponential requires --speed")
+        cli._speed(args.speed)
+        if not 0.0 < args.friction_limit_ratio <= 1.0:
+            raise InvalidInputError("--friction-limit-ratio must lie in (0, 1], got "
+                                    f"{args.friction_limit_ratio:g}")
+        if not 0.0 <= args.friction_decay <= 1e4:
+            raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
+                                    f"{args.friction_decay:g}")
+    creepages, measured = read_measured(args.measured)
+    patch = cli._force_area(args)
+    solver: Any
+    if args.method == "exact":
+        from fastsim_ros.estimation.model import ExactSolver
+        if args.bound != "given":
+            raise cli.UsageError("--method exact takes the pressure as given (--bound given)")
+        if creepages.shape[0] > MAX_EXACT_SAMPLES:
+            raise InvalidInputError(f"--method exact takes at most {MAX_EXACT_SAMPLES} "
+                                    f"samples, got {creepages.shape[0]}")
+        cli._check_exact_grid(patch, forces=True)
+        solver = ExactSolver(args.nu, args.shear_modulus)
+    else:
+        solver = solver_for(args.method, args.nu, args.shear_modulus)
+    fit = fit_friction(solver, patch, creepages, measured, law=args.friction_law,
+                       speed=args.speed, bound=args.bound, mu0=args.mu,
+                       limit_ratio0=args.friction_limit_ratio, decay0=args.friction_decay)
+
+    def finite_or_none(v: float) -> float | None:
+        return v if math.isfinite(v) else None
+
+    result: dict[str, Any] = {
+        "mu_static": fit.mu_s, "friction_law": fit.law, "method": args.method,
+        "N": fit.load, "samples": int(creepages.shape[0]),
+        "components": ["Fx", "Fy"][:measured.shape[1]],
+        "sigma_mu_static": finite_or_none(fit.sigmas["mu_s"]),
+        "worst_error_percent_mu_N": fit.worst_error_percent,
+        "rms_error_percent_mu_N": fit.rms_error_percent, "evaluations": fit.evaluations}
+    if exponential:
+        result.update(friction_limit_ratio=fit.limit_ratio, friction_decay=fit.decay,
+                      sigma_friction_limit_ratio=finite_or_none(fit.sigmas["limit_ratio"]),
+                      sigma_friction_decay=finite_or_none(fit.sigmas["decay"]),
+                      speed=abs(args.speed))
+    cli._finite_result(result, ("mu_static", "worst_error_percent_mu_N",
+                                "rms_error_percent_mu_N"))
+    return result
+
+
+def print_table(result: dict[str, Any]) -> None:
+    """Print the fit readably."""
+    def pm(v: float, s: float | None) -> str:
+        return f"{v:.5g} +- {s:.2g}" if s is not None else f"{v:.5g} (undetermined)"
+
+    print(f"method {result['method']}, friction {result['friction_law']}, N = "
+          f"{result['N']:.6g} N, {result['samples']} samples of "
+          f"{', '.join(result['components'])}")
+    print(f"  mu_s = {pm(result['mu_static'], result['sigma_mu_static'])}")
+    if result["friction_law"] == "exponential":
+        print(f"  A = {pm(result['friction_limit_ratio'], result['sigma_friction_limit_ratio'])}")
+        print(f"  B = {pm(result['friction_decay'], result['sigma_friction_decay'])} s/m")
+    print(f"  fitted curve: worst error {result['worst_error_percent_mu_N']:.3g}% of mu N, "
+          f"rms {result['rms_error_percent_mu_N']:.3g}%")

@@ -1,0 +1,136 @@
+"""Batch fit of a friction law to a measured creep curve (``fastsim_contact estimate``).
+
+The measured samples (creepages ``xi, eta`` (1), ``phi`` (1/m); forces
+``Fx`` and optionally ``Fy`` (N), contact frame, METHOD.md's signs) on one
+patch are fitted by the package's solver (compiled, one batch per
+evaluation) under the friction law: ``mu_s`` for constant friction, ``mu_s``,
+the limit ratio ``A`` and the decay ``B`` (s/m) for the exponential law
+``mu(v) = mu_s ((1 - A) exp(-B v) + A)``.  Least squares over the residuals
+``(F_model - F_measured) / N`` by SciPy's trust-region reflective
+Gauss-Newton (bounds: ``mu_s > 0``, ``0 < A <= 1``, ``B >= 0``), forward
+differences for the Jacobian.  Standard deviations: the diagonal of
+``s^2 (J^T J)^-1``, ``s^2`` the residuals' variance (n - p degrees of
+freedom); a parameter the data do not determine (singular ``J^T J``) has
+none (``nan``).  The fitted curve's worst error is reported in % of
+``mu_s N``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.contact.friction import friction_law
+from fastsim_ros.estimation.model import ExactSolver, Solver
+
+FloatArray = NDArray[np.float64]
+#: bounds of the fitted parameters: mu_s, A (1), B (s/m)
+MU_RANGE = (1e-3, 5.0)
+LIMIT_RATIO_RANGE = (1e-3, 1.0)
+DECAY_RANGE = (0.0, 1e4)
+
+
+@dataclass(frozen=True)
+class FrictionFit:
+    """A fitted law: parameters, their standard deviations, the curve and its errors.
+
+    ``law``: ``"constant"`` or ``"exponential"``; ``mu_s`` (1), ``limit_ratio``
+    ``A`` (1) and ``decay`` ``B`` (s/m; 1 and 0 for constant friction);
+    ``sigmas``: standard deviation of each fitted parameter (nan where
+    undetermined); ``predicted``: the fitted model's forces, the measured
+    shape (N); ``worst_error_percent``: ``max |F_fit - F_measured|`` in % of
+    ``mu_s N``; ``rms_error_percent`` likewise; ``load`` ``N`` (N);
+    ``evaluations``: model evaluations (batches).
+    """
+
+    law: str
+    mu_s: float
+    limit_ratio: float
+    decay: float
+    sigmas: dict[str, float]
+    predicted: FloatArray
+    worst_error_percent: float
+    rms_error_percent: float
+    load: float
+    evaluations: int
+
+
+def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayLike,
+                 measured: ArrayLike,
+                 *, law: str = "constant", speed: float | None = None, bound: str = "given",
+                 mu0: float = 0.3, limit_ratio0: float = 0.5,
+                 decay0: float = 1.0) -> FrictionFit:
+    """Fit ``law`` to ``measured`` (``(n,)`` Fx or ``(n, 2)`` Fx, Fy in N) at ``creepages``.
+
+    ``creepages``: ``(n, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about the
+    area's origin; ``speed``: the rolling speed ``|V|`` (m/s), required by
+    the exponential law; ``mu0``, ``limit_ratio0``, ``decay0`` (s/m): the
+    starting point.
+    """
+    from scipy.optimize import least_squares
+
+    cr = np.ascontiguousarray(creepages, dtype=np.float64)
+    z = np.asarray(measured, dtype=np.float64)
+    if z.ndim == 1:
+        z = z[:, None]
+    if cr.ndim != 2 or cr.shape[1] != 3 or z.ndim != 2 or z.shape[0] != cr.shape[0] \
+            or z.shape[1] not in (1, 2):
+        raise InvalidInputError(f"creepages (n, 3) and measured (n,) or (n, 2) expected, got "
+                                f"{cr.shape} and {np.shape(measured)}")
+    exponential = law == "exponential"
+    if law not in ("constant", "exponential"):
+        raise InvalidInputError(f"unknown friction law {law!r}: constant or exponential")
+    if exponential and speed is None:
+        raise InvalidInputError("the exponential law needs the rolling speed (m/s)")
+    p = 3 if exponential else 1
+    n = cr.shape[0]
+    if n * z.shape[1] <= p:
+        raise InvalidInputError(f"{n} samples cannot determine {p} parameter(s): give more")
+    load = float(area.load)
+    evaluations = [0]
+
+    def forces(theta: FloatArray) -> FloatArray:
+        evaluations[0] += 1
+        if exponential:
+            f = friction_law("exponential", float(theta[0]), limit_ratio=float(theta[1]),
+                             decay=float(theta[2]))
+        else:
+            f = friction_law("constant", float(theta[0]))
+        out = solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, cr,
+                                 bound=bound, friction=f,  # type: ignore[arg-type]
+                                 speed=None if speed is None else abs(speed))
+        return out[:, :z.shape[1]]
+
+    def residuals(theta: FloatArray) -> FloatArray:
+        return ((forces(theta) - z) / load).ravel()
+
+    lo = [MU_RANGE[0]] + ([LIMIT_RATIO_RANGE[0], DECAY_RANGE[0]] if exponential else [])
+    hi = [MU_RANGE[1]] + ([LIMIT_RATIO_RANGE[1], DECAY_RANGE[1]] if exponential else [])
+    x0 = [mu0] + ([limit_ratio0, decay0] if exponential else [])
+    x0 = [min(max(v, a), b) for v, a, b in zip(x0, lo, hi)]
+    if exponential and x0[1] >= 1.0:
+        x0[1] = 0.5  # A = 1 is constant friction: no slope in B to start from
+    sol = least_squares(residuals, np.array(x0, dtype=np.float64), bounds=(lo, hi),
+                        method="trf", x_scale="jac", diff_step=1e-3, xtol=1e-10, ftol=1e-12,
+                        gtol=1e-12, max_nfev=200)
+    theta = sol.x
+    predicted = forces(theta)
+    dof = max(z.size - p, 1)
+    s2 = float(np.sum(sol.fun ** 2)) / dof
+    names = ("mu_s", "limit_ratio", "decay")[:p]
+    sigmas = {name: math.nan for name in names}
+    jtj = sol.jac.T @ sol.jac
+    if np.all(np.isfinite(jtj)) and np.linalg.cond(jtj) < 1e14:
+        cov = np.linalg.inv(jtj) * s2
+        sigmas = {name: math.sqrt(max(float(cov[i, i]), 0.0)) for i, name in enumerate(names)}
+    mu_n = float(theta[0]) * load
+    err = np.abs(predicted - z)
+    return FrictionFit(law, float(theta[0]), float(theta[1]) if exponential else 1.0,
+                       float(theta[2]) if exponential else 0.0, sigmas, predicted,
+                       float(err.max()) / mu_n * 100.0,
+                       float(np.sqrt(np.mean(err ** 2))) / mu_n * 100.0, load, evaluations[0])
