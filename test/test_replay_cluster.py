@@ -95,8 +95,9 @@ def test_a_corrupt_bag_among_good_ones_is_reported_once(tmp_path, cluster):
 # delay): ``before`` the run starts (no task ran on it: nothing retried), in the ``warm-up``
 # of its first task, in the ``replay`` (after the warm-up, the staged outputs half written),
 # between the renames of its outputs (``commit``) and after them with its result not yet
-# fetched (``committed``: the retry finishes that commit instead of replaying)
-MOMENTS = ("before",) + faults.MOMENTS
+# fetched (``committed``: the retry finishes that commit instead of replaying); and into
+# a URL (file://) between the moves of its commit
+MOMENTS = [(m, False) for m in ("before",) + faults.MOMENTS] + [("commit", True)]
 RETRIED = {"before": None, "warm-up": "retried: replayed 2 times",
            "replay": "retried: replayed 2 times", "commit": "retried: 2 attempts",
            "committed": "retried: 2 attempts"}
@@ -130,8 +131,8 @@ def reference(tmp_path_factory):
     return {n: (comparable(out / n), (out / f"{n}.csv").read_text()) for n in SOURCES}
 
 
-@pytest.mark.parametrize("moment", MOMENTS)
-def test_a_worker_killed_at_any_moment_loses_nothing(tmp_path, reference, moment):
+@pytest.mark.parametrize("moment, url", MOMENTS)
+def test_a_worker_killed_at_any_moment_loses_nothing(tmp_path, reference, moment, url):
     hold = tmp_path / "hold"
     hold.mkdir()
     logs = tmp_path / "logs"
@@ -151,7 +152,8 @@ def test_a_worker_killed_at_any_moment_loses_nothing(tmp_path, reference, moment
             cluster.workers[0].wait(timeout=30)
         proc = subprocess.Popen(
             [sys.executable, "-m", "fastsim_ros.replay", *(str(src / n) for n in names), "-o",
-             str(out), "--csv", "--scheduler", cluster.address], cwd=ROOT, env=ENV,
+             f"file://{out}" if url else str(out), "--csv", "--scheduler", cluster.address],
+            cwd=ROOT, env=ENV,
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             if moment != "before":
@@ -178,7 +180,7 @@ def test_a_worker_killed_at_any_moment_loses_nothing(tmp_path, reference, moment
         bag, csv = reference[name.rsplit("-", 1)[0]]
         assert (out / f"{name}.csv").read_text() == csv, name
         assert comparable(out / name) == bag, name
-    assert stdout.count(f"-> {out}/") == len(names)
+    assert stdout.count(f"-> {'file://' if url else ''}{out}/") == len(names)
     if RETRIED[moment] is None:
         assert "retried" not in stdout
     else:

@@ -228,9 +228,11 @@ def _run_local(task: Task, profile: bool) -> Result:
         for tmp, final in zip(staged, finals):
             os.rename(tmp, final)
             moved.append(final)
-            faults.pause("commit")
+            if task.retry:
+                faults.pause("commit")
         done = True
-        faults.pause("committed")
+        if task.retry:
+            faults.pause("committed")
     except BadInput as e:
         result.status, result.error = 2, str(e)
     except OutputError as e:
@@ -251,8 +253,32 @@ def _run_local(task: Task, profile: bool) -> Result:
 
 
 def _run_fetched(task: Task, profile: bool) -> Result:
-    """Replay an input or into an output that is a URL, through local copies."""
+    """Replay an input or into an output that is a URL, through local copies.
+
+    Into a URL, as into a local OUT: the attempt's staging directory at the
+    URL is marked first, an earlier attempt's journalled commit is finished
+    rather than replayed again (:func:`~fastsim_ros.replay.storage.commit`).
+    """
     tag = task.tag or str(os.getpid())
+    attempt, name = 1, ""
+    if storage.is_url(task.out):
+        out = str(task.out)
+        earlier = _earlier_attempts(out, task.name, tag)
+        attempt = 1 + max((_attempt_number(n, task.name, tag) for n in earlier), default=0)
+        name = f"{staging_prefix(task.name, tag)}{attempt}-{uuid.uuid4().hex[:12]}{STAGING}"
+        try:
+            storage.mark(out, name)   # this attempt's mark, first
+            committed = [n for n in earlier if storage.exists(f"{out.rstrip('/')}/{n}/{JOURNAL}")]
+            if committed:
+                result: Result = pickle.loads(storage.finish_commit(out, committed[0], JOURNAL))
+                result.attempts, result.resumed = attempt, True
+                return result
+        except Exception as e:
+            result = Result(str(task.source), task.name, status=1, attempts=attempt)
+            result.error = f"{out}: cannot write: {problem(e)}"
+            return result
+        for leftover in earlier:
+            storage.remove(out, leftover)
     with tempfile.TemporaryDirectory(prefix="fastsim-replay-") as tmp:
         local = Path(tmp)
         source: Path | str = task.source
@@ -260,6 +286,8 @@ def _run_fetched(task: Task, profile: bool) -> Result:
             try:
                 source = storage.fetch(str(task.source), local / "in")
             except Exception as e:
+                if name:
+                    storage.remove(str(task.out), name)
                 result = Result(str(task.source), task.name, status=2)
                 result.error = f"{task.source}: cannot fetch: {problem(e)}"
                 return result
@@ -268,25 +296,27 @@ def _run_fetched(task: Task, profile: bool) -> Result:
             result.source = str(task.source)
             result.error = result.error.replace(str(source), str(task.source))
             return result
-        out = str(task.out)
-        earlier = _earlier_attempts(out, task.name, tag)
-        for leftover in earlier:
-            storage.remove(out, leftover)
         staged = local / "out"
         staged.mkdir()
-        result = _run_local(replace(task, source=source, out=staged), profile)
+        result = _run_local(replace(task, source=source, out=staged, retry=False), profile)
         result.source = str(task.source)
         result.error = result.error.replace(str(source), str(task.source))
-        result.attempts = 1 + len(earlier)
-        if result.ok:
-            name = f"{staging_prefix(task.name, tag)}{uuid.uuid4().hex[:12]}{STAGING}"
-            try:
-                result.written = storage.commit(staged, [Path(p).name for p in result.written],
-                                                out, name)
-            except OSError as e:
-                storage.remove(out, name)
-                result.ok, result.status, result.written = False, 1, []
-                result.error = f"{out}: cannot write: {problem(e)}"
+        result.attempts = attempt
+        if not result.ok:
+            storage.remove(out, name)
+            return result
+        names = [Path(p).name for p in result.written]
+        result.written = [f"{out.rstrip('/')}/{n}" for n in names]
+        try:
+            storage.commit(staged, names, out, name,
+                           journal=(JOURNAL, pickle.dumps(result)) if task.retry else None)
+        except OSError as e:
+            storage.remove(out, name)
+            result.ok, result.status, result.written = False, 1, []
+            result.error = f"{out}: cannot write: {problem(e)}"
+        else:
+            if task.retry:
+                faults.pause("committed")
         return result
 
 
