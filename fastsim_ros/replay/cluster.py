@@ -211,13 +211,20 @@ class LocalProcesses:
                                 env=self.env, stdout=log, stderr=subprocess.STDOUT)
 
     def close(self) -> None:
-        """End the workers, then the scheduler."""
-        for p in reversed(self.procs):
-            if p.poll() is None:
-                p.terminate()
-        for p in self.procs:
-            try:
-                p.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait(timeout=15)
+        """End the workers, then (once they are gone) the scheduler.
+
+        Not all at once: a worker whose scheduler goes away while it closes
+        can hang in its own close (Dask's ``Worker.close`` cancelled) until
+        it is killed.
+        """
+        workers = [p for p in self.procs if p in self.workers]
+        for group in (workers, [p for p in self.procs if p not in workers]):
+            for p in group:
+                if p.poll() is None:
+                    p.terminate()
+            for p in group:
+                try:
+                    p.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait(timeout=15)
