@@ -124,7 +124,7 @@ def comparable(bag: Path):
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
-    """The outputs of a ``--jobs 1`` run of the sources (no --params: contacts from the bags)."""
+    """Replay the sources with ``--jobs 1`` (no --params: contacts from the bags); keep them."""
     out = tmp_path_factory.mktemp("reference") / "out"
     proc = replay(*[BAGS / n for n in SOURCES], "-o", out, "--csv", "--jobs", "1")
     assert proc.returncode == 0, proc.stderr
