@@ -2,9 +2,11 @@
 
 Each test's cluster is a scheduler and two worker processes started by the
 test (the venv's python, this checkout on their path) and torn down after.
-The outputs must equal a local ``--jobs 1`` run; a worker killed while it
-replays must leave every output present once and complete (its task run
-again, the summary saying so); a corrupt bag among good ones is reported
+The outputs must equal a local ``--jobs 1`` run; a worker killed at any
+moment of a task (before the run, in its warm-up, replaying, between the
+renames of its outputs, after them) must leave every output present once,
+complete and equal to a ``--jobs 1`` run (its task run again, the summary
+saying so); a corrupt bag among good ones is reported
 once; fsspec URLs work for inputs and outputs; a scheduler that cannot be
 reached is one line.
 """
@@ -25,8 +27,9 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
+from fastsim_ros.replay import faults  # noqa: E402
 from fastsim_ros.replay.cluster import LocalProcesses  # noqa: E402
-from test_replay import BAGS, bag_contents, decoded_without_timing  # noqa: E402
+from test_replay import BAGS, DIAG, TYPES, bag_contents, decoded_without_timing  # noqa: E402
 
 ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(
     [str(ROOT)] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
@@ -88,35 +91,100 @@ def test_a_corrupt_bag_among_good_ones_is_reported_once(tmp_path, cluster):
     assert proc.stdout.count("messages in") == 2
 
 
-def test_a_killed_worker_leaves_every_output_once_and_whole(tmp_path, cluster):
-    src = tmp_path / "in"
-    src.mkdir()
-    # 24 bags: each replays in about 25 ms, so the workers stay busy long enough for the
-    # test to see both at work before the run ends, even on a loaded machine
-    bags = 24
-    for k in range(bags):
-        (src / f"f{k}").symlink_to(BAGS / "flange_shift", target_is_directory=True)
-    out = tmp_path / "out"
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "fastsim_ros.replay", *sorted(map(str, src.iterdir())), "-o",
-         str(out), "--csv", "--params", str(BAGS / "flange_shift.params.yaml"), "--scheduler",
-         cluster.address], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-        text=True)
-    # both workers busy (two staging directories), then one dies at once (SIGKILL)
-    deadline = time.monotonic() + 120
-    while not (out.is_dir() and sum(p.name.endswith(".replay-tmp") for p in out.iterdir()) >= 2):
-        assert time.monotonic() < deadline and proc.poll() is None
-        time.sleep(0.005)
-    cluster.workers[0].send_signal(signal.SIGKILL)
-    stdout, stderr = proc.communicate(timeout=300)
+# a worker killed at each moment of a task, held there by the faults hook (never a guessed
+# delay): ``before`` the run starts (no task ran on it: nothing retried), in the ``warm-up``
+# of its first task, in the ``replay`` (after the warm-up, the staged outputs half written),
+# between the renames of its outputs (``commit``) and after them with its result not yet
+# fetched (``committed``: the retry finishes that commit instead of replaying); and into
+# a URL (file://) between the moves of its commit
+MOMENTS = [(m, False) for m in ("before",) + faults.MOMENTS] + [("commit", True)]
+RETRIED = {"before": None, "warm-up": "retried: replayed 2 times",
+           "replay": "retried: replayed 2 times", "commit": "retried: 2 attempts",
+           "committed": "retried: 2 attempts"}
+SOURCES = ("flange_shift", "hertz_ramp", "semi_ellipses_spin")
+COPIES = 4   # 12 bags
+
+
+def comparable(bag: Path):
+    """Return a bag's messages by topic: raw CDR, the diagnostics decoded without timing."""
+    raw: dict[str, list] = {}
+    diagnostics: dict[str, tuple] = {}
+    with Reader(bag) as reader:
+        count = reader.message_count
+        for conn, log_ns, data in reader.messages():
+            if conn.msgtype == DIAG:
+                diagnostics.setdefault(conn.topic, (DIAG, []))[1].append(
+                    (log_ns, TYPES.deserialize_cdr(data, DIAG)))
+            else:
+                raw.setdefault(conn.topic, []).append((log_ns, bytes(data)))
+    assert sum(len(v) for v in raw.values()) + sum(len(v[1]) for v in diagnostics.values()) \
+        == count
+    return raw, decoded_without_timing(diagnostics)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """Replay the sources with ``--jobs 1`` (no --params: contacts from the bags); keep them."""
+    out = tmp_path_factory.mktemp("reference") / "out"
+    proc = replay(*[BAGS / n for n in SOURCES], "-o", out, "--csv", "--jobs", "1")
+    assert proc.returncode == 0, proc.stderr
+    return {n: (comparable(out / n), (out / f"{n}.csv").read_text()) for n in SOURCES}
+
+
+@pytest.mark.parametrize("moment, url", MOMENTS)
+def test_a_worker_killed_at_any_moment_loses_nothing(tmp_path, reference, moment, url):
+    hold = tmp_path / "hold"
+    hold.mkdir()
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    # both workers may be held; the first to reach the moment is, the other goes on
+    env = ENV if moment == "before" else dict(ENV, **{faults.ENV: f"{moment}:{hold}"})
+    cluster = LocalProcesses(logs, 2, env=env, cwd=ROOT)
+    try:
+        src = tmp_path / "in"
+        src.mkdir()
+        names = [f"{n}-{k}" for k in range(COPIES) for n in SOURCES]
+        for name in names:
+            (src / name).symlink_to(BAGS / name.rsplit("-", 1)[0], target_is_directory=True)
+        out = tmp_path / "out"
+        if moment == "before":
+            cluster.workers[0].kill()
+            cluster.workers[0].wait(timeout=30)
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "fastsim_ros.replay", *(str(src / n) for n in names), "-o",
+             f"file://{out}" if url else str(out), "--csv", "--scheduler", cluster.address],
+            cwd=ROOT, env=ENV,
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            if moment != "before":
+                deadline = time.monotonic() + faults.PAUSE_S
+                while not (hold / "pid").exists():
+                    assert proc.poll() is None and time.monotonic() < deadline
+                    time.sleep(0.01)
+                pid = int((hold / "pid").read_text())
+                victim = next(w for w in cluster.workers if w.pid == pid)
+                victim.kill()   # SIGKILL: no clean-up of its own
+                victim.wait(timeout=30)
+            stdout, stderr = proc.communicate(timeout=120)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+    finally:
+        cluster.close()
     assert proc.returncode == 0, stderr
-    assert "retried: replayed 2 times" in stdout
-    names = sorted(p.name for p in out.iterdir())
-    assert names == sorted([f"f{k}" for k in range(bags)] + [f"f{k}.csv" for k in range(bags)])
-    for k in range(bags):
-        with Reader(out / f"f{k}") as reader:
-            assert sum(1 for _ in reader.messages()) == reader.message_count > 4000
-        assert (out / f"f{k}.csv").read_text() == (out / "f0.csv").read_text()
+    assert stderr == ""
+    # every output once, nothing else left (no staging directory, no kept result)
+    assert sorted(p.name for p in out.iterdir()) == sorted(names + [f"{n}.csv" for n in names])
+    for name in names:
+        bag, csv = reference[name.rsplit("-", 1)[0]]
+        assert (out / f"{name}.csv").read_text() == csv, name
+        assert comparable(out / name) == bag, name
+    assert stdout.count(f"-> {'file://' if url else ''}{out}/") == len(names)
+    if RETRIED[moment] is None:
+        assert "retried" not in stdout
+    else:
+        assert stdout.count("retried:") == 1 and stdout.count(RETRIED[moment]) == 1, stdout
 
 
 def test_a_lost_scheduler_is_one_line_and_the_written_outputs_stay(tmp_path, cluster):

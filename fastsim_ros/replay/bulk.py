@@ -29,7 +29,7 @@ from rosbags.rosbag2.metadata import dump_qos_v9
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
                                   Outcome, Pipeline)
 from fastsim_ros.profile_pipeline import AnyPipeline
-from fastsim_ros.replay import bagio, batch, encode, kernels, mcap
+from fastsim_ros.replay import bagio, batch, encode, faults, kernels, mcap
 from fastsim_ros.replay.errors import BadInput
 from fastsim_ros.replay.results import Result
 
@@ -232,6 +232,8 @@ class IndexedReplay:
                 base += n
                 last = int(log[-1])
                 self.result.messages_in += n
+                if base == n:   # the first window replayed, its outputs half written
+                    faults.pause("replay")
                 if progress is not None:
                     progress(n)
                 t_read = time.perf_counter()

@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import os
 import re
-import shutil
 import signal
 import sys
 from collections.abc import Sequence
@@ -20,7 +19,7 @@ from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
 from fastsim_ros.replay import storage
 from fastsim_ros.replay.cluster import ClusterError
 from fastsim_ros.replay.errors import problem
-from fastsim_ros.replay.run import PROG, STAGING, Task, targets
+from fastsim_ros.replay.run import PROG, Task, remove_staging, targets, warm_up
 
 
 class _Parser(argparse.ArgumentParser):
@@ -153,8 +152,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             from fastsim_ros.replay.cluster import Cluster
             executor = Cluster(args.scheduler, progress=not args.no_progress)
         else:
-            from fastsim_ros.replay.cluster import warm_worker
-            warm_worker()  # load the kernels once (forked workers inherit them)
+            warm_up()  # load the kernels once (forked workers inherit them)
             executor = InProcess() if jobs == 1 else LocalPool(jobs)
         for r in executor.results(tasks):
             for w in r.warnings:
@@ -164,11 +162,12 @@ def main(argv: Sequence[str] | None = None) -> int:
             else:
                 print(f"{PROG}: {r.error}", file=sys.stderr, flush=True)
                 status = max(status, r.status)
+        remove_staging(out, tag)  # every result in: what a cluster's attempts kept
     except KeyboardInterrupt:
         if executor is not None:
             executor.stop()
             executor = None
-        _clean(out, tag)
+        remove_staging(out, tag)
         print(f"{PROG}: interrupted; nothing left of the unfinished inputs", file=sys.stderr)
         return 130
     except ClusterError as e:
@@ -180,13 +179,3 @@ def main(argv: Sequence[str] | None = None) -> int:
             executor.close()
         signal.signal(signal.SIGTERM, previous)
     return status
-
-
-def _clean(out: Path | str, tag: str) -> None:
-    """Remove this run's temporary directories from OUT."""
-    for name in storage.listing(out):
-        if name.startswith(".") and f".{tag}." in name and name.endswith(STAGING):
-            if storage.is_url(out):
-                storage.remove(str(out), name)
-            else:
-                shutil.rmtree(Path(out) / name, ignore_errors=True)

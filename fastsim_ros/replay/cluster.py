@@ -6,10 +6,16 @@ have this package installed and, for local paths, see the same files as the
 client: a shared file system, or fsspec URLs).  The task stages and commits
 its own outputs, so what the cluster adds is only where it runs:
 
-- a worker that dies mid-bag: the scheduler runs the task again on another
-  worker (Dask's own rescheduling of the tasks of a lost worker); the new
-  attempt removes what the dead one left in OUT and counts itself
-  (``Result.attempts``, in the summary);
+- no broadcast to the workers, which one dead worker would break: each
+  worker loads the compiled kernels in its first task
+  (:func:`~fastsim_ros.replay.run.warm_up`, once per process);
+- a worker that dies at any moment of a task (its warm-up, the replay, the
+  renames of its outputs, after them with its result not yet fetched): the
+  scheduler runs the task again on another worker (Dask's own rescheduling
+  of a lost worker's tasks, and of the results it held); the new attempt
+  removes what the dead one left in OUT, or finishes its commit and
+  returns its result if it had committed (``Task.retry``), and counts
+  itself (``Result.attempts``, in the summary);
 - a bad bag is a result with its one-line error, not a failed task: it is
   reported once and never retried;
 - a task whose workers kept dying (Dask's ``allowed-failures``): reported
@@ -28,12 +34,13 @@ import sys
 import time
 from collections.abc import Iterator, Sequence
 from concurrent.futures import CancelledError
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from fastsim_ros.replay.errors import problem
 from fastsim_ros.replay.results import Result
-from fastsim_ros.replay.run import Task, run_task
+from fastsim_ros.replay.run import Task, run_task, warm_up
 
 #: seconds to wait for the scheduler when connecting
 CONNECT_TIMEOUT = 10.0
@@ -52,13 +59,8 @@ class ClusterError(Exception):
 
 
 def warm_worker() -> str:
-    """Load the compiled kernels on a worker (numba's disk cache), once per worker process."""
-    from fastsim_ros.contact import compiled
-    from fastsim_ros.replay import batch
-    from msg_adapters import patch
-    compiled.warm_up()
-    patch.warm_up()
-    batch.warm_up()
+    """Load the compiled kernels (numba's disk cache), once per process: :func:`warm_up`."""
+    warm_up()
     return "ok"
 
 
@@ -83,11 +85,9 @@ class Cluster:
         """Submit every task; yield the results in the tasks' order."""
         from distributed import as_completed
         client = self.client
-        try:
-            client.run(warm_worker)
-        except Exception as e:
-            raise ClusterError(f"the workers of {self.address} cannot load the package: "
-                               f"{problem(e)}") from None
+        # each attempt keeps its committed result until the end of the run (the command
+        # line removes it): a worker lost with the result not yet fetched costs no replay
+        tasks = [replace(t, retry=True) for t in tasks]
         # all the tasks in one message (client.map, not a submit each) and the results
         # fetched by the batch as they complete (not a round trip each): on a small cluster
         # the client and the scheduler share the cores with the workers, a few ms per bag
@@ -124,6 +124,10 @@ class Cluster:
             result = Result(str(task.source), task.name, status=1,
                             error=f"{task.source}: the workers replaying it died "
                                   f"({problem(e)})")
+        except ImportError as e:   # the worker has not this package (or not all of it)
+            result = Result(str(task.source), task.name, status=1,
+                            error=f"{task.source}: the workers of {self.address} cannot "
+                                  f"load the package: {problem(e)}")
         except Exception as e:
             lost = (CancelledError, OSError, CommClosedError)
             if self.client.status != "running" or isinstance(e, lost):
@@ -207,13 +211,20 @@ class LocalProcesses:
                                 env=self.env, stdout=log, stderr=subprocess.STDOUT)
 
     def close(self) -> None:
-        """End the workers, then the scheduler."""
-        for p in reversed(self.procs):
-            if p.poll() is None:
-                p.terminate()
-        for p in self.procs:
-            try:
-                p.wait(timeout=15)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait(timeout=15)
+        """End the workers, then (once they are gone) the scheduler.
+
+        Not all at once: a worker whose scheduler goes away while it closes
+        can hang in its own close (Dask's ``Worker.close`` cancelled) until
+        it is killed.
+        """
+        workers = [p for p in self.procs if p in self.workers]
+        for group in (workers, [p for p in self.procs if p not in workers]):
+            for p in group:
+                if p.poll() is None:
+                    p.terminate()
+            for p in group:
+                try:
+                    p.wait(timeout=15)
+                except subprocess.TimeoutExpired:
+                    p.kill()
+                    p.wait(timeout=15)

@@ -59,6 +59,7 @@ class Result:
     kinematics: dict[str, int] = field(default_factory=dict)
     written: list[str] = field(default_factory=list)
     attempts: int = 1
+    resumed: bool = False
     profile: Profile | None = None
 
     @property
@@ -102,7 +103,11 @@ class Result:
                         if dropped else ""))
         lines.append(f"  replay: {self.wall_s - self.plot_s:.2f} s, {self.speed:.1f}x real time"
                      + (f"; plot {self.plot_s:.2f} s" if self.plot_s else ""))
-        if self.attempts > 1:
+        if self.attempts > 1 and self.resumed:
+            lines.append(f"  retried: {self.attempts} attempts (a worker died after writing "
+                         "the outputs, before its result came back: its commit finished, "
+                         "nothing replayed again)")
+        elif self.attempts > 1:
             lines.append(f"  retried: replayed {self.attempts} times (a worker died while "
                          "replaying it; what it left was removed)")
         lines += [f"  wrote {p}" for p in self.written[1:]]

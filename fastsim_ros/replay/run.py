@@ -19,6 +19,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import pickle
 import shutil
 import sys
 import tempfile
@@ -34,7 +35,7 @@ from rclpy.serialization import serialize_message
 from fastsim_ros.params import SPECS, ParameterError
 from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig
 from fastsim_ros.profile_pipeline import AnyPipeline, make_pipeline
-from fastsim_ros.replay import bagio, bulk, heap, storage
+from fastsim_ros.replay import bagio, bulk, faults, heap, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
 from fastsim_ros.replay.records import CSV_HEADER, Series, record
@@ -48,6 +49,9 @@ _PROGRESS_EVERY = 256
 _KINEMATICS = ("wheel_twist", "rail_twist")
 #: how staging directories end
 STAGING = ".replay-tmp"
+#: the committed result, pickled, in the staging directory of a task that may run again
+#: (``Task.retry``): written before its outputs are renamed into place
+JOURNAL = "result.pickle"
 
 
 @dataclass(frozen=True)
@@ -64,7 +68,12 @@ class Task:
     indexed MCAP input by the chunk, batched where the batch applies),
     ``"messages"`` (by the chunk, every message through the pipeline's
     handlers) or ``"rosbags"`` (rosbags' reader and writer, message by
-    message: the reference the others are tested against).
+    message: the reference the others are tested against).  ``retry``:
+    the task may run again after its process died, even after it committed
+    (a cluster): its staging directory then keeps the committed result
+    (:data:`JOURNAL`) until the run's client removes it
+    (:func:`remove_staging`), so that another attempt finishes that commit
+    and returns that result instead of replaying again.
     """
 
     source: Path | str
@@ -78,6 +87,7 @@ class Task:
     tag: str = ""
     progress: bool = False
     path: str = "auto"
+    retry: bool = False
 
 
 def targets(out: Any, name: str, plot: bool, write_csv: bool) -> list[Any]:
@@ -105,15 +115,41 @@ def run_task(task: Task, *, profile: bool = False) -> Result:
     are removed.  ``profile``: time each phase
     (:class:`~fastsim_ros.replay.results.Profile`, for the benchmark).
 
-    Each attempt stages under a name of its own (``.NAME.TAG.ID.replay-tmp``
-    in OUT); what an earlier attempt of the same run left there (a worker
-    that died while replaying it) is removed first and counted in
-    ``Result.attempts``.
+    Each attempt first makes a staging directory of its own in OUT
+    (``.NAME.TAG.K-ID.replay-tmp``, ``K`` its attempt number), then loads
+    the kernels (:func:`warm_up`, once per process), replays into it and
+    renames the outputs into place.  What an earlier attempt of the same
+    run left there (a worker that died) is removed, or, if that attempt
+    had committed (``Task.retry``: its :data:`JOURNAL`), its commit is
+    finished and its result returned; ``Result.attempts`` counts them.
     """
     heap.keep_freed_memory()   # once per process: chunk buffers reused, not faulted in anew
     if storage.is_url(task.source) or storage.is_url(task.out):
         return _run_fetched(task, profile)
     return _run_local(task, profile)
+
+
+_warm = False
+
+
+def warm_up() -> None:
+    """Load the compiled kernels (numba's disk cache), once per process.
+
+    On a cluster each worker's first task does it (inside the task: a
+    worker that dies meanwhile costs that task one more attempt, never the
+    run); locally the main process does it before forking its pool.
+    """
+    global _warm
+    if _warm:
+        return
+    from fastsim_ros.contact import compiled
+    from fastsim_ros.replay import batch
+    from msg_adapters import patch
+    compiled.warm_up()
+    faults.pause("warm-up")
+    patch.warm_up()
+    batch.warm_up()
+    _warm = True
 
 
 def staging_prefix(name: str, tag: str) -> str:
@@ -126,28 +162,77 @@ def _earlier_attempts(out: Path | str, name: str, tag: str) -> list[str]:
     return [n for n in storage.listing(out) if n.startswith(prefix) and n.endswith(STAGING)]
 
 
+def _attempt_number(staging_name: str, name: str, tag: str) -> int:
+    """Return the attempt number ``K`` of a staging directory's name (0 if it has none)."""
+    number = staging_name[len(staging_prefix(name, tag)):].partition("-")[0]
+    return int(number) if number.isdigit() else 0
+
+
+def remove_staging(out: Path | str, tag: str) -> None:
+    """Remove the staging directories (and kept results) of the run ``tag`` from OUT."""
+    for name in storage.listing(out):
+        if name.startswith(".") and f".{tag}." in name and name.endswith(STAGING):
+            if storage.is_url(out):
+                storage.remove(str(out), name)
+            else:
+                shutil.rmtree(Path(out) / name, ignore_errors=True)
+
+
+def _finish_commit(out: Path, earlier: Path, attempt: int) -> Result:
+    """Finish the commit of an attempt that died after writing its journal; return its result.
+
+    Its outputs were complete when it wrote the journal: those not yet
+    renamed into place are renamed from its staging directory now.
+    """
+    result: Result = pickle.loads((earlier / JOURNAL).read_bytes())
+    for final in map(Path, result.written):
+        if not os.path.lexists(final):
+            os.rename(earlier / final.name, final)
+    result.attempts, result.resumed = attempt, True
+    return result
+
+
 def _run_local(task: Task, profile: bool) -> Result:
     source, name, out = task.source, task.name, Path(task.out)
     result = Result(str(source), name)
     tag = task.tag or str(os.getpid())
-    earlier = _earlier_attempts(out, name, tag)
-    for leftover in earlier:  # a worker that died while replaying this input
-        shutil.rmtree(out / leftover, ignore_errors=True)
-    result.attempts = 1 + len(earlier)
-    staging = out / f"{staging_prefix(name, tag)}{uuid.uuid4().hex[:12]}{STAGING}"
+    earlier = _earlier_attempts(out, name, tag)   # of workers that died replaying this input
+    attempt = 1 + max((_attempt_number(n, name, tag) for n in earlier), default=0)
+    result.attempts = attempt
+    staging = out / f"{staging_prefix(name, tag)}{attempt}-{uuid.uuid4().hex[:12]}{STAGING}"
     done = False
+    moved: list[Path] = []
     try:
-        staging.mkdir()
+        staging.mkdir()   # this attempt's mark, first: an attempt that dies from here counts
+        committed = [n for n in earlier if (out / n / JOURNAL).is_file()]
+        if committed:
+            result = _finish_commit(out, out / committed[0], attempt)
+            done = True
+            return result
+        for leftover in earlier:
+            shutil.rmtree(out / leftover, ignore_errors=True)
+        warm_up()
         with bagio.fast_yaml():
             _replay(task, staging, profile, result)
-        for tmp in targets(staging, name, task.plot, task.write_csv):
-            final = out / tmp.name
+        staged = targets(staging, name, task.plot, task.write_csv)
+        finals = [out / tmp.name for tmp in staged]
+        for final in finals:
             if os.path.lexists(final):
                 raise OutputError(f"{final}: appeared while replaying; not overwritten")
-            os.rename(tmp, final)
-            result.written.append(str(final))
-        done = True
         result.ok = True
+        result.written = [str(f) for f in finals]
+        if task.retry:   # the result, before any output is in place (renamed whole)
+            journal = staging / f"{JOURNAL}.tmp"
+            journal.write_bytes(pickle.dumps(result))
+            os.rename(journal, staging / JOURNAL)
+        for tmp, final in zip(staged, finals):
+            os.rename(tmp, final)
+            moved.append(final)
+            if task.retry:
+                faults.pause("commit")
+        done = True
+        if task.retry:
+            faults.pause("committed")
     except BadInput as e:
         result.status, result.error = 2, str(e)
     except OutputError as e:
@@ -157,18 +242,43 @@ def _run_local(task: Task, profile: bool) -> Result:
     except Exception as e:  # a bug: still one line, and the other inputs go on
         result.status, result.error = 1, f"{source}: internal error: {problem(e)}"
     finally:
-        shutil.rmtree(staging, ignore_errors=True)
+        if not (done and task.retry):   # a committed result stays for another attempt
+            shutil.rmtree(staging, ignore_errors=True)
         if not done:
-            for p in result.written:  # a partial rename: take back what this bag put there
-                shutil.rmtree(p, ignore_errors=True) if os.path.isdir(p) else \
-                    Path(p).unlink(missing_ok=True)
+            result.ok = False
+            for p in moved:  # a partial rename: take back what this bag put there
+                shutil.rmtree(p, ignore_errors=True) if p.is_dir() else p.unlink(missing_ok=True)
             result.written = []
     return result
 
 
 def _run_fetched(task: Task, profile: bool) -> Result:
-    """Replay an input or into an output that is a URL, through local copies."""
+    """Replay an input or into an output that is a URL, through local copies.
+
+    Into a URL, as into a local OUT: the attempt's staging directory at the
+    URL is marked first, an earlier attempt's journalled commit is finished
+    rather than replayed again (:func:`~fastsim_ros.replay.storage.commit`).
+    """
     tag = task.tag or str(os.getpid())
+    attempt, name = 1, ""
+    if storage.is_url(task.out):
+        out = str(task.out)
+        earlier = _earlier_attempts(out, task.name, tag)
+        attempt = 1 + max((_attempt_number(n, task.name, tag) for n in earlier), default=0)
+        name = f"{staging_prefix(task.name, tag)}{attempt}-{uuid.uuid4().hex[:12]}{STAGING}"
+        try:
+            storage.mark(out, name)   # this attempt's mark, first
+            committed = [n for n in earlier if storage.exists(f"{out.rstrip('/')}/{n}/{JOURNAL}")]
+            if committed:
+                result: Result = pickle.loads(storage.finish_commit(out, committed[0], JOURNAL))
+                result.attempts, result.resumed = attempt, True
+                return result
+        except Exception as e:
+            result = Result(str(task.source), task.name, status=1, attempts=attempt)
+            result.error = f"{out}: cannot write: {problem(e)}"
+            return result
+        for leftover in earlier:
+            storage.remove(out, leftover)
     with tempfile.TemporaryDirectory(prefix="fastsim-replay-") as tmp:
         local = Path(tmp)
         source: Path | str = task.source
@@ -176,6 +286,8 @@ def _run_fetched(task: Task, profile: bool) -> Result:
             try:
                 source = storage.fetch(str(task.source), local / "in")
             except Exception as e:
+                if name:
+                    storage.remove(str(task.out), name)
                 result = Result(str(task.source), task.name, status=2)
                 result.error = f"{task.source}: cannot fetch: {problem(e)}"
                 return result
@@ -184,25 +296,27 @@ def _run_fetched(task: Task, profile: bool) -> Result:
             result.source = str(task.source)
             result.error = result.error.replace(str(source), str(task.source))
             return result
-        out = str(task.out)
-        earlier = _earlier_attempts(out, task.name, tag)
-        for leftover in earlier:
-            storage.remove(out, leftover)
         staged = local / "out"
         staged.mkdir()
-        result = _run_local(replace(task, source=source, out=staged), profile)
+        result = _run_local(replace(task, source=source, out=staged, retry=False), profile)
         result.source = str(task.source)
         result.error = result.error.replace(str(source), str(task.source))
-        result.attempts = 1 + len(earlier)
-        if result.ok:
-            name = f"{staging_prefix(task.name, tag)}{uuid.uuid4().hex[:12]}{STAGING}"
-            try:
-                result.written = storage.commit(staged, [Path(p).name for p in result.written],
-                                                out, name)
-            except OSError as e:
-                storage.remove(out, name)
-                result.ok, result.status, result.written = False, 1, []
-                result.error = f"{out}: cannot write: {problem(e)}"
+        result.attempts = attempt
+        if not result.ok:
+            storage.remove(out, name)
+            return result
+        names = [Path(p).name for p in result.written]
+        result.written = [f"{out.rstrip('/')}/{n}" for n in names]
+        try:
+            storage.commit(staged, names, out, name,
+                           journal=(JOURNAL, pickle.dumps(result)) if task.retry else None)
+        except OSError as e:
+            storage.remove(out, name)
+            result.ok, result.status, result.written = False, 1, []
+            result.error = f"{out}: cannot write: {problem(e)}"
+        else:
+            if task.retry:
+                faults.pause("committed")
         return result
 
 

@@ -78,12 +78,38 @@ def fetch(url: str, into: Path) -> Path:
     return local
 
 
-def commit(local_out: Path, names: list[str], url: str, staging_name: str) -> list[str]:
+#: the empty file that marks an attempt's staging directory at a URL (from its start)
+MARK = ".attempt"
+
+
+def mark(url: str, staging_name: str) -> None:
+    """Make ``url/staging_name/`` with its :data:`MARK`: an attempt's first act."""
+    fs, root = filesystem(url)
+    staging = posixpath.join(root, staging_name)
+    fs.makedirs(staging, exist_ok=True)
+    fs.pipe_file(posixpath.join(staging, MARK), b"")
+
+
+def _moves(fs: Any, root: str, staging: str, moves: list[tuple[str, str]]) -> None:
+    """Move staged files into place (``metadata.yaml`` last: callers order them)."""
+    from fastsim_ros.replay import faults
+    for tmp, final in moves:
+        fs.makedirs(posixpath.dirname(final), exist_ok=True)
+        fs.mv(tmp, final)
+        faults.pause("commit")
+
+
+def commit(local_out: Path, names: list[str], url: str, staging_name: str,
+           journal: tuple[str, bytes] | None = None) -> list[str]:
     """Upload ``names`` (files and bag directories in ``local_out``) to the directory ``url``.
 
     Staged under ``url/staging_name/`` and moved into place file by file,
-    each bag's ``metadata.yaml`` last; return the final URLs.  Raises
-    ``OSError`` (the caller removes what was staged: :func:`remove`).
+    each bag's ``metadata.yaml`` last; return the final URLs.  ``journal``
+    (a file name and its bytes): written into the staging directory (whole:
+    under a temporary name, then moved) once everything is uploaded and
+    before the first move; the staging directory then stays (the journal
+    in it) for :func:`finish_commit`, and for the caller to remove.
+    Raises ``OSError`` (the caller removes what was staged: :func:`remove`).
     """
     fs, root = filesystem(url)
     staging = posixpath.join(root, staging_name)
@@ -98,12 +124,36 @@ def commit(local_out: Path, names: list[str], url: str, staging_name: str) -> li
             fs.makedirs(posixpath.dirname(tmp), exist_ok=True)
             fs.put_file(str(f), tmp)
             (last if f.name == METADATA else moves).append((tmp, final))
-    for tmp, final in moves + last:
-        fs.makedirs(posixpath.dirname(final), exist_ok=True)
-        fs.mv(tmp, final)
-    remove(url, staging_name)
+    if journal is not None:
+        file, data = journal
+        fs.pipe_file(posixpath.join(staging, file + ".tmp"), data)
+        fs.mv(posixpath.join(staging, file + ".tmp"), posixpath.join(staging, file))
+    _moves(fs, root, staging, moves + last)
+    if journal is None:
+        remove(url, staging_name)
     prefix = url.rstrip("/")
     return [f"{prefix}/{name}" for name in names]
+
+
+def finish_commit(url: str, staging_name: str, journal: str) -> bytes:
+    """Move what a journalled :func:`commit` had not moved yet into place; return the journal.
+
+    For an attempt that died between its moves (or after them): whatever
+    is still in its staging directory, ``metadata.yaml`` last.
+    """
+    fs, root = filesystem(url)
+    staging = posixpath.join(root, staging_name)
+    data = bytes(fs.cat_file(posixpath.join(staging, journal)))
+    moves: list[tuple[str, str]] = []
+    last: list[tuple[str, str]] = []
+    for tmp in sorted(fs.find(staging)):
+        rel = posixpath.relpath(tmp, staging)
+        if rel in (journal, MARK):
+            continue
+        (last if posixpath.basename(rel) == METADATA else moves).append(
+            (tmp, posixpath.join(root, rel)))
+    _moves(fs, root, staging, moves + last)
+    return data
 
 
 def remove(url: str, name: str) -> None:
