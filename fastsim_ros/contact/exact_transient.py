@@ -149,7 +149,7 @@ def transient_step(area: GridArea, operators: TransientOperators, shift: tuple[F
 def cattaneo_shift(area: GridArea, shift_x: float, shift_y: float, *, mu: float, nu: float,
                    shear_modulus: float,
                    previous: TransientSolution | None = None) -> TransientSolution:
-    """The shift (Cattaneo) problem: the bodies, pressed together, shifted by ``shift`` (m)."""
+    """Solve the shift (Cattaneo) problem: the bodies, pressed together, shifted (m)."""
     ops = TransientOperators.of(area, 0, nu=nu, shear_modulus=shear_modulus)
     shape = area.mask.shape
     return transient_step(area, ops, (np.full(shape, float(shift_x)),
