@@ -24,6 +24,8 @@ METHODS = ("mae", "mae_calibrated", "fastsim_ellipse")
 #: friction laws (:mod:`fastsim_ros.contact.friction`): Coulomb, and the falling
 #: mu(v) = mu_s ((1 - A) exp(-B v) + A) of the local slip velocity v
 FRICTION_LAWS = ("constant", "exponential")
+#: rolling: the steady state each cycle, or the contact's memory between cycles
+ROLLING_MODES = ("steady", "transient")
 #: patch sources: patch topics, or the profiles and the wheelset's pose
 PATCH_SOURCES = ("topics", "profiles")
 #: the contacts of profiles mode, fixed per wheel: the patch nearer the tread, then a second
@@ -167,6 +169,15 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_min_sensitivity", "double", 0.02,
                   "observability threshold on |dF/dmu_s| / N: below it (the linear range) "
                   "the estimate holds and its sigma grows", low=0.0, high=1.0, dynamic=True),
+    ParameterSpec("rolling", "string", "steady",
+                  "steady (each cycle at the steady state) or transient (each contact keeps "
+                  "its traction between cycles, convected by |V| dt: Kalker's non-steady "
+                  "FastSim, fastsim_ros/contact/transient.py)",
+                  choices=ROLLING_MODES, dynamic=True),
+    ParameterSpec("transient_max_gap", "double", 0.05,
+                  "transient rolling: a longer time (s) between a contact's solved patches "
+                  "resets it to the steady state (its history is unknown)",
+                  low=1.0e-6, high=10.0, dynamic=True),
     ParameterSpec("publish_markers", "bool", True,
                   "publish contact/markers (one creep-force arrow per contact)", dynamic=True),
     ParameterSpec("marker_scale", "double", 1.0e-5,

@@ -41,6 +41,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
+from fastsim_ros.contact.transient import RESET_REASONS, ContactMemory, TransientSolver
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
 from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist, stamped_doubles,
@@ -351,6 +352,9 @@ class Pipeline:
         # the twists last given to the compiled path, as its arrays (v, w)
         self._twist_arrays: dict[str, tuple[StampedTwist, np.ndarray]] = {}
         self._contacts = {name: _ContactState() for name in config.contacts}
+        # transient rolling: each contact's traction between cycles (contact/transient.py)
+        self._memories: dict[str, ContactMemory] = {}
+        self._memory_key: tuple[Any, ...] | None = None
         self._fresh = 0  # contacts with a wrench not yet in a wheelset wrench
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
@@ -399,7 +403,13 @@ class Pipeline:
         # tractions; the solver's arguments as its solve_arrays passes them
         self._compiled: tuple[Any, ...] | None = None
         solver = self._solver
-        if isinstance(solver, MaeSolver) and not self._tractions:
+        self._transient = config["rolling"] == "transient" and self._override is None
+        # a new method, material or gap rule: the contacts' memories start afresh
+        key = (self._transient, config["method"], float(config["transient_max_gap"]))
+        if key != self._memory_key:
+            self._memories = {}
+            self._memory_key = key
+        if isinstance(solver, MaeSolver) and not self._tractions and not self._transient:
             code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
             self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
                               solver._knots, solver._polys, code, prm, mu_s,
@@ -665,7 +675,7 @@ class Pipeline:
                     if not abs(creep.speed) >= self._min_speed:
                         raise RejectedInput("standstill",
                                             f"rolling speed {creep.speed:.4g} m/s")
-                    forces = self._solve(patch, creep, stats)
+                    forces = self._solve(patch, creep, stats, self._memory(contact))
             if done is None:
                 f_ws = patch.frame.to_wheelset((forces.fx, forces.fy, forces.n))
                 m_ws = patch.frame.to_wheelset((0.0, 0.0, forces.mz))
@@ -782,9 +792,23 @@ class Pipeline:
         stats.last_detail = f"{reason}: {detail}"
         return Outcome(contact, stamp_ns, reason, detail)
 
+    def _memory(self, contact: str) -> ContactMemory | None:
+        """Return the contact's transient state (None when rolling is steady)."""
+        if not self._transient:
+            return None
+        memory = self._memories.get(contact)
+        if memory is None:
+            memory = ContactMemory(TransientSolver(self._solver),
+                                   max_gap=float(self.config["transient_max_gap"]))
+            self._memories[contact] = memory
+        return memory
+
     def _no_contact(self, contact: str, state: _ContactState, stamp: int) -> Outcome:
         state.stats.counts[NO_CONTACT] += 1
         state.solved = None
+        memory = self._memory(contact)
+        if memory is not None:  # a lifted wheel: the next contact starts from zero traction
+            memory.lose_contact(stamp)
         wheelset = self._add_wrench(state, stamp, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
         friction = (self._estimate(wheelset) if wheelset is not None and self._ekf is not None
                     else None)
@@ -792,7 +816,8 @@ class Pipeline:
                        wheelset=wheelset, markers=self._markers_due(state, stamp),
                        friction=friction)
 
-    def _solve(self, patch: ContactPatch, creep: Creepage, stats: ContactStats) -> ContactForces:
+    def _solve(self, patch: ContactPatch, creep: Creepage, stats: ContactStats,
+               memory: ContactMemory | None = None) -> ContactForces:
         p, x0, y0, dx, dy = patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy
         xi, eta, phi = creep.xi, creep.eta, creep.phi
         reverse = creep.speed < 0.0
@@ -803,9 +828,17 @@ class Pipeline:
             phi = -phi
         start = time.perf_counter()
         try:
-            f = self._solver.solve_arrays(p, x0, y0, dx, dy, xi, eta, phi, self._mu,
-                                          bound=self._bound, tractions=self._tractions,
-                                          friction=self._law, speed=abs(creep.speed))
+            if memory is None:
+                f = self._solver.solve_arrays(p, x0, y0, dx, dy, xi, eta, phi, self._mu,
+                                              bound=self._bound, tractions=self._tractions,
+                                              friction=self._law, speed=abs(creep.speed))
+            else:
+                # transient: the distance rolled from the stamps, the rules of ContactMemory
+                f, _ = memory.solve(patch.stamp_ns, creep.speed, p, x0, y0, dx, dy, xi, eta,
+                                    phi, None if self._law else self._mu, bound=self._bound,
+                                    friction=self._law)
+                if not self._tractions:
+                    f = ContactForces(f.fx, f.fy, f.mz, f.n, f.slip_fraction)
         except OutOfTableError as e:
             raise RejectedInput("out_of_table", str(e)) from None
         except ContactError as e:  # inputs the adapters passed but the solver refuses
@@ -975,6 +1008,10 @@ class Pipeline:
             ("rejected", str(rejected)),
         ]
         values += [(f"rejected/{r}", str(stats.counts[r])) for r in REJECTION_REASONS]
+        values.append(("rolling", str(self.config["rolling"])))
+        memory = self._memories.get(contact)
+        if memory is not None:  # why the contact's traction state was reset (transient.py)
+            values += [(f"transient/{r}", str(memory.counts[r])) for r in RESET_REASONS]
         level, message = 0, "ok"
         if stats.window_inputs == 0:
             level, message = 1, "no patch in the last period"

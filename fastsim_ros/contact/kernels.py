@@ -300,11 +300,43 @@ def law_ratio(law, prm, v):
 
 # ---------------------------------------------------------------- the sweep
 
+#: the previous traction state of a steady sweep: none (never read)
+_NO_STATE = np.zeros((0, 0))
+
 
 @njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
           law, prm, speed, out_x, out_y, slip, store, rigid):
     """March every strip from its leading edge; return ``(Fx, Fy, Mz, slipping, in contact)``.
+
+    The steady state: :func:`rolling_sweep` with an infinite distance rolled
+    (every cell's material entered the contact under the present creepages).
+    """
+    return rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c,
+                         y_s, xp, yp, law, prm, speed, out_x, out_y, slip, store, rigid,
+                         _NO_STATE, _NO_STATE, math.inf)
+
+
+@njit(cache=True, error_model="numpy")
+def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
+                  yp, law, prm, speed, out_x, out_y, slip, store, rigid, prev_x, prev_y,
+                  rolled):
+    """March every strip from its leading edge over one time step of rolling ``rolled`` (m).
+
+    Kalker's non-steady FASTSIM (Kalker 1990, "Three-dimensional elastic
+    bodies in rolling contact", section 5.4; :mod:`fastsim_ros.contact.transient`):
+    the particle at cell centre ``x`` was at ``x + rolled`` one step ago.
+    Where its distance ``d`` from its segment's front face is at most
+    ``rolled`` it entered the contact during the step, with zero traction,
+    and rolled ``d`` under the present creepages: its traction is the steady
+    march's (``rolled = inf`` is the steady state, :func:`sweep`).
+    Elsewhere its trial traction is the previous state ``prev_x``,
+    ``prev_y`` (Pa, shape of ``shape``) interpolated linearly along the strip
+    at ``x + rolled`` (zero at the segment's front face), minus the rigid
+    slip over ``rolled`` divided by ``L`` (``phi x`` at the middle of the
+    step), and the same projection on the bound follows, with the step
+    ``h = rolled``.  Slip-dependent laws: the kinetic level is the upstream
+    cell's friction ratio in this sweep, as in the steady march.
 
     The kernel of :func:`fastsim_ros.contact.fastsim.sweep` and the
     resultants of :func:`~fastsim_ros.contact.fastsim.fastsim`.  The
@@ -343,6 +375,10 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     rate_x, rate_y0, rate_yx, yr, w_x = w[5], w[6], w[7], w[8], w[9]
     # the column a strip's current segment continues into (else: a new segment)
     cont = np.empty(ny, dtype=np.int64)
+    # distance from the segment's front face to the last cell's centre (m), the segment's first
+    # column (the previous state is interpolated between the cells up to that one)
+    dist = np.zeros(ny)
+    first = np.zeros(ny, dtype=np.int64)
     # slip-dependent laws: strip j's friction ratio in its last cell if that one slipped, else 1
     level = np.ones(ny)
     for j in range(ny):
@@ -379,13 +415,43 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                 s = dx
                 t_x = tx[j]
                 t_y = ty[j]
+                dist[j] += dx
             else:
                 # first cell of a segment: zero traction at its front face, half a step back
                 s = half
                 t_x = 0.0
                 t_y = 0.0
                 level[j] = 1.0
+                dist[j] = half
+                first[j] = i
             cont[j] = i - 1
+            if dist[j] > rolled:
+                # in the contact before the step: from the previous state at x + rolled
+                s = rolled
+                f = rolled / dx
+                k0 = int(f)
+                iu = i + k0
+                if iu + 2 <= first[j] and iu >= 1 and shape[j, iu - 1] > 0.0:
+                    # cubic Lagrange through the cells iu - 1 .. iu + 2 (exact for the
+                    # quadratic traction of spin in adhesion: no smearing over the steps)
+                    u = f - k0
+                    c0 = -u * (u - 1.0) * (u - 2.0) / 6.0
+                    c1 = (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0
+                    c2 = -(u + 1.0) * u * (u - 2.0) / 2.0
+                    c3 = (u + 1.0) * u * (u - 1.0) / 6.0
+                    t_x = (c0 * prev_x[j, iu - 1] + c1 * prev_x[j, iu] + c2 * prev_x[j, iu + 1]
+                           + c3 * prev_x[j, iu + 2])
+                    t_y = (c0 * prev_y[j, iu - 1] + c1 * prev_y[j, iu] + c2 * prev_y[j, iu + 1]
+                           + c3 * prev_y[j, iu + 2])
+                elif iu < first[j]:
+                    w1 = f - k0
+                    t_x = (1.0 - w1) * prev_x[j, iu] + w1 * prev_x[j, iu + 1]
+                    t_y = (1.0 - w1) * prev_y[j, iu] + w1 * prev_y[j, iu + 1]
+                else:
+                    # between the first cell's centre and the front face (zero traction there)
+                    w0 = 1.0 - (rolled - k0 * dx) / half
+                    t_x = w0 * prev_x[j, iu]
+                    t_y = w0 * prev_y[j, iu]
             x_mid = x_rel + 0.5 * s
             p_x = t_x
             p_y = t_y
@@ -432,7 +498,7 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
                         inv = 1.0 / mag
                         lx = flex[0, j] * t_x
                         ly = flex[1, j] * t_y
-                        vs = v_full if s == dx else v_half
+                        vs = v_full if s == dx else (v_half if s == half else speed / s)
                         done = False
                         if rigid:
                             wyh = (eta + phi * x_rel) * s

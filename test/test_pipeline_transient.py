@@ -1,0 +1,99 @@
+"""The pipeline with ``rolling: transient``: each contact's memory, its rules, its diagnostics."""
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import area as areas
+from fastsim_ros.contact.compiled import CalibratedMaeSolver
+from fastsim_ros.contact.transient import ContactMemory, TransientSolver
+from fastsim_ros.params import ParameterError
+from fastsim_ros.pipeline import Pipeline, PipelineConfig
+from ros_messages import cdr, cloud_msg, in_plane_area, rolling_twist
+
+MS = 1_000_000
+T0 = 1_700_000_000 * 1_000_000_000
+SPEED = 2.0  # m/s; at 1 kHz a cycle rolls 2 mm of the 12 mm patch
+XI0, XI1 = 5e-4, 2e-3
+
+
+def patch():
+    """Return a Hertzian ellipse a = 6 mm, b = 4 mm, 30 x 20 cells, 40 kN."""
+    return areas.ellipse(6e-3, 4e-3, nx=30, ny=20, load=4e4)
+
+
+def make(**values):
+    values.setdefault("contacts", ["left"])
+    return Pipeline(PipelineConfig.from_values(values))
+
+
+def cycle(pipe, stamp, xi, **cloud):
+    """Feed one 1 kHz cycle: the twist, then the patch with the same stamp."""
+    assert pipe.on_wheel_twist(cdr(rolling_twist(xi, speed=SPEED, stamp_ns=stamp))) == "ok"
+    return pipe.on_patch("left", cdr(cloud_msg(patch(), stamp_ns=stamp, dtype="<f8",
+                                               **cloud)))
+
+
+def test_creepage_step_builds_up_over_a_contact_length() -> None:
+    """A step in xi at 1 kHz, 2 m/s: the force rises over ~one contact length to the steady one."""
+    steady = make()
+    transient = make(rolling="transient")
+    fx = []
+    for n in range(12):
+        stamp = T0 + n * MS
+        xi = XI0 if n < 2 else XI1
+        s = cycle(steady, stamp, xi)
+        t = cycle(transient, stamp, xi)
+        assert s.status == t.status == "solved"
+        fx.append((s.forces.fx, t.forces.fx))
+    # before the step: the steady state (start, then a carried steady state)
+    assert fx[0][1] == fx[0][0]
+    assert fx[1][1] == pytest.approx(fx[1][0], rel=1e-9)
+    # after it: early and too large in steady rolling, rising in transient rolling
+    assert abs(fx[0][0]) < abs(fx[2][1]) < 0.85 * abs(fx[2][0])
+    rising = [abs(t) for _, t in fx[2:]]
+    assert all(b >= a * (1.0 - 1e-9) for a, b in zip(rising, rising[1:]))
+    # after 2 mm x 9 cycles (18 mm > 12 mm): the steady answer
+    assert fx[-1][1] == pytest.approx(fx[-1][0], rel=1e-9)
+
+
+def test_the_pipeline_state_is_the_librarys() -> None:
+    """Wrench for wrench the pipeline's transient answers are ContactMemory's on the patch."""
+    pipe = make(rolling="transient")
+    memory = ContactMemory(TransientSolver(CalibratedMaeSolver(0.28, 8e10)), max_gap=0.05)
+    a = in_plane_area(patch())
+    for n in range(6):
+        stamp = T0 + n * MS
+        xi = XI0 if n < 2 else XI1
+        out = cycle(pipe, stamp, xi)
+        ref, _ = memory.solve(stamp, out.creepage.speed, a.pressure, a.x0, a.y0, a.dx, a.dy,
+                              out.creepage.xi, out.creepage.eta, out.creepage.phi, 0.3)
+        assert out.forces.fx == pytest.approx(ref.fx, rel=1e-9, abs=1e-6)
+        assert out.forces.tau_x is None  # no tractions unless publish_traction
+
+
+def test_reset_rules_in_diagnostics() -> None:
+    """A stamp gap resets to the steady state; a lifted wheel restarts from zero traction."""
+    pipe = make(rolling="transient", transient_max_gap=0.01)
+    steady = make()
+    cycle(pipe, T0, XI0)
+    cycle(pipe, T0 + MS, XI1)
+    # 20 ms later: beyond the gap, the steady answer at once
+    gap = cycle(pipe, T0 + 21 * MS, XI1)
+    assert gap.forces.fx == cycle(steady, T0 + 21 * MS, XI1).forces.fx
+    # the wheel lifts for a cycle, then touches down: the traction builds up again
+    empty = np.zeros_like(patch().pressure)
+    assert cycle(pipe, T0 + 22 * MS, XI1, pressure=empty).status == "no_contact"
+    down = cycle(pipe, T0 + 23 * MS, XI1)
+    assert 0.0 < down.forces.fx / gap.forces.fx < 0.6
+    values = dict(pipe.report("left").values)
+    assert values["rolling"] == "transient"
+    assert values["transient/start"] == "1"
+    assert values["transient/stamp_gap"] == "1"
+    assert values["transient/lost_contact"] == "1"
+    assert dict(steady.report("left").values)["rolling"] == "steady"
+
+
+def test_rolling_parameter_is_checked() -> None:
+    """Only steady and transient are allowed."""
+    with pytest.raises(ParameterError, match="rolling"):
+        make(rolling="unsteady")
