@@ -377,3 +377,10 @@ def test_pipeline_holds_without_a_fresh_measurement(hertz):
         == "wrong_frame"
     assert pipe.on_measured_wrench(cdr(wrench_msg((math.nan, 0.0, 0.0), t0 + 2))) == "nonfinite"
     assert pipe.estimation_counts["dropped"] == 2
+
+
+def test_estimation_is_refused_in_profiles_mode():
+    from fastsim_ros.params import ParameterError, checked
+    with pytest.raises(ParameterError, match="friction_estimation"):
+        checked({"patch_source": "profiles", "friction_estimation": "on"})
+    assert checked({"friction_estimation": "on"})["friction_estimation"] == "on"
