@@ -594,8 +594,15 @@ class Pipeline:
             except ContactError:  # the solver refused the perturbed mu: hold
                 status = "unobservable"
         self.estimation_counts[status] += 1
-        if ekf.mu != mu:
-            self._use_mu(ekf.mu, self.config)
+        if ekf.mu != mu:  # as _use_mu, which gives the same law and tuple, for less
+            self._mu = ekf.mu
+            if self._law is not None:
+                self._law = friction_law(str(self.config["friction_law"]), self._mu,
+                                         limit_ratio=float(self.config["friction_limit_ratio"]),
+                                         decay=float(self.config["friction_decay"]))
+            c = self._compiled
+            if c is not None:  # only mu_s (slot 7) depends on mu
+                self._compiled = c[:7] + (self._mu,) + c[8:]
         return FrictionEstimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:

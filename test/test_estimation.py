@@ -345,8 +345,12 @@ def test_pipeline_estimates_mu_and_solves_with_it(hertz):
     last = estimates[-1]
     assert abs(last.mu - 0.35) < 0.01 * 0.35 and last.sigma < 0.01
     assert 0.0 < last.utilisation <= 1.0
-    # the next cycle's wrench uses the estimate
+    # the next cycle's wrench uses the estimate: the compiled path's arguments are those a
+    # pipeline configured with it builds
     assert pipe._mu == last.mu
+    fresh = Pipeline(PipelineConfig.from_values(dict(contacts=["left"],
+                                                     friction_coefficient=last.mu)))
+    assert all(a is b or np.array_equal(a, b) for a, b in zip(pipe._compiled, fresh._compiled))
     values = {v.key: v.value for v in pipe.diagnostics(t0).status[0].values}
     assert float(values["friction_estimation/mu"]) == pytest.approx(last.mu, rel=1e-5)
     assert values["friction_estimation/updated"] == "60"
@@ -373,3 +377,10 @@ def test_pipeline_holds_without_a_fresh_measurement(hertz):
         == "wrong_frame"
     assert pipe.on_measured_wrench(cdr(wrench_msg((math.nan, 0.0, 0.0), t0 + 2))) == "nonfinite"
     assert pipe.estimation_counts["dropped"] == 2
+
+
+def test_estimation_is_refused_in_profiles_mode():
+    from fastsim_ros.params import ParameterError, checked
+    with pytest.raises(ParameterError, match="friction_estimation"):
+        checked({"patch_source": "profiles", "friction_estimation": "on"})
+    assert checked({"friction_estimation": "on"})["friction_estimation"] == "on"
