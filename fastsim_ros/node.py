@@ -115,6 +115,8 @@ def descriptor(spec: parameters.ParameterSpec, *,
     d = ParameterDescriptor(type=_TYPES[spec.kind], description=spec.description,
                             additional_constraints=spec.allowed(),
                             read_only=(not spec.dynamic) if read_only is None else read_only)
+    if spec.switch:  # on/off arrive as strings or as YAML's booleans: checked by the spec
+        d.type, d.dynamic_typing = ParameterType.PARAMETER_NOT_SET, True
     if spec.low is not None and spec.high is not None:
         if spec.kind == "double":
             d.floating_point_range = [FloatingPointRange(

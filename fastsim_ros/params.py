@@ -54,6 +54,9 @@ class ParameterSpec:
     choices: tuple[str, ...] = ()
     dynamic: bool = False
     empty_ok: bool = False
+    #: a switch ``off``/``on``: YAML (and so ``-p name:=on`` and a params file's bare
+    #: ``on``) reads those words as booleans, so true/false are taken as on/off too
+    switch: bool = False
 
     def allowed(self) -> str:
         """Return the allowed values in words (for descriptors and error messages)."""
@@ -84,6 +87,8 @@ class ParameterSpec:
             if not isinstance(value, bool):
                 raise bad
         elif self.kind == "string":
+            if self.switch and isinstance(value, bool):
+                value = "on" if value else "off"
             if not isinstance(value, str) or not (value or self.empty_ok):
                 raise bad
         elif self.kind == "string_array":
@@ -156,7 +161,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "frame) with an extended Kalman filter whose measurement model is the "
                   "solver; on: friction/estimate is published and every wrench uses the "
                   "estimate (friction_coefficient is its start)",
-                  choices=("off", "on")),
+                  choices=("off", "on"), switch=True),
     ParameterSpec("friction_process_noise", "double", 2.0e-5,
                   "q (1/s): variance of mu_s added per second (how fast mu may change)",
                   low=0.0, high=10.0, dynamic=True),

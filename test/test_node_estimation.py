@@ -35,7 +35,7 @@ def test_node_estimates_as_the_pipeline_does(tmp_path):
     values = {"contacts": ["left"], "friction_estimation": "on", "friction_coefficient": 0.2,
               "friction_measurement_noise": 250.0, "friction_estimate_sigma": 0.15}
     # 'on' quoted: a bare on is YAML's true, and the parameter is a string
-    proc = NodeProcess("-p", 'contacts:=["left"]', "-p", "friction_estimation:='on'",
+    proc = NodeProcess("-p", 'contacts:=["left"]', "-p", "friction_estimation:=on",
                        "-p", "friction_coefficient:=0.2",
                        "-p", "friction_measurement_noise:=250.0",
                        "-p", "friction_estimate_sigma:=0.15", log_dir=tmp_path)

@@ -100,6 +100,15 @@ def refusals() -> dict[str, subprocess.CompletedProcess[str]]:
     return {case[0]: proc for case, proc in zip(CASES, done)}
 
 
+def test_a_bare_on_starts_the_estimator():
+    # YAML reads `on` as true: the switch takes it (then refuses profiles mode, one line)
+    done = subprocess.run([str(NODE_SCRIPT), "--ros-args", *PROFILES,
+                           "-p", "friction_estimation:=on"],
+                          capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    assert "needs patch_source" in done.stderr and "friction_estimation" in done.stderr
+
+
 def test_every_parameter_has_a_bad_start_here():
     named = {name for _, name, _ in CASES}
     ranged = {s.name for s in PARAMETERS if _value_out_of(s) is not None}

@@ -3,7 +3,7 @@
 import pytest
 
 from fastsim_ros import params
-from fastsim_ros.params import ParameterError, load_params_file
+from fastsim_ros.params import SPECS, ParameterError, load_params_file
 from ros_harness import PACKAGE_ROOT
 
 CONFIG = PACKAGE_ROOT / "config"
@@ -115,3 +115,15 @@ def test_friction_laws_and_their_parameters_are_dynamic():
     for name in ("friction_law", "friction_limit_ratio", "friction_decay"):
         assert params.SPECS[name].dynamic
     assert params.SPECS["friction_law"].check("exponential") == "exponential"
+
+
+@pytest.mark.parametrize("given, taken", [(True, "on"), (False, "off"), ("on", "on"),
+                                          ("off", "off")])
+def test_a_switch_takes_yamls_booleans_for_on_and_off(given, taken):
+    # `-p friction_estimation:=on` and a params file's bare `on` arrive as YAML's true
+    assert SPECS["friction_estimation"].check(given) == taken
+
+
+def test_a_switch_refuses_other_words():
+    with pytest.raises(ParameterError, match="friction_estimation"):
+        SPECS["friction_estimation"].check("yes please")
