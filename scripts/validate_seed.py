@@ -36,11 +36,11 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import asm, dlm  # noqa: E402
 from fastsim_ros.contact.fastsim import sweep_integrals  # noqa: E402
 
-import validate  # noqa: E402  (the machine line)
 
 DOCS = ROOT / "docs"
 DATA = DOCS / "data" / "validation_seed.json"
@@ -568,7 +568,7 @@ def main() -> int:
     else:
         start = time.time()
         old = json.loads(DATA.read_text()) if DATA.exists() else {}
-        res = {"machine": validate._machine(),
+        res = {"machine": machine(),
                "kalker": "published" if KALKER == PUBLISHED else "package"}
         if args.fit_asm:
             res["asm_fit"] = fit_asm()
