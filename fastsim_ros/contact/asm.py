@@ -285,6 +285,35 @@ def fastsim_with(area: GridArea, flex: CalibratedFlexibility, xi: float, eta: fl
                    speed=speed)
 
 
+def bounded_fastsim(area: GridArea, flex: CalibratedFlexibility, xi: float, eta: float,
+                    phi: float, *, mu: float, reference: tuple[float, float] = (0.0, 0.0),
+                    bound: str = "given", friction: FrictionLaw | None = None,
+                    speed: float | None = None) -> Tractions:
+    """Solve FastSim on ``area`` with ``flex`` under the traction bound ``mu p`` (``bound``).
+
+    The shared step of ASM + FastSim and DLM + FastSim (and of any method
+    that hands FastSim one ``L1, L2, L3`` for the area).
+    """
+    return fastsim_with(area, flex, xi, eta, phi, bound=traction_bound(area, mu, bound=bound),
+                        reference=reference, friction=friction, speed=speed)
+
+
+def full_adhesion_coefficients(area: GridArea, flex: CalibratedFlexibility, *,
+                               reference: tuple[float, float] = (0.0, 0.0)
+                               ) -> CreepCoefficients:
+    """Return FastSim's generalised coefficients with ``flex`` in full adhesion (G = 1 Pa).
+
+    The shared loop of ASM + FastSim and DLM + FastSim: unit creepages, no
+    traction bound, coefficients about ``reference`` normalised with the
+    area of the cells in contact.
+    """
+    unbounded = np.where(area.mask, np.inf, 0.0)
+    return coefficients_of_solver(
+        area.area, lambda xi, eta, phi: fastsim_with(area, flex, xi, eta, phi, bound=unbounded,
+                                                     reference=reference),
+        reference=reference)
+
+
 def asm_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu: float,
                 shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                 bound: str = "given", friction: FrictionLaw | None = None,
@@ -296,16 +325,12 @@ def asm_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
     material, to reuse over many creepages (it costs ASM's linear system).
     """
     flex = flexibility or asm_flexibility(area, nu=nu, shear_modulus=shear_modulus)
-    return fastsim_with(area, flex, xi, eta, phi, bound=traction_bound(area, mu, bound=bound),
-                        reference=reference, friction=friction, speed=speed)
+    return bounded_fastsim(area, flex, xi, eta, phi, mu=mu, reference=reference, bound=bound,
+                           friction=friction, speed=speed)
 
 
 def asm_fastsim_coefficients(area: GridArea, *, nu: float,
                              reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
     """Return ASM + FastSim's coefficients in full adhesion (ASM's own ``C~11, C~22, C~23``)."""
-    flex = asm_flexibility(area, nu=nu, shear_modulus=1.0)
-    unbounded = np.where(area.mask, np.inf, 0.0)
-    return coefficients_of_solver(
-        area.area, lambda xi, eta, phi: fastsim_with(area, flex, xi, eta, phi, bound=unbounded,
-                                                     reference=reference),
-        reference=reference)
+    return full_adhesion_coefficients(area, asm_flexibility(area, nu=nu, shear_modulus=1.0),
+                                      reference=reference)

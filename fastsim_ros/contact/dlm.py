@@ -45,10 +45,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.asm import CalibratedFlexibility, centroid, fastsim_with
+from fastsim_ros.contact.asm import (CalibratedFlexibility, bounded_fastsim, centroid,
+                                     full_adhesion_coefficients)
 from fastsim_ros.contact.checks import check_material
-from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
-from fastsim_ros.contact.fastsim import sweep_integrals, traction_bound
+from fastsim_ros.contact.coefficients import CreepCoefficients
+from fastsim_ros.contact.fastsim import sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.influence import influence_kernel
 from fastsim_ros.contact.traction import Tractions
@@ -183,16 +184,12 @@ def dlm_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
     material, to reuse over many creepages.
     """
     flex = flexibility or dlm_flexibility(area, nu=nu, shear_modulus=shear_modulus)
-    return fastsim_with(area, flex, xi, eta, phi, bound=traction_bound(area, mu, bound=bound),
-                        reference=reference, friction=friction, speed=speed)
+    return bounded_fastsim(area, flex, xi, eta, phi, mu=mu, reference=reference, bound=bound,
+                           friction=friction, speed=speed)
 
 
 def dlm_coefficients(area: GridArea, *, nu: float,
                      reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
     """Return DLM + FastSim's generalised coefficients in full adhesion about ``reference``."""
-    flex = dlm_flexibility(area, nu=nu, shear_modulus=1.0)
-    unbounded = np.where(area.mask, np.inf, 0.0)
-    return coefficients_of_solver(
-        area.area, lambda xi, eta, phi: fastsim_with(area, flex, xi, eta, phi, bound=unbounded,
-                                                     reference=reference),
-        reference=reference)
+    return full_adhesion_coefficients(area, dlm_flexibility(area, nu=nu, shear_modulus=1.0),
+                                      reference=reference)
