@@ -392,7 +392,10 @@ def report(res: dict[str, Any]) -> None:
         " (0.13, 1.23, 10.73) is matched at a/b = 1 (+3%) and 0.1 (+9%) but not at a/b = 10"
         f" ({_pct(pk['10.0']['C23'] / TABLE1[(10.0, 'C23')][1] - 1)}), where no reading"
         " tried comes near it (the per-strip translation gives +4%, at the cost of C11 and"
-        " C22).\n")
+        " C22). Levelling the spin traction's lateral component alone gives C23 -12%, -13%,"
+        " +55% at a/b = 0.1, 1, 10, its longitudinal component alone +9%, +6%, +149%"
+        " (exploration, 2026-12-03, 60 and 100 cells alike): the miss at a/b = 10 is not the"
+        " mixing of the two components either.\n")
     add("Grid check of the package's DLM (C11, C22, C23 on n x n cells):\n")
     add("| a/b | " + " | ".join(f"{n} cells" for n in d["grid"]) + " |")
     add("| --- | " + " | ".join("---" for _ in d["grid"]) + " |")
