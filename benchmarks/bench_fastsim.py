@@ -29,13 +29,10 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
-import platform
 import time
 from collections.abc import Callable
 from typing import Any
 
-import numba
 import numpy as np
 from numba import njit
 
@@ -47,31 +44,12 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipse
 from fastsim_ros.contact.fastsim import traction_bound
 from fastsim_ros.contact.mae import mae_fastsim
 from fastsim_ros.contact.tables import coefficient_table
+from fastsim_ros.machine import machine  # the one machine line of every benchmark
 
 NU, G, MU, LOAD = 0.28, 8.0e10, 0.3, 5.0e4
 # wheel-rail creepages in partial slip with spin (saturation near 5e-3 here)
 CREEP = (1.0e-3, 5.0e-4, 1.0)
 GRIDS = (10, 20, 30, 45, 60)
-
-
-def machine() -> str:
-    """Describe the machine: platform, CPU model, cores, load (a busy machine slows runs)."""
-    model = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    model = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    cores = os.cpu_count()
-    usable = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else cores
-    load = ", load average %.2f %.2f %.2f" % os.getloadavg() if hasattr(os, "getloadavg") \
-        else ""
-    return (f"{platform.platform()}; {model}; {cores} cores ({usable} usable){load}; "
-            f"Python {platform.python_version()}, numpy {np.__version__}, "
-            f"numba {numba.__version__}")
 
 
 def semi_ellipses(cells: int) -> GridArea:

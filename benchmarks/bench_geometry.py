@@ -30,8 +30,6 @@ poses, ``pose (per pose)`` (the same pipeline without the table).
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import sys
 import time
 from collections.abc import Callable
@@ -45,6 +43,7 @@ sys.path.insert(0, str(ROOT))
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.placement import Pose  # noqa: E402
 from fastsim_ros.geometry.planar import planar_grid  # noqa: E402
+from fastsim_ros.machine import machine  # noqa: E402
 from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
 from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
 from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
@@ -53,18 +52,6 @@ from msg_adapters.profile_msgs import StampedPose, patch_cloud, quaternion  # no
 
 #: A-2.2 poses: centred on the treads, 5 mm (the right gauge corner), 7 mm (the flange)
 POSES = (1, 11, 15)
-
-
-def machine() -> str:
-    cpu = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
 def timed(fn: Callable[[], object], repeat: int) -> np.ndarray:

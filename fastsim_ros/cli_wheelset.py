@@ -23,14 +23,13 @@ from __future__ import annotations
 import argparse
 import csv
 import math
-import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from fastsim_ros.atomic import write_atomically
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import ContactForces
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
@@ -312,7 +311,7 @@ def sweep(args: argparse.Namespace) -> dict[str, Any]:
                              "side": wheel["side"], "status": "ok", "wheel_Fx": fx,
                              "wheel_Fy": fy, "wheel_Fz": fz,
                              **{k: patch[k] for k in SWEEP_COLUMNS if k in patch}})
-    _write_atomically(args.output, lambda f: _write_csv(f, rows))
+    write_atomically(args.output, lambda f: _write_csv(f, rows))
     if args.plot is not None:
         from fastsim_ros.geometry.sweep_plot import plot_sweep
         plot_sweep(args, poses, results, args.plot)
@@ -327,24 +326,6 @@ def _write_csv(f: Any, rows: Sequence[dict[str, Any]]) -> None:
     w.writeheader()
     for row in rows:
         w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in row.items()})
-
-
-def _write_atomically(path: Path, write: Any, *, binary: bool = False) -> None:
-    path = Path(path)
-    target_dir = path.parent if str(path.parent) else Path(".")
-    if not target_dir.is_dir():
-        raise InvalidInputError(f"{target_dir}: no such directory")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=target_dir)
-    try:
-        with (os.fdopen(fd, "wb") if binary else os.fdopen(fd, "w", newline="")) as f:
-            write(f)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def print_table(result: dict[str, Any]) -> None:

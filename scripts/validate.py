@@ -18,7 +18,6 @@ import argparse
 import csv
 import json
 import math
-import platform
 import sys
 import time
 from pathlib import Path
@@ -34,6 +33,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import exact, samples  # noqa: E402
 from fastsim_ros.contact.coefficients import CreepCoefficients  # noqa: E402
@@ -91,19 +91,6 @@ def _load(name: str) -> Any:
     return json.loads((DATA / f"validation_{name}.json").read_text())
 
 
-def _machine() -> str:
-    cpu = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    import os
-    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
-
-
 # ----------------------------------------------------------------------------- exact
 
 def part_exact() -> None:
@@ -131,7 +118,7 @@ def part_timing() -> None:
     import os
     # the machine is shared: its load when the timing started goes with the times
     load = " (load average %.1f at the start)" % os.getloadavg()[0]
-    res: dict[str, Any] = {"machine": _machine() + load, "adhesion": [], "coulomb": []}
+    res: dict[str, Any] = {"machine": machine() + load, "adhesion": [], "coulomb": []}
     a, b = areas.semi_ellipse_axes(1.0)
     for n in (10, 20, 30, 40, 60, 80, 100, 120, 160):
         ar = areas.ellipse(a, b, nx=n, ny=n)

@@ -37,8 +37,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -54,6 +52,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros import cli  # noqa: E402
 from fastsim_ros.cli_wheelset import result_of, solve_pose, wheel_twist  # noqa: E402
 from fastsim_ros.geometry import benchmark  # noqa: E402
@@ -72,18 +71,6 @@ LABEL = {"exact": "exact", "mae_calibrated": "calibrated MAE", "mae": "paper's M
          "analyn": "CONTACT ANALYN+FASTSIM"}
 TARGET = {"position": 0.5e-3, "angle": 0.01, "n": 0.01, "creepage": 0.02, "creepage_abs": 1e-5,
           "exact": 5.0, "default": 10.0}
-
-
-def _machine() -> str:
-    cpu = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
 def _args(case: benchmark.CaseResult, method: str) -> argparse.Namespace:
@@ -140,7 +127,7 @@ def _pressure_picture(patches: list[Any]) -> list[dict[str, Any]]:
 
 
 def compute(methods: tuple[str, ...], cases: tuple[int, ...]) -> dict[str, Any]:
-    results: dict[str, Any] = {"machine": _machine(), "runs": []}
+    results: dict[str, Any] = {"machine": machine(), "runs": []}
     for side in ("left", "right"):
         for case in benchmark.a22(side):
             if case.number not in cases:

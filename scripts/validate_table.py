@@ -26,8 +26,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import platform
 import sys
 import time
 from pathlib import Path
@@ -38,6 +36,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.placement import Pose, rotation  # noqa: E402
@@ -53,18 +52,6 @@ PROFILES = DOCS / "data" / "validation_profiles.json"
 REPORT = DOCS / "validation_table.md"
 CONFIG = ROOT / "config" / "profiles_track_table.yaml"
 TARGET = {"exact": 5.0, "default": 10.0, "angle": 0.01, "n": 0.01}
-
-
-def _machine() -> str:
-    cpu = "unknown CPU"
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}"
 
 
 def _values(table: bool) -> dict[str, Any]:
@@ -131,7 +118,7 @@ def _pct(a: list[float], b: list[float] | tuple[float, ...], n: float) -> float:
 
 def compute() -> dict[str, Any]:
     runner = Runner()
-    results: dict[str, Any] = {"machine": _machine(), "table_seconds": runner.table_seconds,
+    results: dict[str, Any] = {"machine": machine(), "table_seconds": runner.table_seconds,
                                "nodes": len(runner.table.table.nodes) if runner.table.table
                                else 0, "a22": [], "sweep": [], "loads": []}
     profiles = json.loads(PROFILES.read_text()) if PROFILES.exists() else {"runs": []}

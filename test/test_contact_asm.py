@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -95,3 +96,29 @@ def test_too_many_strips_are_refused_before_the_system_is_built():
                          collocation=(0.7, 0.2))
     with pytest.raises(InvalidInputError):
         asm_coefficients(areas.ellipse(1.0, 1.0, nx=8, ny=8), nu=0.7)
+
+
+SEED_TABLES = Path(__file__).resolve().parents[1].parent / "shared" / "reference" / \
+    "seed_tables_1_2.md"
+
+
+def test_table2_reading_maps_its_amk_columns_onto_kalkers_table():
+    # the printed labels of the two blocks are swapped: the AMK columns are Kalker's at a/b = g
+    # (first block) and 1/g (second), to the 3-digit rounding, but for the one misprint
+    if not SEED_TABLES.exists():
+        pytest.skip("shared/reference is not beside this checkout")
+    from fastsim_ros.contact.seed_tables import read_table2
+    published = {}
+    for line in (SEED_TABLES.parent / "kalker_coefficients.csv").read_text().splitlines():
+        cells = line.split(",")
+        if not line.startswith("#") and cells[0] != "a_over_b" and float(cells[1]) == 0.25:
+            published[round(float(cells[0]), 6)] = tuple(float(c) for c in cells[2:5])
+    rows = read_table2(SEED_TABLES)
+    assert {round(r.a_over_b, 6) for r in rows} == set(published)
+    for r in rows:
+        for name, printed, kalker in zip(("C11", "C22", "C23"), r.amk,
+                                         published[round(r.a_over_b, 6)]):
+            if (r.block, r.g, name) == ("b<a", 0.8, "C23"):
+                assert printed == 1.15 and kalker == 1.25
+                continue
+            assert printed == pytest.approx(kalker, abs=0.0051), (r, name)

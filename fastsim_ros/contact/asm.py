@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -285,27 +286,57 @@ def fastsim_with(area: GridArea, flex: CalibratedFlexibility, xi: float, eta: fl
                    speed=speed)
 
 
-def asm_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu: float,
-                shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
-                bound: str = "given", friction: FrictionLaw | None = None,
-                speed: float | None = None,
-                flexibility: CalibratedFlexibility | None = None) -> Tractions:
-    """Solve ASM + FastSim (forces in N, ``Mz`` about ``reference``); ``phi`` in 1/m.
+class FlexibilityOf(Protocol):
+    """A method's flexibilities of an area: ``(area, *, nu, shear_modulus) -> L1, L2, L3``."""
 
-    ``flexibility``: :func:`asm_flexibility`'s result for this area and
-    material, to reuse over many creepages (it costs ASM's linear system).
+    def __call__(self, area: GridArea, *, nu: float,
+                 shear_modulus: float) -> CalibratedFlexibility: ...
+
+
+@dataclass(frozen=True)
+class FlexibilityMethod:
+    """FastSim with one ``L1, L2, L3`` on the area, from ``flexibility_of`` (ASM's, DLM's).
+
+    The loop ASM + FastSim and DLM + FastSim share: :meth:`solve` under the
+    traction bound, :meth:`coefficients` in full adhesion.
     """
-    flex = flexibility or asm_flexibility(area, nu=nu, shear_modulus=shear_modulus)
-    return fastsim_with(area, flex, xi, eta, phi, bound=traction_bound(area, mu, bound=bound),
-                        reference=reference, friction=friction, speed=speed)
+
+    flexibility_of: FlexibilityOf
+
+    def solve(self, area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
+              nu: float, shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
+              bound: str = "given", friction: FrictionLaw | None = None,
+              speed: float | None = None,
+              flexibility: CalibratedFlexibility | None = None) -> Tractions:
+        """Solve FastSim (forces in N, ``Mz`` about ``reference``); ``phi`` in 1/m.
+
+        ``flexibility``: ``flexibility_of``'s result for this area and
+        material, to reuse over many creepages.
+        """
+        flex = flexibility or self.flexibility_of(area, nu=nu, shear_modulus=shear_modulus)
+        return fastsim_with(area, flex, xi, eta, phi,
+                            bound=traction_bound(area, mu, bound=bound), reference=reference,
+                            friction=friction, speed=speed)
+
+    def coefficients(self, area: GridArea, *, nu: float,
+                     reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
+        """Return the generalised coefficients in full adhesion about ``reference`` (m).
+
+        Unit creepages, no traction bound, normalised with the area of the
+        cells in contact.
+        """
+        flex = self.flexibility_of(area, nu=nu, shear_modulus=1.0)
+        unbounded = np.where(area.mask, np.inf, 0.0)
+        return coefficients_of_solver(
+            area.area, lambda xi, eta, phi: fastsim_with(area, flex, xi, eta, phi,
+                                                         bound=unbounded, reference=reference),
+            reference=reference)
 
 
-def asm_fastsim_coefficients(area: GridArea, *, nu: float,
-                             reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
-    """Return ASM + FastSim's coefficients in full adhesion (ASM's own ``C~11, C~22, C~23``)."""
-    flex = asm_flexibility(area, nu=nu, shear_modulus=1.0)
-    unbounded = np.where(area.mask, np.inf, 0.0)
-    return coefficients_of_solver(
-        area.area, lambda xi, eta, phi: fastsim_with(area, flex, xi, eta, phi, bound=unbounded,
-                                                     reference=reference),
-        reference=reference)
+#: ASM + FastSim
+ASM_FASTSIM = FlexibilityMethod(asm_flexibility)
+#: ASM + FastSim: solve (forces in N, ``Mz`` about ``reference``; ``flexibility``: the result
+#: of :func:`asm_flexibility`, to reuse over many creepages: it costs ASM's linear system)
+asm_fastsim = ASM_FASTSIM.solve
+#: ASM + FastSim's coefficients in full adhesion (ASM's own ``C~11, C~22, C~23``)
+asm_fastsim_coefficients = ASM_FASTSIM.coefficients

@@ -45,13 +45,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.asm import CalibratedFlexibility, centroid, fastsim_with
+from fastsim_ros.contact.asm import CalibratedFlexibility, FlexibilityMethod, centroid
 from fastsim_ros.contact.checks import check_material
-from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
-from fastsim_ros.contact.fastsim import sweep_integrals, traction_bound
-from fastsim_ros.contact.friction import FrictionLaw
+from fastsim_ros.contact.fastsim import sweep_integrals
 from fastsim_ros.contact.influence import influence_kernel
-from fastsim_ros.contact.traction import Tractions
 
 FloatArray = NDArray[np.float64]
 
@@ -172,27 +169,10 @@ def dlm_flexibility(area: GridArea, *, nu: float, shear_modulus: float) -> Calib
     return CalibratedFlexibility(it.l1[-1], it.l2[-1], it.l3[-1], x_c, y_c)
 
 
-def dlm_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, mu: float, nu: float,
-                shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
-                bound: str = "given", friction: FrictionLaw | None = None,
-                speed: float | None = None,
-                flexibility: CalibratedFlexibility | None = None) -> Tractions:
-    """Solve DLM + FastSim (forces in N, ``Mz`` about ``reference``); ``phi`` in 1/m.
-
-    ``flexibility``: :func:`dlm_flexibility`'s result for this area and
-    material, to reuse over many creepages.
-    """
-    flex = flexibility or dlm_flexibility(area, nu=nu, shear_modulus=shear_modulus)
-    return fastsim_with(area, flex, xi, eta, phi, bound=traction_bound(area, mu, bound=bound),
-                        reference=reference, friction=friction, speed=speed)
-
-
-def dlm_coefficients(area: GridArea, *, nu: float,
-                     reference: tuple[float, float] = (0.0, 0.0)) -> CreepCoefficients:
-    """Return DLM + FastSim's generalised coefficients in full adhesion about ``reference``."""
-    flex = dlm_flexibility(area, nu=nu, shear_modulus=1.0)
-    unbounded = np.where(area.mask, np.inf, 0.0)
-    return coefficients_of_solver(
-        area.area, lambda xi, eta, phi: fastsim_with(area, flex, xi, eta, phi, bound=unbounded,
-                                                     reference=reference),
-        reference=reference)
+#: DLM + FastSim
+DLM_FASTSIM = FlexibilityMethod(dlm_flexibility)
+#: DLM + FastSim: solve (forces in N, ``Mz`` about ``reference``; ``flexibility``: the result
+#: of :func:`dlm_flexibility`, to reuse over many creepages)
+dlm_fastsim = DLM_FASTSIM.solve
+#: DLM + FastSim's generalised coefficients in full adhesion about ``reference``
+dlm_coefficients = DLM_FASTSIM.coefficients

@@ -23,7 +23,7 @@ def plot_sweep(args: argparse.Namespace, poses: Sequence[tuple[float, float]],
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from fastsim_ros.cli_wheelset import _write_atomically
+    from fastsim_ros.atomic import write_atomically
     from fastsim_ros.geometry.placement import Placement, place_rail
     from fastsim_ros.geometry.profiles import read_profile
 
@@ -83,5 +83,5 @@ def plot_sweep(args: argparse.Namespace, poses: Sequence[tuple[float, float]],
         ax.legend(fontsize=8)
     fig.suptitle(f"wheelset sweep, method {args.method}")
     fig.tight_layout()
-    _write_atomically(Path(path), lambda f: fig.savefig(f, format="png", dpi=110), binary=True)
+    write_atomically(Path(path), lambda f: fig.savefig(f, format="png", dpi=110), binary=True)
     plt.close(fig)
