@@ -649,7 +649,7 @@ def mbench_a22() -> tuple[Bag, dict[str, Any]]:
 
 
 def transient_step() -> tuple[Bag, dict[str, Any]]:
-    """Build (g): a step in xi at 2 m/s, patches at 1 kHz, ``rolling: transient``.
+    """Build (g): a step in xi at 2 m/s, patches at 1 kHz, ``rolling: transient`` (MAE).
 
     Hertzian treads; xi 0.5e-3 -> 2e-3 at 30 ms (twists at 2 kHz, patches
     0.25 ms after a twist): each cycle rolls 2 mm of the patch, so the
@@ -676,7 +676,7 @@ def transient_step() -> tuple[Bag, dict[str, Any]]:
             bag.add("/contact/left/patch", ns, cloud_msg(ns, pts["left"]))
         bag.add("/contact/right/patch", ns, cloud_msg(ns, lifted if k in (90, 91)
                                                       else pts["right"]))
-    return bag, {"rolling": "transient", "method": "mae_calibrated"}
+    return bag, {"rolling": "transient"}
 
 
 # ------------------------------------------------------------------ params, main
