@@ -657,7 +657,7 @@ def transient_step() -> tuple[Bag, dict[str, Any]]:
     60.25 ms (the state rolls 4 mm that cycle); the right wheel lifts at
     90.25 and 91.25 ms (empty patches: its traction restarts from zero).
     """
-    dur, v0, dt = 0.2, 2.0, 0.001
+    dur, v0, dt = 0.25, 2.0, 0.001
     bag = track_bag("transient_step", ["left", "right"])
     area = hertz_area(R, 0.3, 6.0e4, 24)
     pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
