@@ -18,6 +18,9 @@ each call, after a warm-up; the three compiled calls interleaved in blocks):
 - ``EquivalentEllipseSolver.solve`` (the baseline, same patch),
 - ``CalibratedMaeSolver.solve`` (the second MAE method, same patch; the
   target is at most 1.5x ``MaeSolver.solve``, TARGETS.md),
+- ``TransientSolver.step`` on the calibrated MAE (transient rolling: the
+  traction carried from the last step, which rolled two cells; the issue's
+  target is at most 1.5x the steady ``CalibratedMaeSolver.solve``),
 
 then the batched throughput (patch solves per second, one core) of
 ``solve_batch`` on distinct patches and on one patch under many creepages.
@@ -44,6 +47,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipse
 from fastsim_ros.contact.fastsim import traction_bound
 from fastsim_ros.contact.mae import mae_fastsim
 from fastsim_ros.contact.tables import coefficient_table
+from fastsim_ros.contact.transient import TransientSolver
 from fastsim_ros.machine import machine  # the one machine line of every benchmark
 
 NU, G, MU, LOAD = 0.28, 8.0e10, 0.3, 5.0e4
@@ -158,6 +162,7 @@ def main() -> None:
     mae = MaeSolver(NU, G)
     calibrated = CalibratedMaeSolver(NU, G)
     baseline = EquivalentEllipseSolver(NU, G)
+    transient = TransientSolver(calibrated)
     table = coefficient_table(NU)
     knots, polys = mae._knots, mae._polys
     rng = np.random.default_rng(0)
@@ -165,7 +170,8 @@ def main() -> None:
 
     head = (f"{'patch':<14}{'grid':>6}{'cells':>6}{'slip':>6}  {'solve':>13}  "
             f"{'solve_arrays':>13}  {'geometry':>8}{'share':>7}  {'numpy ref':>10}  "
-            f"{'equivalent':>13}{'eq/mae':>7}  {'calibrated':>13}{'cal/mae':>8}")
+            f"{'equivalent':>13}{'eq/mae':>7}  {'calibrated':>13}{'cal/mae':>8}"
+            f"  {'transient':>13}{'tr/cal':>7}")
     print(head)
     print("-" * len(head))
     rates = []
@@ -175,13 +181,18 @@ def main() -> None:
             p = np.array(ar.pressure)
             grid = (ar.x0, ar.y0, ar.dx, ar.dy)
             res = mae.solve(ar, xi, eta, phi, mu=MU)
+            state = [transient.step(None, p, *grid, xi, eta, phi, 2 * ar.dx, MU)[1]]
+
+            def step() -> None:
+                state[0] = transient.step(state[0], p, *grid, xi, eta, phi, 2 * ar.dx, MU)[1]
             t = per_call({
                 "solve": lambda: mae.solve(ar, xi, eta, phi, mu=MU),
                 "arrays": lambda: mae.solve_arrays(p, *grid, xi, eta, phi, MU),
                 "equivalent": lambda: baseline.solve(ar, xi, eta, phi, mu=MU),
-                "calibrated": lambda: calibrated.solve(ar, xi, eta, phi, mu=MU)}, args.calls)
+                "calibrated": lambda: calibrated.solve(ar, xi, eta, phi, mu=MU),
+                "transient": step}, args.calls)
             t_solve, t_arrays, t_eq = t["solve"], t["arrays"], t["equivalent"]
-            t_cal = t["calibrated"]
+            t_cal, t_tr = t["calibrated"], t["transient"]
             kargs = (ar.pressure, *grid, G, knots, polys)
             t_geo = in_kernel(_loop_prepare, *kargs)
             t_whole = in_kernel(_loop_solve, *kargs, xi, eta, phi, MU)
@@ -194,7 +205,8 @@ def main() -> None:
                   f"{t_arrays[0]:>6.1f} /{t_arrays[1]:>5.1f}  {t_geo:>8.2f}"
                   f"{100 * t_geo / t_whole:>6.0f}%  {t_ref[0]:>10.0f}  "
                   f"{t_eq[0]:>6.1f} /{t_eq[1]:>5.1f}{t_eq[0] / t_solve[0]:>7.2f}  "
-                  f"{t_cal[0]:>6.1f} /{t_cal[1]:>5.1f}{t_cal[0] / t_solve[0]:>8.2f}")
+                  f"{t_cal[0]:>6.1f} /{t_cal[1]:>5.1f}{t_cal[0] / t_solve[0]:>8.2f}"
+                  f"  {t_tr[0]:>6.1f} /{t_tr[1]:>5.1f}{t_tr[0] / t_cal[0]:>7.2f}")
             # batches: distinct patches (load and a fore-aft tilt of the pressure vary
             # smoothly from patch to patch, as from a normal solver) and creepages
             b = args.batch
@@ -210,7 +222,8 @@ def main() -> None:
           "loop);\nshare: of the whole compiled MAE solve (mae_solve, same loop); numpy ref: "
           "mae_fastsim,\nmedian of fewer calls; eq/mae: median of EquivalentEllipseSolver.solve "
           "over MaeSolver.solve;\ncalibrated: CalibratedMaeSolver.solve, cal/mae its median over "
-          "MaeSolver.solve's.\n")
+          "MaeSolver.solve's;\ntransient: TransientSolver(CalibratedMaeSolver).step rolling 2 "
+          "cells from the last state,\ntr/cal its median over CalibratedMaeSolver.solve's.\n")
     print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
     head = (f"{'patch':<14}{'grid':>6}  {'MAE distinct':>13}{'MAE 1 patch':>13}"
             f"{'eq distinct':>13}{'eq 1 patch':>13}{'cal distinct':>13}{'cal 1 patch':>13}")

@@ -648,6 +648,37 @@ def mbench_a22() -> tuple[Bag, dict[str, Any]]:
                  "wheel_load": 0.0}
 
 
+def transient_step() -> tuple[Bag, dict[str, Any]]:
+    """Build (g): a step in xi at 2 m/s, patches at 1 kHz, ``rolling: transient`` (MAE).
+
+    Hertzian treads; xi 0.5e-3 -> 2e-3 at 30 ms (twists at 2 kHz, patches
+    0.25 ms after a twist): each cycle rolls 2 mm of the patch, so the
+    traction builds up over a few cycles.  One left patch is dropped at
+    60.25 ms (the state rolls 4 mm that cycle); the right wheel lifts at
+    90.25 and 91.25 ms (empty patches: its traction restarts from zero).
+    """
+    dur, v0, dt = 0.25, 2.0, 0.001
+    bag = track_bag("transient_step", ["left", "right"])
+    area = hertz_area(R, 0.3, 6.0e4, 24)
+    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
+           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
+    lifted = pts["right"].copy()
+    lifted[..., 6] = 0.0
+    for k in range(int(round(dur / (dt / 2)))):
+        t = k * dt / 2
+        xi = 0.5e-3 if t < 0.03 else 2.0e-3
+        bag.add("/wheelset/twist", stamp_ns(t),
+                twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, xi, R), 0)))
+    for k in range(int(round(dur / dt))):
+        t = 0.00025 + k * dt
+        ns = stamp_ns(t)
+        if k != 60:
+            bag.add("/contact/left/patch", ns, cloud_msg(ns, pts["left"]))
+        bag.add("/contact/right/patch", ns, cloud_msg(ns, lifted if k in (90, 91)
+                                                      else pts["right"]))
+    return bag, {"rolling": "transient"}
+
+
 # ------------------------------------------------------------------ params, main
 
 SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
@@ -657,6 +688,7 @@ SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
     "roller_rig": roller_rig,
     "bad_inputs": bad_inputs,
     "mbench_a22": mbench_a22,
+    "transient_step": transient_step,
 }
 
 BASE_PARAMS: dict[str, Any] = {

@@ -26,7 +26,7 @@ def _published() -> list[dict[str, str]]:
 
 @pytest.fixture(scope="module")
 def area():
-    """The example's normal contact: its gap A x^2 + B y^2 under FN on its grid."""
+    """Return the example's normal contact: its gap A x^2 + B y^2 under FN on its grid."""
     x0 = XL + 0.5 * DX
     x = x0 + DX * np.arange(NX)
     y = x0 + DX * np.arange(NY)

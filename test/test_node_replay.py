@@ -54,7 +54,7 @@ def force(w):
     return (w.wrench.force.x, w.wrench.force.y, w.wrench.force.z, w.wrench.torque.z)
 
 
-@pytest.mark.parametrize("bag", ["hertz_ramp", "roller_rig", "flange_shift"])
+@pytest.mark.parametrize("bag", ["hertz_ramp", "roller_rig", "flange_shift", "transient_step"])
 def test_node_fed_by_a_player_equals_the_offline_replay(bag, tmp_path):
     want = offline_wrenches(bag, tmp_path / "offline")
     with Reader(BAGS / bag) as reader:

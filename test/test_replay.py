@@ -48,7 +48,7 @@ from msg_adapters.patch import patch_from_cloud  # noqa: E402
 BAGS = ROOT / "bags"
 GOLDEN = BAGS / "golden"
 NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_inputs",
-         "mbench_a22")
+         "mbench_a22", "transient_step")
 TYPES = get_typestore(Stores.ROS2_JAZZY)
 WRENCH, VECTOR = "geometry_msgs/msg/WrenchStamped", "geometry_msgs/msg/Vector3Stamped"
 POSE, DIAG = "geometry_msgs/msg/PoseStamped", "diagnostic_msgs/msg/DiagnosticArray"

@@ -71,18 +71,18 @@ STEADY_RESETS = ("start", "stamp_gap", "reversed")
 @njit(cache=True, error_model="numpy")
 def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                       shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
-                      calibrated, pair_knots, pair_values, prev_x, prev_y, rolled):
+                      calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo):
     """One time step of MAE + FastSim, rolling ``rolled`` (m) from the state ``prev_x, prev_y``.
 
     As :func:`fastsim_ros.contact.kernels.mae_solve` (same arguments and
     return) with the previous tractions (Pa, the patch's grid) and the new
-    ones written to ``out_x``, ``out_y`` (always stored: the next state).
+    ones written to ``out_x``, ``out_y`` (always stored: the next state);
+    ``geo`` receives the MAE geometry (:data:`~kernels.GEO_SIZE`).
     """
     status = k.check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != k.OK:
         return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
     ny, nx = p.shape
-    geo = np.empty(k.GEO_SIZE)
     env = np.empty((2, nx), dtype=np.int64)
     strips = np.empty((3, ny), dtype=np.int64)
     status, info = k.mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo,
@@ -193,21 +193,6 @@ class TractionState:
         return out[0], out[1]
 
 
-def _patch_measures(p: FloatArray, grid: tuple[float, float, float, float]
-                    ) -> tuple[float, tuple[float, float], float]:
-    """Return the area in contact (m^2), the pressure centroid (m) and the half length (m)."""
-    x0, y0, dx, dy = grid
-    inside = p > 0.0
-    cols = np.flatnonzero(inside.any(axis=0))
-    total = float(p[inside].sum())
-    xs = x0 + dx * np.arange(p.shape[1])
-    ys = y0 + dy * np.arange(p.shape[0])
-    centroid = (float((p.sum(axis=0) * xs).sum() / total),
-                float((p.sum(axis=1) * ys).sum() / total))
-    return (float(inside.sum()) * dx * dy, centroid,
-            0.5 * dx * float(cols[-1] - cols[0] + 1))
-
-
 class TransientSolver:
     """Non-steady FastSim on a compiled solver's patches (MAE, calibrated MAE, ellipse).
 
@@ -246,11 +231,15 @@ class TransientSolver:
             shape = p.shape
             prev = self._previous(state, grid, shape)
             out = (np.empty(shape), np.empty(shape), np.empty(shape, dtype=np.bool_))
+            geo = np.empty(k.GEO_SIZE)
             result = mae_rolling_solve(
                 p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta), float(phi),
                 float(mu_s), xp, yp, s._rule, parabolic, s.shear_modulus, s._knots, s._polys,
                 code, prm, v, out[0], out[1], out[2], s._calibrated, s._pair_knots,
-                s._pair_values, prev[0], prev[1], float(rolled))
+                s._pair_values, prev[0], prev[1], float(rolled), geo)
+            # the patch's area, centroid and half length, for ContactMemory's jump rule
+            measures = (float(geo[k.G_AREA]), (float(geo[k.G_XC]), float(geo[k.G_YC])),
+                        float(geo[k.G_ELLIPSE + 2]))
         else:
             n = s.cells or k.ellipse_cells(int(np.count_nonzero(p > 0.0)))
             ell = np.empty(k.ELL_SIZE)
@@ -267,9 +256,11 @@ class TransientSolver:
                 float(phi), float(mu_s), xp, yp, parabolic, n, s.shear_modulus, s._knots,
                 s._polys, code, prm, v, out[0], out[1], out[2], prev[0], prev[1],
                 float(rolled), ell)
+            # the equivalent ellipse has the patch's area and centroid
+            measures = (math.pi * float(ell[k.ELL_A] * ell[k.ELL_B]),
+                        (float(ell[k.ELL_XC]), float(ell[k.ELL_YC])), float(ell[k.ELL_A]))
         forces = s._forces(result, grid, out, True)
-        area, centroid, half = _patch_measures(p, (float(x0), float(y0), float(dx), float(dy)))
-        return forces, TractionState(out[0], out[1], grid, area, centroid, half)
+        return forces, TractionState(out[0], out[1], grid, *measures)
 
     def _previous(self, state: TractionState | None, grid: tuple[float, float, float, float],
                   shape: tuple[int, ...]) -> tuple[FloatArray, FloatArray]:
@@ -311,9 +302,8 @@ class ContactMemory:
         self.lost = True
         self.lost_ns = int(stamp_ns)
 
-    def _rule(self, stamp_ns: int, speed: float, pressure: FloatArray,
-              grid: tuple[float, float, float, float]) -> str | None:
-        """Return the reset (or resampling) that applies to this patch, ``None`` for none."""
+    def _rule(self, stamp_ns: int, speed: float) -> str | None:
+        """Return the reset that applies before the solve (the jump is found after it)."""
         if self.lost and self.lost_ns is not None and stamp_ns >= self.lost_ns and (
                 stamp_ns - self.lost_ns) * 1e-9 <= self.max_gap:
             return "lost_contact"
@@ -323,13 +313,13 @@ class ContactMemory:
             return "stamp_gap"
         if math.copysign(1.0, speed) != self.direction:
             return "reversed"
-        area, centroid, _ = _patch_measures(pressure, grid)
-        s = self.state
-        tol = self.jump_tolerance
-        moved = math.hypot(centroid[0] - s.centroid[0], centroid[1] - s.centroid[1])
-        if abs(area - s.area) > tol * s.area or moved > tol * s.half_length:
-            return "patch_jump"
         return None
+
+    def _jumped(self, old: TractionState, new: TractionState) -> bool:
+        """Whether the patch's area or centroid moved beyond the tolerance in one step."""
+        tol = self.jump_tolerance
+        moved = math.hypot(new.centroid[0] - old.centroid[0], new.centroid[1] - old.centroid[1])
+        return abs(new.area - old.area) > tol * old.area or moved > tol * old.half_length
 
     def solve(self, stamp_ns: int, speed: float, pressure: ArrayLike, x0: float, y0: float,
               dx: float, dy: float, xi: float, eta: float, phi: float, mu: float | None = None,
@@ -343,8 +333,7 @@ class ContactMemory:
         the reset reason that applied (``None``: the state carried over).
         """
         p = _pressure(pressure, 2)
-        grid = (float(x0), float(y0), float(dx), float(dy))
-        reason = self._rule(stamp_ns, speed, p, grid)
+        reason = self._rule(stamp_ns, speed)
         state = self.state
         if reason in STEADY_RESETS:
             rolled, state = math.inf, None
@@ -356,11 +345,16 @@ class ContactMemory:
             rolled = abs(speed) * max(stamp_ns - since, 0) * 1e-9
             if reason is not None:
                 state = None
-        forces, self.state = self.solver.step(state, p, x0, y0, dx, dy, xi, eta, phi, rolled,
-                                              mu, reference=reference, bound=bound,
-                                              friction=friction, speed=abs(speed))
-        if reason is None and self.solver.resampled:
+        args = (p, x0, y0, dx, dy, xi, eta, phi, rolled, mu)
+        kw = {"reference": reference, "bound": bound, "friction": friction, "speed": abs(speed)}
+        forces, new = self.solver.step(state, *args, **kw)  # type: ignore[arg-type]
+        if reason is None and state is not None and self._jumped(state, new):
+            # another contact than the last one: its material has no history
+            reason = "patch_jump"
+            forces, new = self.solver.step(None, *args, **kw)  # type: ignore[arg-type]
+        elif reason is None and self.solver.resampled:
             reason = "resampled"
+        self.state = new
         if reason is not None:
             self.counts[reason] += 1
         self.stamp_ns = int(stamp_ns)
