@@ -49,6 +49,10 @@ ALLOWED = {
               "partial_slip", "rolling", "traction"},
     "normal": {"numpy", "scipy", "area", "checks", "errors", "influence"},
     "samples": {"numpy", "area", "errors", "normal"},
+    "transient": {"numpy", "numba", "checks", "compiled", "errors", "friction", "kernels"},
+    "exact_transient": {"numpy", "area", "checks", "errors", "influence", "partial_slip",
+                        "rolling", "traction"},
+    "seed_tables": {"errors"},
 }
 
 
