@@ -480,26 +480,35 @@ class Pipeline:
 
     # ---------------------------------------------------------------- kinematics
 
+    def _screened(self, message: StampedTwist | bytes | memoryview, last_ns: int | None
+                  ) -> StampedTwist | str:
+        """Return a twist or wrench (one CDR layout) screened, or why it is dropped.
+
+        The kinematics' rules. Dropped: malformed, another frame than the
+        wheelset's, non-finite, or a stamp older than ``last_ns`` (the last taken).
+        """
+        if not isinstance(message, StampedTwist):
+            try:
+                message = read_twist(message)
+            except MalformedMessageError:
+                return "malformed"
+        if message.frame_id != self._frame_id:
+            return "wrong_frame"
+        if not twist_is_finite(message):
+            return "nonfinite"
+        if last_ns is not None and message.stamp_ns < last_ns:
+            return "old_stamp"
+        return message
+
     def _twist(self, history: deque[StampedTwist], twist: StampedTwist | bytes | memoryview,
                what: str) -> str:
-        if not isinstance(twist, StampedTwist):
-            try:
-                twist = read_twist(twist)
-            except MalformedMessageError:
-                self.kinematics_counts["malformed"] += 1
-                return "malformed"
-        if twist.frame_id != self._frame_id:
-            reason = "wrong_frame"
-        elif not twist_is_finite(twist):
-            reason = "nonfinite"
-        elif history and twist.stamp_ns < history[-1].stamp_ns:
-            reason = "old_stamp"
-        else:
-            history.append(twist)
-            self.kinematics_counts[what] += 1
-            return "ok"
-        self.kinematics_counts[reason] += 1
-        return reason
+        taken = self._screened(twist, history[-1].stamp_ns if history else None)
+        if isinstance(taken, str):
+            self.kinematics_counts[taken] += 1
+            return taken
+        history.append(taken)
+        self.kinematics_counts[what] += 1
+        return "ok"
 
     def on_wheel_twist(self, twist: StampedTwist | bytes | memoryview) -> str:
         """Take a wheelset twist (decoded or CDR); return ``"ok"`` or why it was dropped."""
@@ -517,25 +526,14 @@ class Pipeline:
         ``estimation_counts["dropped"]``) as a twist is: malformed, another
         frame, non-finite, older than the last.
         """
-        if not isinstance(wrench, StampedTwist):
-            try:
-                wrench = read_twist(wrench)  # the layout of a WrenchStamped
-            except MalformedMessageError:
-                self.estimation_counts["dropped"] += 1
-                return "malformed"
-        if wrench.frame_id != self._frame_id:
-            reason = "wrong_frame"
-        elif not twist_is_finite(wrench):
-            reason = "nonfinite"
-        elif self._measured and wrench.stamp_ns < self._measured[-1][0]:
-            reason = "old_stamp"
-        else:
-            f = wrench.linear
-            self._measured.append((wrench.stamp_ns, (f[0], f[1], f[2])))
-            self.estimation_counts["measured"] += 1
-            return "ok"
-        self.estimation_counts["dropped"] += 1
-        return reason
+        taken = self._screened(wrench, self._measured[-1][0] if self._measured else None)
+        if isinstance(taken, str):
+            self.estimation_counts["dropped"] += 1
+            return taken
+        f = taken.linear
+        self._measured.append((taken.stamp_ns, (f[0], f[1], f[2])))
+        self.estimation_counts["measured"] += 1
+        return "ok"
 
     def _measurement(self, stamp_ns: int) -> tuple[float, float, float] | None:
         """Return the measured force of the cycle stamped ``stamp_ns``, by the kinematics' rules.
