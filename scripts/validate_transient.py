@@ -99,23 +99,27 @@ def main() -> None:
                      f"{'yes' if r[9] else 'no'} |")
     ok = sum(r[9] for r in rows)
     lines += ["", f"{ok} of {len(rows)} step responses within the criterion.", "",
-              "With V dt at least the patch length (V dt / a >= 2) the fast methods give "
-              "their steady answers at once (tested exactly in "
-              "`test/test_contact_transient.py`); the exact response is then within a few "
-              "points of its steady value (its elastic field outside the patch keeps a "
-              "memory that decays about 7 % a cell rolled, "
-              "`test_rolling_reaches_the_steady_state`). The gaps at small V dt are those "
-              "of the simplified theory's build-up: FastSim's traction grows with the "
-              "distance a particle has rolled (u = L tau, local), the half-space's with "
-              "the whole patch's displacement field, so the first cycles after a step "
-              "differ by more than the steady error. The first step from zero traction is "
-              "a shift of the bodies by xi dx: FastSim answers it with the stiffness "
-              "pi a^2 / L = (3 pi / 8) C11 G a, the half-space (Cattaneo-Mindlin) with "
-              "about half of it, so the fast methods build up roughly twice as fast over "
-              "the first contact length. Issue 29's criterion is met only when V dt is at "
-              "least the patch length; a remedy (a separate flexibility for the elastic "
-              "memory, e.g. from the shift problem) is left open.",
-              ""]
+              "The fast methods step with Kalker's non-steady FASTSIM and two additions "
+              "(`fastsim_ros/contact/transient.py`, each stated there): (1) the "
+              "half-space's far field: FastSim's displacement is local (u = L tau), so a "
+              "rigid shift of the bodies meets the stiffness sum dA / L = (3 pi / 8) C11 G a "
+              "on a circle, about twice the half-space's (Mindlin: 4 G a / (2 - nu), "
+              "checked against the exact Cattaneo shift in `test/test_contact_transient.py`"
+              "); with u = L tau + M F (F the patch's force, M = c_Mindlin - 1 / sum(dA/L)) "
+              "the first cycles after a step build up at the half-space's stiffness, while "
+              "steady rolling is unchanged (F constant); the step's own force is found by "
+              "secant steps, each a sweep, and material that entered during the step sees "
+              "the far field's change since it entered (a first-order lag of the force "
+              "over its relaxation length, tapered so that a step of the patch's length "
+              "is the steady state). (2) A particle that slips on its way from x + V dt "
+              "is marched along its path cell by cell (the slip's direction follows the "
+              "local rigid slip, which spin turns along the path); one projection over a "
+              "long step gave a fixed point of twice the steady Fy under spin.", "",
+              "With V dt at least the patch length the fast methods give their steady "
+              "answers at once (tested exactly in `test/test_contact_transient.py`); the "
+              "exact response is then within a few points of its steady value (its "
+              "elastic field outside the patch keeps a memory that decays about 7 % a cell "
+              "rolled, `test_rolling_reaches_the_steady_state`).", ""]
     OUT.write_text("\n".join(lines))
     print(f"wrote {OUT}: {ok} of {len(rows)} within the criterion")
 

@@ -13,7 +13,11 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseS
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.fastsim import sweep_integrals
 from fastsim_ros.contact.friction import ExponentialFriction
-from fastsim_ros.contact.transient import ContactMemory, TransientSolver
+from fastsim_ros.contact.exact import coulomb
+from fastsim_ros.contact.exact_transient import (TransientOperators, cattaneo_shift,
+                                                 rolling_step)
+from fastsim_ros.contact.transient import (ContactMemory, TransientSolver, elliptic_ke,
+                                           mindlin_compliance)
 
 NU, G, MU = 0.28, 8.0e10, 0.3
 SOLVERS = (MaeSolver, CalibratedMaeSolver, EquivalentEllipseSolver)
@@ -62,9 +66,9 @@ def test_steady_limit_with_slip_dependent_friction(patch) -> None:
 
 @pytest.mark.parametrize("solver_cls", SOLVERS)
 def test_steps_of_one_cell_reach_the_steady_state_exactly(solver_cls, patch) -> None:
-    """Steps of ``V dt = dx`` from zero traction: the steady answer after one patch length."""
+    """Kalker's local model, steps of ``V dt = dx`` from zero: steady after one patch length."""
     solver = solver_cls(NU, G)
-    t = TransientSolver(solver)
+    t = TransientSolver(solver, far_field=False)
     creep = CREEPAGES[2]
     steady = solver.solve(patch, *creep, mu=MU, tractions=True)
     state = None
@@ -96,7 +100,7 @@ def test_fractional_steps_converge_to_the_refined_steady_state() -> None:
     and ``dx/2``, nearer the latter.
     """
     solver = MaeSolver(NU, G)
-    t = TransientSolver(solver)
+    t = TransientSolver(solver, far_field=False)
     creep = CREEPAGES[2]
     coarse = areas.ellipse(6e-3, 4e-3, nx=40, ny=30, load=4e4)
     fine = areas.ellipse(6e-3, 4e-3, nx=80, ny=30, load=4e4)
@@ -124,7 +128,7 @@ def test_build_up_in_adhesion_follows_kalkers_transient(patch) -> None:
     ``s`` from zero traction (``d``: its distance from the leading edge).
     """
     solver = MaeSolver(NU, G)
-    t = TransientSolver(solver)
+    t = TransientSolver(solver, far_field=False)
     xi = 2e-5
     status, _, geo = solver._prepare(patch)
     assert status == kernels.OK
@@ -192,3 +196,111 @@ def test_refuses_negative_distance(patch) -> None:
     """A negative distance rolled is refused."""
     with pytest.raises(InvalidInputError):
         _step(TransientSolver(MaeSolver(NU, G)), None, patch, CREEPAGES[0], -1e-3, mu=MU)
+
+
+def test_elliptic_integrals_against_published_values() -> None:
+    """``K(m)``, ``E(m)`` by the AGM against Abramowitz & Stegun's Table 17.1 (m = 0.5, 0.9)."""
+    assert elliptic_ke(0.0) == pytest.approx((math.pi / 2, math.pi / 2), rel=1e-15)
+    assert elliptic_ke(0.5) == pytest.approx((1.8540746773013719, 1.3506438810476755),
+                                             rel=1e-14)
+    assert elliptic_ke(0.9) == pytest.approx((2.5780921133481731, 1.1047747327040733),
+                                             rel=1e-14)
+
+
+@pytest.mark.parametrize("a_over_b", [0.2, 1.0, 5.0])
+def test_mindlin_compliance_is_the_exact_shift_in_adhesion(a_over_b: float) -> None:
+    """Mindlin's compliance of an ellipse against the exact Cattaneo shift in full stick.
+
+    The exact solver on 40 x 40 cells (uniform tractions on cells miss a
+    little of the edge singularity of the adhesive traction: 0.3 %).
+    """
+    a, b = 6e-3 * math.sqrt(a_over_b), 6e-3 / math.sqrt(a_over_b)
+    ar = areas.ellipse(a, b, nx=40, ny=40, load=4e4)
+    c_x, c_y = mindlin_compliance(a, b, NU, G)
+    delta = 1e-9
+    k_x = abs(cattaneo_shift(ar, delta, 0.0, mu=1e3, nu=NU, shear_modulus=G).fx) / delta
+    k_y = abs(cattaneo_shift(ar, 0.0, delta, mu=1e3, nu=NU, shear_modulus=G).fy) / delta
+    assert k_x * c_x == pytest.approx(1.0, abs=0.005)
+    assert k_y * c_y == pytest.approx(1.0, abs=0.005)
+    if a_over_b == 1.0:
+        assert c_x == pytest.approx((2 - NU) / (4 * G * a), rel=1e-12)
+
+
+@pytest.mark.parametrize("solver_cls", SOLVERS)
+def test_the_first_step_from_zero_takes_mindlins_stiffness(solver_cls, patch) -> None:
+    """A small creepage step, rolled a tenth of a cell: the force is Mindlin's shift's.
+
+    The particles in the contact are shifted by ``xi h``: the far field
+    gives the patch the half-space's stiffness ``1 / c`` (the local model
+    twice as stiff).
+    """
+    solver = solver_cls(NU, G)
+    xi, h = 1e-5, 0.1 * patch.dx
+    f, _ = _step(TransientSolver(solver), None, patch, (xi, 0.0, 0.0), h, mu=MU)
+    local, _ = _step(TransientSolver(solver, far_field=False), None, patch, (xi, 0.0, 0.0), h,
+                     mu=MU)
+    c_x, _ = mindlin_compliance(6e-3, 4e-3, NU, G)
+    mindlin = -xi * h / c_x
+    # the material entered during the step (a twentieth of the patch) shifts less
+    assert f.fx == pytest.approx(mindlin, rel=0.05)
+    assert local.fx / mindlin > 1.8
+
+
+@pytest.mark.parametrize("solver_cls", SOLVERS)
+def test_the_far_field_keeps_the_steady_state_and_reaches_it(solver_cls, patch) -> None:
+    """From the steady state, steps of a cell stay on it; from zero, they converge to it."""
+    solver = solver_cls(NU, G)
+    t = TransientSolver(solver)
+    creep = CREEPAGES[1]
+    steady = solver.solve(patch, *creep, mu=MU)
+    state = None
+    _, state = _step(t, None, patch, creep, math.inf, mu=MU)
+    h = state.grid[2]
+    for _ in range(3):
+        f, state = _step(t, state, patch, creep, h, mu=MU)
+        assert (f.fx, f.fy) == pytest.approx((steady.fx, steady.fy), rel=1e-12)
+    state = None
+    for _ in range(int(6 * 6e-3 / h)):
+        f, state = _step(t, state, patch, creep, h, mu=MU)
+    assert (f.fx, f.fy) == pytest.approx((steady.fx, steady.fy), rel=2e-3)
+
+
+def test_spin_in_slip_reaches_the_steady_state_with_long_steps() -> None:
+    """Steps of ten cells under spin in slip: the fixed point is the steady answer.
+
+    The traction's direction follows the local rigid slip along a particle's
+    path; projected once over a long step it took the path's mean direction
+    (a fixed point of twice the steady Fy before the path was marched cell
+    by cell).
+    """
+    ar = areas.ellipse(6e-3, 6e-3, nx=20, ny=20, load=4e4)
+    solver = EquivalentEllipseSolver(NU, G)
+    t = TransientSolver(solver)
+    steady = solver.solve(ar, 0.0, 0.0, 3.0, mu=MU)
+    state = None
+    for _ in range(8):
+        f, state = _step(t, state, ar, (0.0, 0.0, 3.0), 10 * ar.dx, mu=MU)
+    assert f.fy == pytest.approx(steady.fy, rel=1e-3)
+
+
+@pytest.mark.parametrize("kind", ["xi", "phi"])
+def test_step_response_follows_the_exact_transient_solver(kind: str) -> None:
+    """A creepage step at V dt / a = 0.3: within the steady error plus 2 % of mu N (issue 29)."""
+    a, n, load = 6e-3, 20, 4e4
+    ar = areas.ellipse(a, a, nx=n, ny=n, load=load)
+    creep = (1.5e-3, 0.0, 0.0) if kind == "xi" else (0.0, 0.0, 3.0)
+    key = "fx" if kind == "xi" else "fy"
+    ops = TransientOperators.of(ar, 1, nu=NU, shear_modulus=G)
+    exact, state = [], None
+    for _ in range(2 * n):
+        state = rolling_step(ar, ops, *creep, mu=MU, previous=state)
+        exact.append(getattr(state, key))
+    exact_steady = getattr(coulomb(ar, *creep, mu=MU, nu=NU, shear_modulus=G), key)
+    solver = CalibratedMaeSolver(NU, G)
+    steady_error = abs(getattr(solver.solve(ar, *creep, mu=MU), key) - exact_steady)
+    t = TransientSolver(solver)
+    tstate = None
+    for step in range(2 * n // 3):
+        f, tstate = _step(t, tstate, ar, creep, 3 * ar.dx, mu=MU)
+        gap = abs(getattr(f, key) - exact[3 * step + 2])
+        assert gap <= steady_error + 0.02 * MU * load, step

@@ -52,8 +52,10 @@ def test_creepage_step_builds_up_over_a_contact_length() -> None:
     assert abs(fx[0][0]) < abs(fx[2][1]) < 0.85 * abs(fx[2][0])
     rising = [abs(t) for _, t in fx[2:]]
     assert all(b >= a * (1.0 - 1e-9) for a, b in zip(rising, rising[1:]))
-    # after 2 mm x 9 cycles (18 mm > 12 mm): the steady answer
-    assert fx[-1][1] == pytest.approx(fx[-1][0], rel=1e-9)
+    # after 2 mm x 9 cycles (18 mm > 12 mm): the steady answer; the local model has it
+    # exactly once the patch is renewed, the half-space's far field (the patch's shift as
+    # the force builds up, transient.far_field) decays over its relaxation length (~1.8 a)
+    assert fx[-1][1] == pytest.approx(fx[-1][0], rel=1e-3)
 
 
 def test_the_pipeline_state_is_the_librarys() -> None:

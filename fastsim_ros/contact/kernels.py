@@ -314,13 +314,13 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     """
     return rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c,
                          y_s, xp, yp, law, prm, speed, out_x, out_y, slip, store, rigid,
-                         _NO_STATE, _NO_STATE, math.inf)
+                         _NO_STATE, _NO_STATE, math.inf, 0.0, 0.0, 1.0, 1.0)
 
 
 @njit(cache=True, error_model="numpy")
 def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
                   yp, law, prm, speed, out_x, out_y, slip, store, rigid, prev_x, prev_y,
-                  rolled):
+                  rolled, shift_x, shift_y, relax_x, relax_y):
     """March every strip from its leading edge over one time step of rolling ``rolled`` (m).
 
     Kalker's non-steady FASTSIM (Kalker 1990, "Three-dimensional elastic
@@ -335,7 +335,17 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     at ``x + rolled`` (zero at the segment's front face), minus the rigid
     slip over ``rolled`` divided by ``L`` (``phi x`` at the middle of the
     step), and the same projection on the bound follows, with the step
-    ``h = rolled``.  Slip-dependent laws: the kinetic level is the upstream
+    ``h = rolled``.  ``shift_x``, ``shift_y`` (m): the elastic shift of the
+    whole patch over the step (:mod:`fastsim_ros.contact.transient`, the
+    half-space's far field ``M dF``), added to the rigid slip of the cells
+    that were in the contact before the step (zero: Kalker's local model).
+    A cell that entered during the step, ``d`` (m) from the front face,
+    saw the part of it since it entered: the force is taken to approach its
+    new value over the step as a first-order lag of length ``relax_x``,
+    ``relax_y`` (m), so the shift since entry is ``s expm1(d/l) /
+    expm1(h/l)`` (``d/h`` for ``h << l``, nothing but the last ``l``
+    before the step's end for ``h >> l``: the steady state).
+    Slip-dependent laws: the kinetic level is the upstream
     cell's friction ratio in this sweep, as in the steady march.
 
     The kernel of :func:`fastsim_ros.contact.fastsim.sweep` and the
@@ -400,6 +410,20 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
         slip[:, :] = False
     nslip = 0
     ncontact = 0
+    # the far field's share since entry of the n-th cell of a segment (d = half + n dx)
+    far = shift_x != 0.0 or shift_y != 0.0
+    share = np.zeros((2, nx + 1 if far else 1))
+    if far:
+        for c in range(2):
+            relax = relax_x if c == 0 else relax_y
+            for n in range(nx + 1):
+                d = half + n * dx
+                if d >= rolled:
+                    share[c, n] = 1.0
+                elif rolled > 50.0 * relax:
+                    share[c, n] = math.exp((d - rolled) / relax)
+                else:
+                    share[c, n] = math.expm1(d / relax) / math.expm1(rolled / relax)
     # slip-dependent laws: |V| per metre of a full step and of a segment's first half step
     v_full = speed / dx
     v_half = speed / half
@@ -425,7 +449,20 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                 dist[j] = half
                 first[j] = i
             cont[j] = i - 1
+            g_x = 0.0
+            g_y = 0.0
+            if far and dist[j] <= rolled:
+                # entered during the step: the far field's increment over this cell's march
+                n = int((dist[j] - half) / dx + 0.5)
+                if n == 0:
+                    g_x = shift_x * share[0, 0]
+                    g_y = shift_y * share[1, 0]
+                else:
+                    g_x = shift_x * (share[0, n] - share[0, n - 1])
+                    g_y = shift_y * (share[1, n] - share[1, n - 1])
             if dist[j] > rolled:
+                g_x = shift_x
+                g_y = shift_y
                 # in the contact before the step: from the previous state at x + rolled
                 s = rolled
                 f = rolled / dx
@@ -452,11 +489,38 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                     w0 = 1.0 - (rolled - k0 * dx) / half
                     t_x = w0 * prev_x[j, iu]
                     t_y = w0 * prev_y[j, iu]
+                if rolled > dx:
+                    # a particle that slips on its way from x + h: the slip's direction follows
+                    # the local rigid slip (spin turns it along the path), so the path is
+                    # marched in steps of at most a cell, each projected on the bound where
+                    # the particle is, as the steady march does; the last step is the cell's
+                    o_x = t_x - rate_x[j] * rolled - g_x / flex[0, j]
+                    o_y = (t_y - (rate_y0[j] + rate_yx[j] * (x_rel + 0.5 * rolled)) * rolled
+                           - g_y / flex[1, j])
+                    if o_x * o_x + o_y * o_y > g * g:
+                        nsub = int(math.ceil(rolled / dx - 1e-9))
+                        s = rolled / nsub
+                        g_x = g_x / nsub
+                        g_y = g_y / nsub
+                        for m in range(nsub - 1):
+                            x_m = x_rel + rolled - (m + 0.5) * s
+                            t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
+                            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_m) * s - g_y / flex[1, j]
+                            ic = min(i + int((rolled - (m + 1) * s) / dx + 0.5), nx - 1)
+                            g_m = outer * (shape[j, ic] * inner)
+                            m2 = t_x * t_x + t_y * t_y
+                            if not g_m > 0.0:
+                                t_x = 0.0
+                                t_y = 0.0
+                            elif m2 > g_m * g_m:
+                                scale = g_m / math.sqrt(m2)
+                                t_x = t_x * scale
+                                t_y = t_y * scale
             x_mid = x_rel + 0.5 * s
             p_x = t_x
             p_y = t_y
-            t_x = t_x - rate_x[j] * s
-            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s
+            t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
+            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s - g_y / flex[1, j]
             over = False
             m2 = t_x * t_x + t_y * t_y
             if law == LAW_CONSTANT:
@@ -472,8 +536,8 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                         done = False
                         if rigid:
                             r_x, r_y, done = rigid_slip_return(
-                                p_x, p_y, w_x[j] * s, (eta + phi * x_rel) * s, flex[0, j],
-                                flex[1, j], g)
+                                p_x, p_y, w_x[j] * s + g_x, (eta + phi * x_rel) * s + g_y,
+                                flex[0, j], flex[1, j], g)
                             if done:
                                 t_x = r_x
                                 t_y = r_y
@@ -501,12 +565,13 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                         vs = v_full if s == dx else (v_half if s == half else speed / s)
                         done = False
                         if rigid:
-                            wyh = (eta + phi * x_rel) * s
-                            r_x, r_y, done = rigid_slip_return(p_x, p_y, w_x[j] * s, wyh,
+                            wxh = w_x[j] * s + g_x
+                            wyh = (eta + phi * x_rel) * s + g_y
+                            r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh,
                                                                flex[0, j], flex[1, j], gk)
                             if done:
                                 # the slip at the kinetic level: |w h + L (tau_k - tau_p)| / h
-                                s_x = w_x[j] * s + flex[0, j] * (r_x - p_x)
+                                s_x = wxh + flex[0, j] * (r_x - p_x)
                                 s_y = wyh + flex[1, j] * (r_y - p_y)
                                 k = law_ratio(law, prm, speed * math.sqrt(s_x * s_x + s_y * s_y)
                                               / s)

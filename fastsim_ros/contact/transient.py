@@ -18,6 +18,25 @@ Dynamics 46, 2008, for the MAE patches):
   ``mu p`` (slip-dependent friction and the rigid-slip return as in the
   steady sweep): :func:`fastsim_ros.contact.kernels.rolling_sweep`.
 
+Two additions to Kalker's local model, each for a failure measured against
+the exact transient solver (``docs/validation_transient.md``):
+
+- **the half-space's far field** (:func:`far_field`): FastSim's displacement
+  is local, ``u = L tau``, so a rigid shift meets the stiffness ``sum dA /
+  L``, about twice Mindlin's (:func:`mindlin_compliance`), and a creepage
+  step built up twice as fast as the exact one.  With ``u = L tau + M F``
+  (``F`` the patch's total force, ``M`` making a uniform shift Mindlin's) the
+  patch shifts as its force changes; steady rolling does not see it (``F``
+  constant).  The step's own ``F`` is a fixed point, solved by secant steps
+  (:func:`elastic_sweep`; one sweep in the steady state).  Assumed: the far
+  field is uniform over the patch (its first moment only: no torsion term),
+  and the force changes over a step as a first-order lag of the relaxation
+  length (for the material that entered during the step);
+- **slipping paths marched**: a particle that slips on its way from ``x +
+  h`` is marched cell by cell, each step projected on the bound where it is
+  (the slip's direction follows the local rigid slip, which spin turns along
+  the path; one projection over a long step took the path's mean).
+
 Material that entered during the step (within ``h`` of its segment's front
 face) rolled under the present creepages only: it has the steady march's
 traction.  So the steady FastSim is the limit ``h`` >= the patch length
@@ -69,15 +88,194 @@ STEADY_RESETS = ("start", "stamp_gap", "reversed")
 
 
 @njit(cache=True, error_model="numpy")
+def elliptic_ke(m):
+    """Return the complete elliptic integrals ``K(m)``, ``E(m)`` of parameter ``m = e^2`` < 1.
+
+    By the arithmetic-geometric mean (Abramowitz & Stegun 17.6): ``K = pi /
+    (2 a_n)``, ``E = K (1 - sum_n 2^(n-1) c_n^2)``; quadratic convergence,
+    a few iterations to machine precision.
+    """
+    a = 1.0
+    b = math.sqrt(1.0 - m)
+    total = 0.5 * m      # 2^-1 c_0^2, c_0^2 = m
+    power = 0.5
+    for _ in range(40):
+        c = 0.5 * (a - b)
+        a, b = 0.5 * (a + b), math.sqrt(a * b)
+        power *= 2.0
+        total += power * c * c
+        if abs(c) <= 1e-16 * a:
+            break
+    k_m = math.pi / (2.0 * a)
+    return k_m, k_m * (1.0 - total)
+
+
+@njit(cache=True, error_model="numpy")
+def mindlin_compliance(a, b, nu, shear_modulus):
+    """Return the tangential compliances ``(c_x, c_y)`` (m/N) of an elliptical contact in stick.
+
+    Mindlin (1949), Johnson "Contact Mechanics" (1985) section 7.2: a rigid
+    shift ``delta`` of two elastically (quasi-)identical bodies in full
+    adhesion on the ellipse of semi-axes ``a`` (along x) and ``b`` (m)
+    takes the force ``delta / c``, with ``a1`` the major semi-axis and
+    ``e^2 = 1 - (minor/major)^2``,
+
+        c_major = (K(e) - nu B(e)) / (pi G a1),  c_minor = (K(e) - nu D(e)) / (pi G a1),
+
+    ``D = (K - E)/e^2``, ``B = (E - (1 - e^2) K)/e^2`` (both ``pi/4`` on a
+    circle: ``c = (2 - nu)/(4 G a)``).  Checked against the exact Cattaneo
+    shift of :mod:`~fastsim_ros.contact.exact_transient` (``test_contact_transient``).
+    """
+    major = max(a, b)
+    m = 1.0 - (min(a, b) / major) ** 2
+    k_m, e_m = elliptic_ke(m)
+    if m < 1e-8:
+        big_d = 0.25 * math.pi
+        big_b = 0.25 * math.pi
+    else:
+        big_d = (k_m - e_m) / m
+        big_b = (e_m - (1.0 - m) * k_m) / m
+    scale = 1.0 / (math.pi * shear_modulus * major)
+    c_major = (k_m - nu * big_b) * scale
+    c_minor = (k_m - nu * big_d) * scale
+    if a >= b:
+        return c_major, c_minor
+    return c_minor, c_major
+
+
+@njit(cache=True, error_model="numpy")
+def far_field(shape, env, flex, dx, dy, a, b, nu, shear_modulus):
+    """Return ``(M_x, M_y, K_x, K_y, l_x, l_y, length)``: the far field of a patch.
+
+    The far field makes a uniform shift Mindlin's.
+
+    FastSim's displacement is local, ``u = L tau``: a uniform shift
+    ``delta`` of the patch in stick takes ``K_L delta``, ``K_L = sum dA / L``
+    (N/m; about ``(3 pi / 8) C11 G a`` on a circle, twice Mindlin's ``4 G a
+    / (2 - nu)``).  The half-space's displacement is not local: a traction
+    field displaces the whole patch.  Its first moment is kept by ``u = L
+    tau + M F`` (``F`` the patch's total force, ``M`` in m/N): a uniform
+    shift then takes ``delta / (1/K_L + M)``, Mindlin's ``delta / c`` for
+    ``M = c - 1/K_L`` (zero where the local model is already as compliant).
+    Steady rolling does not see ``M`` (``F`` constant: no slip from it);
+    transient rolling does (the shift of the patch as the force builds up).
+    ``shape``: the bound's shape (positive in contact), ``a``, ``b`` (m):
+    the ellipse Mindlin's compliance is taken on.  Also returns the
+    relaxation lengths ``(l_x, l_y)`` (m): the linear steady force per unit
+    creepage over the shift stiffness, ``c sum dA d / L`` (``d`` a cell's
+    distance from its strip's front face), the distance a first-order lag
+    with Mindlin's initial slope needs to reach the steady force (about
+    ``1.8 a`` on a circle), and the patch's length along x (m), its
+    longest strip segment.
+    """
+    ny, nx = shape.shape
+    k_x = 0.0
+    k_y = 0.0
+    c11 = 0.0
+    c22 = 0.0
+    da = dx * dy
+    length = 0.0
+    front = np.zeros(ny)
+    inside = np.zeros(ny, dtype=np.bool_)
+    for i in range(nx - 1, -1, -1):
+        for j in range(ny):
+            if j < env[0, i] or j >= env[1, i] or not shape[j, i] > 0.0:
+                inside[j] = False
+                continue
+            d = front[j] + dx if inside[j] else 0.5 * dx
+            front[j] = d
+            inside[j] = True
+            length = max(length, d + 0.5 * dx)
+            k_x += da / flex[0, j]
+            k_y += da / flex[1, j]
+            c11 += da * d / flex[0, j]
+            c22 += da * d / flex[1, j]
+    c_x, c_y = mindlin_compliance(a, b, nu, shear_modulus)
+    if not k_x > 0.0 or not k_y > 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0
+    m_x = max(c_x - 1.0 / k_x, 0.0)
+    m_y = max(c_y - 1.0 / k_y, 0.0)
+    return m_x, m_y, k_x, k_y, c_x * c11, c_y * c22, length
+
+
+#: the far field's fixed point is solved to this fraction of the traction bound's total (1)
+FAR_FIELD_TOLERANCE = 1e-6
+#: at most this many secant steps (each a sweep) for the far field's fixed point
+FAR_FIELD_STEPS = 6
+
+
+@njit(cache=True, error_model="numpy")
+def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
+                  yp, law, prm, speed, out_x, out_y, slip, rigid, prev_x, prev_y, rolled,
+                  m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total):
+    """One time step with the far field: :func:`kernels.rolling_sweep` at its fixed point.
+
+    The patch's shift over the step is ``s = M (F - F_old)`` (m per
+    direction, :func:`far_field`), ``F`` the step's own force: ``g(s) = s -
+    M (F(s) - F_old) = 0`` is solved by secant steps from ``s = 0`` (``F`` is
+    monotone in ``s``: memory cells in stick lose ``s / L`` each, those in
+    slip stay on the bound), the second point the root if every cell were a
+    memory cell in stick (stiffness ``K``).  In the steady state ``F =
+    F_old``: one sweep, ``s = 0``.  A cell that entered during the step saw
+    the shift since it entered (:func:`kernels.rolling_sweep`): a lag of
+    length ``l (1 - h / length)``, so that a step ``h`` of the patch's
+    ``length`` or more is the steady state (no material saw the old force).
+    Returns as :func:`kernels.rolling_sweep`; the last
+    sweep's tractions stored.
+    """
+    fx, fy, mz, nslip, ncontact = k.rolling_sweep(
+        shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp, law,
+        prm, speed, out_x, out_y, slip, True, rigid, prev_x, prev_y, rolled, 0.0, 0.0, 1.0, 1.0)
+    if (m_x == 0.0 and m_y == 0.0) or not rolled < length:
+        return fx, fy, mz, nslip, ncontact
+    # the lag completes within the step as the step nears the patch's length: a step over
+    # the whole patch leaves no material that saw the old force (the steady state, exactly)
+    taper = 1.0 - rolled / length
+    r_x = l_x * taper
+    r_y = l_y * taper
+    tol = FAR_FIELD_TOLERANCE * bound_total
+    s0x = 0.0
+    s0y = 0.0
+    g0x = -m_x * (fx - f_old_x)
+    g0y = -m_y * (fy - f_old_y)
+    if abs(g0x) * k_x <= tol and abs(g0y) * k_y <= tol:
+        return fx, fy, mz, nslip, ncontact
+    s1x = m_x * (fx - f_old_x) / (1.0 + m_x * k_x)
+    s1y = m_y * (fy - f_old_y) / (1.0 + m_y * k_y)
+    for _ in range(FAR_FIELD_STEPS):
+        fx, fy, mz, nslip, ncontact = k.rolling_sweep(
+            shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
+            law, prm, speed, out_x, out_y, slip, True, rigid, prev_x, prev_y, rolled, s1x,
+            s1y, r_x, r_y)
+        g1x = s1x - m_x * (fx - f_old_x)
+        g1y = s1y - m_y * (fy - f_old_y)
+        if abs(g1x) * k_x <= tol and abs(g1y) * k_y <= tol:
+            break
+        s2x = s1x
+        s2y = s1y
+        if g1x != g0x:
+            s2x = s1x - g1x * (s1x - s0x) / (g1x - g0x)
+        if g1y != g0y:
+            s2y = s1y - g1y * (s1y - s0y) / (g1y - g0y)
+        s0x, s0y, g0x, g0y = s1x, s1y, g1x, g1y
+        s1x, s1y = s2x, s2y
+    return fx, fy, mz, nslip, ncontact
+
+
+@njit(cache=True, error_model="numpy")
 def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                       shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
-                      calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo):
+                      calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo, nu,
+                      with_far_field, f_old_x, f_old_y):
     """One time step of MAE + FastSim, rolling ``rolled`` (m) from the state ``prev_x, prev_y``.
 
     As :func:`fastsim_ros.contact.kernels.mae_solve` (same arguments and
     return) with the previous tractions (Pa, the patch's grid) and the new
     ones written to ``out_x``, ``out_y`` (always stored: the next state);
-    ``geo`` receives the MAE geometry (:data:`~kernels.GEO_SIZE`).
+    ``geo`` receives the MAE geometry (:data:`~kernels.GEO_SIZE`).  With
+    ``with_far_field`` the patch's shift (:func:`far_field`, Mindlin's on the
+    equivalent ellipse, Poisson ratio ``nu``) from the previous force
+    ``f_old_x``, ``f_old_y`` (N).
     """
     status = k.check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != k.OK:
@@ -96,28 +294,39 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
     y_s = geo[k.G_YS]
     xi_s = xi + phi * (yp - y_s)
     eta_s = eta - phi * (xp - x_c)
+    m_x = m_y = k_x = k_y = 0.0
+    l_x = l_y = 1.0
+    length = 0.0
+    if with_far_field:
+        m_x, m_y, k_x, k_y, l_x, l_y, length = far_field(
+            p, env, flex, dx, dy, geo[k.G_ELLIPSE + 2], geo[k.G_ELLIPSE + 3], nu,
+            shear_modulus)
+    bound_total = mu * geo[k.G_LOAD]
     if parabolic:
         bound = np.empty((ny, nx))
         k.parabolic_bound(p, dx, dy, mu, geo[k.G_LOAD], bound)
-        fx, fy, mz, nslip, _ = k.rolling_sweep(
+        fx, fy, mz, nslip, _ = elastic_sweep(
             bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-            law, prm, speed, out_x, out_y, slip, True, calibrated, prev_x, prev_y, rolled)
+            law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
+            m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total)
     else:
-        fx, fy, mz, nslip, _ = k.rolling_sweep(
+        fx, fy, mz, nslip, _ = elastic_sweep(
             p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-            law, prm, speed, out_x, out_y, slip, True, calibrated, prev_x, prev_y, rolled)
+            law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
+            m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total)
     return k.OK, 0.0, fx, fy, mz, geo[k.G_LOAD], nslip, int(geo[k.G_NCONTACT])
 
 
 @njit(cache=True, error_model="numpy")
 def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
                           shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
-                          prev_x, prev_y, rolled, ell):
+                          prev_x, prev_y, rolled, ell, nu, with_far_field, f_old_x, f_old_y):
     """One time step of FastSim on the patch's equivalent ellipse (``n`` x ``n`` cells).
 
     As :func:`fastsim_ros.contact.kernels.equivalent_solve` with the state
     on the ellipse's grid (``prev_x``, ``prev_y`` in, ``out_x``, ``out_y``
-    out, Pa); ``ell`` receives the ellipse (:data:`~kernels.ELL_SIZE`).
+    out, Pa); ``ell`` receives the ellipse (:data:`~kernels.ELL_SIZE`); the
+    far field as :func:`mae_rolling_solve`, on the ellipse itself.
     """
     status = k.check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != k.OK:
@@ -142,9 +351,16 @@ def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic
         flex[3, j] = ell[k.ELL_L3]
     xi_s = xi + phi * (yp - y_c)
     eta_s = eta - phi * (xp - x_c)
-    fx, fy, mz, nslip, ncontact = k.rolling_sweep(
+    m_x = m_y = k_x = k_y = 0.0
+    l_x = l_y = 1.0
+    length = 0.0
+    if with_far_field:
+        m_x, m_y, k_x, k_y, l_x, l_y, length = far_field(shape, env, flex, gdx, gdy, a, b, nu,
+                                                         shear_modulus)
+    fx, fy, mz, nslip, ncontact = elastic_sweep(
         shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi, flex, x_c, y_c, xp, yp,
-        law, prm, speed, out_x, out_y, slip, True, False, prev_x, prev_y, rolled)
+        law, prm, speed, out_x, out_y, slip, False, prev_x, prev_y, rolled, m_x, m_y, k_x,
+        k_y, l_x, l_y, length, f_old_x, f_old_y, mu * ell[k.ELL_LOAD])
     return k.OK, 0.0, fx, fy, mz, ell[k.ELL_LOAD], nslip, ncontact
 
 
@@ -154,7 +370,8 @@ class TractionState:
 
     ``load``: the patch's normal load (N), ``area``: its cells in contact
     times the cell area (m^2), ``centroid``: its pressure centroid (m) and
-    ``half_length``: half its extent along ``x`` (m), for the jump rule.
+    ``half_length``: half its extent along ``x`` (m), for the jump rule;
+    ``force``: its total ``(Fx, Fy)`` (N), the far field's previous force.
     """
 
     tau_x: FloatArray
@@ -163,6 +380,7 @@ class TractionState:
     area: float
     centroid: tuple[float, float]
     half_length: float
+    force: tuple[float, float] = (0.0, 0.0)
 
     def resampled(self, grid: tuple[float, float, float, float],
                   shape: tuple[int, int]) -> tuple[FloatArray, FloatArray]:
@@ -199,11 +417,16 @@ class TransientSolver:
     ``solver``: a :class:`~fastsim_ros.contact.compiled.MaeSolver` (or
     :class:`~fastsim_ros.contact.compiled.CalibratedMaeSolver`) or an
     :class:`~fastsim_ros.contact.compiled.EquivalentEllipseSolver`; its
-    material, tables and options are used.
+    material, tables and options are used.  ``far_field``: the patch's
+    elastic shift (:func:`far_field`: after a creepage step the force builds
+    up at the half-space's shift stiffness, not FastSim's, twice as stiff);
+    ``False``: Kalker's local non-steady FASTSIM.
     """
 
-    def __init__(self, solver: MaeSolver | EquivalentEllipseSolver) -> None:
+    def __init__(self, solver: MaeSolver | EquivalentEllipseSolver, *,
+                 far_field: bool = True) -> None:
         self.solver = solver
+        self.far_field = bool(far_field)
         #: whether the last step interpolated its state onto another grid
         self.resampled = False
 
@@ -226,6 +449,7 @@ class TransientSolver:
         s = self.solver
         parabolic = check_bound(bound)
         xp, yp = float(reference[0]), float(reference[1])
+        f_old = state.force if state is not None else (0.0, 0.0)
         if isinstance(s, MaeSolver):
             grid = (float(x0), float(y0), float(dx), float(dy))
             shape = p.shape
@@ -236,7 +460,8 @@ class TransientSolver:
                 p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta), float(phi),
                 float(mu_s), xp, yp, s._rule, parabolic, s.shear_modulus, s._knots, s._polys,
                 code, prm, v, out[0], out[1], out[2], s._calibrated, s._pair_knots,
-                s._pair_values, prev[0], prev[1], float(rolled), geo)
+                s._pair_values, prev[0], prev[1], float(rolled), geo, s.nu, self.far_field,
+                f_old[0], f_old[1])
             # the patch's area, centroid and half length, for ContactMemory's jump rule
             measures = (float(geo[k.G_AREA]), (float(geo[k.G_XC]), float(geo[k.G_YC])),
                         float(geo[k.G_ELLIPSE + 2]))
@@ -255,12 +480,13 @@ class TransientSolver:
                 p, float(x0), float(y0), float(dx), float(dy), float(xi), float(eta),
                 float(phi), float(mu_s), xp, yp, parabolic, n, s.shear_modulus, s._knots,
                 s._polys, code, prm, v, out[0], out[1], out[2], prev[0], prev[1],
-                float(rolled), ell)
+                float(rolled), ell, s.nu, self.far_field, f_old[0], f_old[1])
             # the equivalent ellipse has the patch's area and centroid
             measures = (math.pi * float(ell[k.ELL_A] * ell[k.ELL_B]),
                         (float(ell[k.ELL_XC]), float(ell[k.ELL_YC])), float(ell[k.ELL_A]))
         forces = s._forces(result, grid, out, True)
-        return forces, TractionState(out[0], out[1], grid, *measures)
+        return forces, TractionState(out[0], out[1], grid, *measures,
+                                     force=(float(result[2]), float(result[3])))
 
     def _previous(self, state: TractionState | None, grid: tuple[float, float, float, float],
                   shape: tuple[int, ...]) -> tuple[FloatArray, FloatArray]:
