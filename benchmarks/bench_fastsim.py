@@ -163,6 +163,7 @@ def main() -> None:
     calibrated = CalibratedMaeSolver(NU, G)
     baseline = EquivalentEllipseSolver(NU, G)
     transient = TransientSolver(calibrated)
+    local = TransientSolver(calibrated, far_field=False)
     table = coefficient_table(NU)
     knots, polys = mae._knots, mae._polys
     rng = np.random.default_rng(0)
@@ -171,7 +172,8 @@ def main() -> None:
     head = (f"{'patch':<14}{'grid':>6}{'cells':>6}{'slip':>6}  {'solve':>13}  "
             f"{'solve_arrays':>13}  {'geometry':>8}{'share':>7}  {'numpy ref':>10}  "
             f"{'equivalent':>13}{'eq/mae':>7}  {'calibrated':>13}{'cal/mae':>8}"
-            f"  {'transient':>13}{'tr/cal':>7}")
+            f"  {'transient':>13}{'tr/cal':>7}  {'local':>6}{'lo/cal':>7}  {'stepping':>13}"
+            f"{'st/cal':>7}")
     print(head)
     print("-" * len(head))
     rates = []
@@ -182,15 +184,29 @@ def main() -> None:
             grid = (ar.x0, ar.y0, ar.dx, ar.dy)
             res = mae.solve(ar, xi, eta, phi, mu=MU)
             state = [transient.step(None, p, *grid, xi, eta, phi, 2 * ar.dx, MU)[1]]
+            state_local = [local.step(None, p, *grid, xi, eta, phi, 2 * ar.dx, MU)[1]]
+            state_steps = [state[0], 0]
 
             def step() -> None:
                 state[0] = transient.step(state[0], p, *grid, xi, eta, phi, 2 * ar.dx, MU)[1]
+
+            def step_local() -> None:
+                state_local[0] = local.step(state_local[0], p, *grid, xi, eta, phi, 2 * ar.dx,
+                                            MU)[1]
+
+            def stepping() -> None:
+                # a creepage step every cycle (between the creepages and half of them): the
+                # far field's secant every time, the worst case
+                k = 1.0 if state_steps[1] % 2 else 0.5
+                state_steps[1] += 1
+                state_steps[0] = transient.step(state_steps[0], p, *grid, k * xi, k * eta,
+                                                k * phi, 2 * ar.dx, MU)[1]
             t = per_call({
                 "solve": lambda: mae.solve(ar, xi, eta, phi, mu=MU),
                 "arrays": lambda: mae.solve_arrays(p, *grid, xi, eta, phi, MU),
                 "equivalent": lambda: baseline.solve(ar, xi, eta, phi, mu=MU),
                 "calibrated": lambda: calibrated.solve(ar, xi, eta, phi, mu=MU),
-                "transient": step}, args.calls)
+                "transient": step, "local": step_local, "stepping": stepping}, args.calls)
             t_solve, t_arrays, t_eq = t["solve"], t["arrays"], t["equivalent"]
             t_cal, t_tr = t["calibrated"], t["transient"]
             kargs = (ar.pressure, *grid, G, knots, polys)
@@ -206,7 +222,10 @@ def main() -> None:
                   f"{100 * t_geo / t_whole:>6.0f}%  {t_ref[0]:>10.0f}  "
                   f"{t_eq[0]:>6.1f} /{t_eq[1]:>5.1f}{t_eq[0] / t_solve[0]:>7.2f}  "
                   f"{t_cal[0]:>6.1f} /{t_cal[1]:>5.1f}{t_cal[0] / t_solve[0]:>8.2f}"
-                  f"  {t_tr[0]:>6.1f} /{t_tr[1]:>5.1f}{t_tr[0] / t_cal[0]:>7.2f}")
+                  f"  {t_tr[0]:>6.1f} /{t_tr[1]:>5.1f}{t_tr[0] / t_cal[0]:>7.2f}"
+                  f"  {t['local'][0]:>6.1f}{t['local'][0] / t_cal[0]:>7.2f}"
+                  f"  {t['stepping'][0]:>6.1f} /{t['stepping'][1]:>5.1f}"
+                  f"{t['stepping'][0] / t_cal[0]:>7.2f}")
             # batches: distinct patches (load and a fore-aft tilt of the pressure vary
             # smoothly from patch to patch, as from a normal solver) and creepages
             b = args.batch
@@ -223,7 +242,10 @@ def main() -> None:
           "mae_fastsim,\nmedian of fewer calls; eq/mae: median of EquivalentEllipseSolver.solve "
           "over MaeSolver.solve;\ncalibrated: CalibratedMaeSolver.solve, cal/mae its median over "
           "MaeSolver.solve's;\ntransient: TransientSolver(CalibratedMaeSolver).step rolling 2 "
-          "cells from the last state,\ntr/cal its median over CalibratedMaeSolver.solve's.\n")
+          "cells from the last state\n(the same creepages: the steady state, one sweep), "
+          "tr/cal its median over CalibratedMaeSolver.solve's;\nlocal: the same without the "
+          "far field (Kalker's local model); stepping: the far field\nwith a creepage step "
+          "every call (its secant every time).\n")
     print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
     head = (f"{'patch':<14}{'grid':>6}  {'MAE distinct':>13}{'MAE 1 patch':>13}"
             f"{'eq distinct':>13}{'eq 1 patch':>13}{'cal distinct':>13}{'cal 1 patch':>13}")

@@ -198,10 +198,12 @@ def far_field(shape, env, flex, dx, dy, a, b, nu, shear_modulus):
     return m_x, m_y, k_x, k_y, c_x * c11, c_y * c22, length
 
 
-#: the far field's fixed point is solved to this fraction of the traction bound's total (1)
-FAR_FIELD_TOLERANCE = 1e-6
+#: the far field's fixed point is solved to this fraction of the step's change of force (1)
+FAR_FIELD_TOLERANCE = 1e-3
+#: a change of force below this fraction of the traction bound's total is none (1)
+FAR_FIELD_STEADY = 1e-12
 #: at most this many secant steps (each a sweep) for the far field's fixed point
-FAR_FIELD_STEPS = 6
+FAR_FIELD_STEPS = 4
 
 
 @njit(cache=True, error_model="numpy")
@@ -233,13 +235,14 @@ def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     taper = 1.0 - rolled / length
     r_x = l_x * taper
     r_y = l_y * taper
-    tol = FAR_FIELD_TOLERANCE * bound_total
+    change = abs(fx - f_old_x) + abs(fy - f_old_y)
+    if change <= FAR_FIELD_STEADY * bound_total:
+        return fx, fy, mz, nslip, ncontact
+    tol = FAR_FIELD_TOLERANCE * change
     s0x = 0.0
     s0y = 0.0
     g0x = -m_x * (fx - f_old_x)
     g0y = -m_y * (fy - f_old_y)
-    if abs(g0x) * k_x <= tol and abs(g0y) * k_y <= tol:
-        return fx, fy, mz, nslip, ncontact
     s1x = m_x * (fx - f_old_x) / (1.0 + m_x * k_x)
     s1y = m_y * (fy - f_old_y) / (1.0 + m_y * k_y)
     for _ in range(FAR_FIELD_STEPS):
