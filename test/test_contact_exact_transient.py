@@ -97,3 +97,40 @@ def test_rolling_reaches_the_steady_state(area, sequence) -> None:
     assert all(b < a for a, b in zip(gaps[::10], gaps[10::10]))
     assert gaps[-1] < 1e-6 * MU * FN
     np.testing.assert_array_equal(state.slip, steady.slip)
+
+
+def test_cattaneo_example_as_published() -> None:
+    """CONTACT's ``cattaneo`` example (Kalker 1990, section 5.2.1.1): a ball shifted in stick.
+
+    Polyethylene on polyethylene (G = 200 N/mm^2, nu = 0.42, mu = 0.4), the
+    gap 0.01 (x^2 + y^2) (mm) under FN = 9.1954 N on 19 x 19 cells of
+    0.13333 mm, shifted until Fx = -0.875 mu FN.  ``cattaneo.ref_out``
+    publishes: 177 cells in contact, approach 1.998e-2 mm, pmax 4.393
+    N/mm^2; the shift 8.155e-3 mm with 45 cells in adhesion and 132 in
+    slip; dFx/dshift = -67.6 (1/mm, Fx in mu FN).  The shift is found here by
+    bisection on the force, as CONTACT's Newton on the prescribed force.
+    """
+    nu, g, mu, fn, dx, xl, n = 0.42, 200.0, 0.4, 9.1954, 0.13333, -1.26667, 19
+    x0 = xl + 0.5 * dx
+    x = x0 + dx * np.arange(n)
+    normal = solve_normal(x0, x0, dx, dx, 0.01 * x[None, :] ** 2 + 0.01 * x[:, None] ** 2,
+                          load=fn, shear_modulus=g, nu=nu)
+    assert int(normal.area.mask.sum()) == 177
+    assert normal.approach == pytest.approx(1.998e-2, abs=1e-5)
+    assert float(normal.pressure.max()) == pytest.approx(4.393, abs=1e-3)
+
+    def force(shift: float) -> float:
+        return cattaneo_shift(normal.area, shift, 0.0, mu=mu, nu=nu, shear_modulus=g).fx / (
+            mu * fn)
+
+    lo, hi = 0.0, 0.02
+    for _ in range(50):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if force(mid) > -0.875 else (lo, mid)
+    shift = 0.5 * (lo + hi)
+    sol = cattaneo_shift(normal.area, shift, 0.0, mu=mu, nu=nu, shear_modulus=g)
+    assert shift == pytest.approx(8.155e-3, abs=1e-6)
+    assert sol.adhesion_cells == 45
+    assert int(sol.slip.sum()) == 132
+    slope = (force(shift + 1e-6) - force(shift - 1e-6)) / 2e-6
+    assert slope == pytest.approx(-67.6, rel=0.01)
