@@ -430,9 +430,11 @@ class ProfilePipeline:
         except ContactError as e:
             return self._dropped(stamp, "degenerate", str(e))
         self._clouds = dict(patches)
-        if self.table is not None and loads is not None:
+        if self.table is not None and loads is not None and self.config["rolling"] == "steady":
             # the balance's last step solved these very patches with the configured method:
-            # the pipeline takes those solves (the clouds carry the same patches, to rounding)
+            # the pipeline takes those solves (the clouds carry the same patches, to rounding).
+            # Transient rolling solves them again with each contact's memory (the balance
+            # took the steady creep forces' vertical share: a few N of a wheel's load)
             outcomes = tuple(self.pipeline.on_patch(name, cloud, given=solved.get(name))
                              for name, cloud in patches)
         else:
