@@ -177,6 +177,8 @@ def far_field(shape, env, flex, dx, dy, a, b, nu, shear_modulus):
     length = 0.0
     front = np.zeros(ny)
     inside = np.zeros(ny, dtype=np.bool_)
+    cells = np.zeros(ny)
+    moment = np.zeros(ny)
     for i in range(nx - 1, -1, -1):
         for j in range(ny):
             if j < env[0, i] or j >= env[1, i] or not shape[j, i] > 0.0:
@@ -186,10 +188,15 @@ def far_field(shape, env, flex, dx, dy, a, b, nu, shear_modulus):
             front[j] = d
             inside[j] = True
             length = max(length, d + 0.5 * dx)
-            k_x += da / flex[0, j]
-            k_y += da / flex[1, j]
-            c11 += da * d / flex[0, j]
-            c22 += da * d / flex[1, j]
+            cells[j] += 1.0
+            moment[j] += d
+    # per strip: its cells in contact and their distances' sum (one division a strip)
+    for j in range(ny):
+        if cells[j] > 0.0:
+            k_x += da * cells[j] / flex[0, j]
+            k_y += da * cells[j] / flex[1, j]
+            c11 += da * moment[j] / flex[0, j]
+            c22 += da * moment[j] / flex[1, j]
     c_x, c_y = mindlin_compliance(a, b, nu, shear_modulus)
     if not k_x > 0.0 or not k_y > 0.0:
         return 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0
