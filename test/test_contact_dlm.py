@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -63,6 +64,47 @@ def test_circle_and_long_ellipse_reproduce_table_1(g, c11, c22):
     assert c.C11 == pytest.approx(c11, rel=0.03)
     assert c.C22 == pytest.approx(c22, rel=0.03)
     assert c.C13 == pytest.approx(0.0, abs=1e-9)
+
+
+SEED_TABLES = Path(__file__).resolve().parents[1].parent / "shared" / "reference" / \
+    "seed_tables_1_2.md"
+
+
+def _table1_rows() -> list:
+    if not SEED_TABLES.exists():
+        return [None]
+    from fastsim_ros.contact.seed_tables import read_table1
+    rows = read_table1(SEED_TABLES)
+    # a/b = 0.1 is missed (C11 -8.9%, C22 -6.0%: docs/validation_seed.md, section 1)
+    return [pytest.param(r, marks=pytest.mark.xfail(strict=True, reason="Table 1 at a/b = 0.1 "
+                                                    "is not reproduced"))
+            if r.a_over_b == 0.1 else r for r in rows]
+
+
+@pytest.mark.parametrize("row", _table1_rows(),
+                         ids=lambda r: "absent" if r is None else f"a/b={r.a_over_b:g}")
+def test_table_1_dlm_values_as_printed(row):
+    # Table 1 read from the reference file: DLM's C11 and C22 within 3% (issue 30)
+    if row is None:
+        pytest.skip("shared/reference is not beside this checkout")
+    c = dlm_coefficients(ellipse(row.a_over_b, 60), nu=NU)
+    assert c.C11 == pytest.approx(row.dlm[0], rel=0.03)
+    assert c.C22 == pytest.approx(row.dlm[1], rel=0.03)
+
+
+def test_table_1_reading_gives_kalkers_values_as_its_amk_numbers():
+    if not SEED_TABLES.exists():
+        pytest.skip("shared/reference is not beside this checkout")
+    from fastsim_ros.contact.seed_tables import read_table1
+    rows = read_table1(SEED_TABLES)
+    assert [r.a_over_b for r in rows] == [0.1, 1.0, 10.0]
+    published = {}
+    for line in (SEED_TABLES.parent / "kalker_coefficients.csv").read_text().splitlines():
+        cells = line.split(",")
+        if not line.startswith("#") and cells[0] != "a_over_b" and float(cells[1]) == 0.25:
+            published[round(float(cells[0]), 6)] = tuple(float(c) for c in cells[2:5])
+    for r in rows:
+        assert r.amk == published[r.a_over_b]
 
 
 def test_flexibilities_scale_with_length_over_shear_modulus():
