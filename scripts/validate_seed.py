@@ -447,7 +447,7 @@ def _report_candidates(add: Callable[[str], None], cand: dict[str, Any],
         " Further readings (exploration, 2026-12-03, not in the data above): piecewise-linear"
         " tractions on 2 to 6 elements per strip collocated at the elements' middles (rms"
         " 7-23%), least squares over ten points per strip instead of collocation (rms 6-60%),"
-        " a one-term longitudinal with a two-term lateral shape (rms 4-8%, C23 at a/b = 0.1"
+        " a one-term longitudinal with a two-term lateral shape (rms 4-14%, C23 at a/b = 0.1"
         " 0.47 again), the Poisson coupling left out (C23 at a/b = 0.1 0.34): none nearer."
         " Knothe and Hung's own ansatz and placement are therefore not established: the"
         " package keeps its fitted points (`ASM_COLLOCATION`), which reproduce Kalker's"
