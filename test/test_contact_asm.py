@@ -122,3 +122,33 @@ def test_table2_reading_maps_its_amk_columns_onto_kalkers_table():
                 assert printed == 1.15 and kalker == 1.25
                 continue
             assert printed == pytest.approx(kalker, abs=0.0051), (r, name)
+
+
+def _table2_rows() -> list:
+    if not SEED_TABLES.exists():
+        return [None]
+    from fastsim_ros.contact.seed_tables import read_table2
+    return read_table2(SEED_TABLES)
+
+
+def _meets_issue_target(name: str, got: float, printed: float) -> bool:
+    # issue 30: within 2%; C23 within 3% or 0.02
+    err = abs(got / printed - 1.0)
+    return err <= 0.02 if name != "C23" else (err <= 0.03 or abs(got - printed) <= 0.02)
+
+
+@pytest.mark.xfail(strict=True, reason="the printed ASM columns are not reproduced: Knothe "
+                   "and Hung's ansatz and placement are not established (docs/"
+                   "validation_seed.md, section 2, the readings tried)")
+@pytest.mark.parametrize("row", _table2_rows(),
+                         ids=lambda r: "absent" if r is None else f"{r.block}-g{r.g:g}")
+def test_table2_asm_columns_as_printed(row):
+    # each row of Table 2 (a/b mapped as the reference file states) at the package's ASM, as
+    # `fastsim_contact coefficients --shape ellipse --method asm --nu 0.25` reports it
+    if row is None:
+        pytest.skip("shared/reference is not beside this checkout")
+    c = ellipse_coefficients(row.a_over_b, nu=NU, strips=60)
+    misses = [(name, got, printed) for name, got, printed in
+              zip(("C11", "C22", "C23"), (c.C11, c.C22, c.C23), row.asm)
+              if not _meets_issue_target(name, got, printed)]
+    assert not misses

@@ -22,6 +22,16 @@ it.  As the issue reads the paper (the paper's own text was not at hand):
   a/b = 0.2, 0.5, 1, 2, 5 and checks every other entry of his table and nu
   = 0 and 0.5, docs/validation_seed.md).
 
+What this does not reproduce: the seed's Table 2 prints ASM's own
+coefficients, 0-8% below Kalker's; these points give Kalker's (within 2% for
+0.1 <= a/b <= 3.3, 4% at 5 and 10), not the printed ASM.  Knothe and Hung's
+own ansatz and collocation could not be established (their text was not at
+hand): of the readings tried in ``scripts/asm_candidates.py`` (quadratic,
+2-D full-adhesion and Hertz-like strip tractions, natural and Gauss-Chebyshev
+placements) none reproduces the printed columns within 2%, and none gives
+the printed C23 at a/b = 0.1 (docs/validation_seed.md, section 2).  So the
+fitted points stay the default: they make ASM an accurate strip method.
+
 ``du_i/dx`` of a strip's traction ``f(x')`` at ``(x, y)``, integrated by
 parts along the strip (``f(x_l) = 0``): ``M_ij(x - x_t) f(x_t) + int M_ij(x
 - x') f'(x') dx'``, ``M`` the kernels integrated across the strip's width

@@ -87,21 +87,49 @@ class Displacements:
 
 
 def level(displacements: list[FloatArray], tractions: list[FloatArray],
-          mask: NDArray[np.bool_]) -> float:
+          mask: NDArray[np.bool_], weight: FloatArray | None = None) -> float:
     """Return the ``L`` (m/Pa) that levels ``u ~ L tau + c`` by least squares over ``mask``.
 
     One ``L`` for the listed components, a free translation ``c`` per
-    component: ``L = sum cov(u, tau) / sum var(tau)`` over the cells;
-    ``nan`` where the traction is uniform (a rigid translation itself:
-    nothing to level, as the full-slip traction of a uniform pressure).
+    component: ``L = sum cov(u, tau) / sum var(tau)`` over the cells (each
+    cell weighted by ``weight`` if given, else equally); ``nan`` where the
+    traction is uniform (a rigid translation itself: nothing to level, as
+    the full-slip traction of a uniform pressure).
     """
+    w = np.ones(int(np.count_nonzero(mask))) if weight is None else weight[mask]
     num = den = 0.0
     for u, t in zip(displacements, tractions):
-        uu = u[mask] - u[mask].mean()
-        tt = t[mask] - t[mask].mean()
-        num += float((uu * tt).sum())
-        den += float((tt * tt).sum())
+        uu = u[mask] - float((w * u[mask]).sum()) / float(w.sum())
+        tt = t[mask] - float((w * t[mask]).sum()) / float(w.sum())
+        num += float((w * uu * tt).sum())
+        den += float((w * tt * tt).sum())
     return num / den if den > 0.0 else math.nan
+
+
+#: the levelling's weights: ``area`` (every cell alike: the least squares over the area, the
+#: package's reading) or ``chord`` (every cell by the length of its strip, the run of cells
+#: along ``x`` it belongs to; exploration: docs/validation_seed.md, section 1)
+WEIGHTINGS = ("area", "chord")
+
+
+def strip_chords(area: GridArea) -> FloatArray:
+    """Return, on every cell in contact, the length of its strip (its run along ``x``, m)."""
+    mask = area.mask
+    out = np.zeros(mask.shape)
+    edges = np.diff(np.pad(mask.astype(np.int8), ((0, 0), (1, 1))), axis=1)
+    rows, starts = np.nonzero(edges == 1)
+    _, ends = np.nonzero(edges == -1)
+    for j, i0, i1 in zip(rows, starts, ends):
+        out[j, i0:i1] = (i1 - i0) * area.dx
+    return out
+
+
+def _weights(area: GridArea, weighting: str) -> FloatArray | None:
+    if weighting == "area":
+        return None
+    if weighting == "chord":
+        return strip_chords(area)
+    raise ValueError(f"weighting must be one of {WEIGHTINGS}, got {weighting!r}")
 
 
 @dataclass(frozen=True)
@@ -133,14 +161,16 @@ def _unit_tractions(area: GridArea, x_c: float, y_c: float,
 
 
 def dlm_iteration(area: GridArea, *, nu: float, shear_modulus: float,
-                  steps: int = 3) -> DlmIteration:
+                  steps: int = 3, weighting: str = "area") -> DlmIteration:
     """Return the levelled flexibilities after each of ``steps`` steps from the full slip.
 
     Step 0 levels the full-slip traction; every later step the adhesion
     traction of the simplified theory with the previous ``L``, whose shape
     does not depend on ``L``: so step 1 is the converged value.
+    ``weighting``: one of :data:`WEIGHTINGS`.
     """
     check_material(nu, shear_modulus)
+    weight = _weights(area, weighting)
     x_c, y_c = centroid(area)
     disp = Displacements(area, nu=nu, shear_modulus=shear_modulus)
     mask = area.mask
@@ -150,18 +180,22 @@ def dlm_iteration(area: GridArea, *, nu: float, shear_modulus: float,
         for k, (tx, ty) in enumerate(unit):
             ux, uy = disp(tx, ty)
             if k == 0:
-                lk = level([ux], [tx], mask)
+                lk = level([ux], [tx], mask, weight)
             elif k == 1:
-                lk = level([uy], [ty], mask)
+                lk = level([uy], [ty], mask, weight)
             else:
-                lk = level([ux, uy], [tx, ty], mask)
+                lk = level([ux, uy], [tx, ty], mask, weight)
             hist[k].append(lk)
     return DlmIteration(tuple(hist[0]), tuple(hist[1]), tuple(hist[2]))
 
 
-def dlm_flexibility(area: GridArea, *, nu: float, shear_modulus: float) -> CalibratedFlexibility:
-    """Return DLM's converged ``L1, L2, L3`` (m/Pa) of ``area``, sweep point its centroid."""
-    it = dlm_iteration(area, nu=nu, shear_modulus=shear_modulus, steps=2)
+def dlm_flexibility(area: GridArea, *, nu: float, shear_modulus: float,
+                    weighting: str = "area") -> CalibratedFlexibility:
+    """Return DLM's converged ``L1, L2, L3`` (m/Pa) of ``area``, sweep point its centroid.
+
+    ``weighting``: one of :data:`WEIGHTINGS` (``area``, the package's reading).
+    """
+    it = dlm_iteration(area, nu=nu, shear_modulus=shear_modulus, steps=2, weighting=weighting)
     x_c, y_c = centroid(area)
     for l_k in (it.l1[-1], it.l2[-1], it.l3[-1]):
         if not (math.isfinite(l_k) and l_k > 0.0):
@@ -169,8 +203,16 @@ def dlm_flexibility(area: GridArea, *, nu: float, shear_modulus: float) -> Calib
     return CalibratedFlexibility(it.l1[-1], it.l2[-1], it.l3[-1], x_c, y_c)
 
 
+def dlm_chord_flexibility(area: GridArea, *, nu: float,
+                          shear_modulus: float) -> CalibratedFlexibility:
+    """Return DLM's ``L1, L2, L3`` levelled with every cell weighted by its strip's length."""
+    return dlm_flexibility(area, nu=nu, shear_modulus=shear_modulus, weighting="chord")
+
+
 #: DLM + FastSim
 DLM_FASTSIM = FlexibilityMethod(dlm_flexibility)
+#: DLM + FastSim with the chord-weighted levelling (a named option: docs/validation_seed.md)
+DLM_CHORD_FASTSIM = FlexibilityMethod(dlm_chord_flexibility)
 #: DLM + FastSim: solve (forces in N, ``Mz`` about ``reference``; ``flexibility``: the result
 #: of :func:`dlm_flexibility`, to reuse over many creepages)
 dlm_fastsim = DLM_FASTSIM.solve

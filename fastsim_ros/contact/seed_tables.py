@@ -8,10 +8,15 @@ g = 1..0.1) at ``a/b = 1/g`` (``a`` along the rolling direction, as the
 command line's ``--a-over-b``).  So Table 2's row g of the first block is
 ``fastsim_contact coefficients --shape ellipse --a-over-b g``, a row g of the
 second ``--a-over-b 1/g``.
+
+Table 1 (DLM beside AMK at a/b = 0.1, 1, 10) is printed in pairs whose first
+number is Kalker's; the reference file states DLM's numbers (the second of
+each pair) and AMK's in one sentence, which :func:`read_table1` reads.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -45,3 +50,32 @@ def read_table2(path: Path | str) -> list[Table2Row]:
     if len(rows) != 19:
         raise InvalidInputError(f"{path}: Table 2 has 19 rows, read {len(rows)}")
     return rows
+
+
+@dataclass(frozen=True)
+class Table1Row:
+    """Table 1 at ``a_over_b``: DLM's ``(C11, C22, C23)`` and AMK's (Kalker's), as printed."""
+
+    a_over_b: float
+    dlm: tuple[float, float, float]
+    amk: tuple[float, float, float]
+
+
+_NUMBERS = r"([0-9.]+),\s*([0-9.]+),\s*([0-9.]+)"
+_TRIPLE = rf"C11\s+{_NUMBERS};\s*C22\s+{_NUMBERS};\s*C23\s+{_NUMBERS}"
+
+
+def read_table1(path: Path | str) -> list[Table1Row]:
+    """Return Table 1's three rows from the reference file's sentence on it.
+
+    ``a/b = g1, g2, g3 -> C11 .., .., ..; C22 ...; C23 ... (AMK: C11 ...; C22 ...;
+    C23 ...)``, read across line breaks.
+    """
+    text = " ".join(Path(path).read_text(encoding="utf-8").split())
+    m = re.search(rf"a/b = {_NUMBERS} -> {_TRIPLE} \(AMK: {_TRIPLE}\)", text)
+    if m is None:
+        raise InvalidInputError(f"{path}: Table 1's sentence (DLM and AMK values) not found")
+    v = [float(x) for x in m.groups()]
+    gs, dlm, amk = v[0:3], v[3:12], v[12:21]
+    return [Table1Row(g, (dlm[i], dlm[3 + i], dlm[6 + i]), (amk[i], amk[3 + i], amk[6 + i]))
+            for i, g in enumerate(gs)]
