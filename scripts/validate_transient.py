@@ -31,9 +31,10 @@ from fastsim_ros.contact.exact import coulomb  # noqa: E402
 from fastsim_ros.contact.exact_transient import TransientOperators, rolling_step  # noqa: E402
 from fastsim_ros.contact.transient import TransientSolver  # noqa: E402
 
-NU, G, MU, N, A, CELLS = 0.28, 8.0e10, 0.3, 4.0e4, 6.0e-3, 20
+NU, G, MU, N, A, CELLS = 0.28, 8.0e10, 0.3, 4.0e4, 6.0e-3, 40
 STEPS = {"xi": (1.5e-3, 0.0, 0.0), "eta": (0.0, 1.5e-3, 0.0), "phi": (0.0, 0.0, 3.0)}
-CELLS_PER_STEP = (1, 3, 10, 30)   # V dt / a = 0.1, 0.3, 1, 3 (dx = a/10)
+#: V dt / a = 0.1, 0.3, 1, 3 in cells (dx = 2a / CELLS)
+CELLS_PER_STEP = tuple(round(r * CELLS / 2) for r in (0.1, 0.3, 1.0, 3.0))
 ROLLED = 3.0 * 2 * A              # three diameters
 METHODS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
            "fastsim_ellipse": EquivalentEllipseSolver}
@@ -73,7 +74,7 @@ def other_shapes() -> list[tuple[str, str, float, str, float, float, bool] | tup
                 out.append((shape, f"{kind}: the exact transient solver did not converge "
                                    f"after {len(fine)} steps ({e})"))
                 continue
-            for m in (1, 3, 10):
+            for m in CELLS_PER_STEP[:3]:
                 n = math.ceil(len(fine) / m)
                 exact = np.array([fine[min(m * (k + 1), len(fine)) - 1] for k in range(n)])
                 for name in ("mae_calibrated", "fastsim_ellipse"):
@@ -127,7 +128,7 @@ def main() -> None:
                     f, tstate = t.step(tstate, ar.pressure, ar.x0, ar.y0, ar.dx, ar.dy, *creep,
                                        m * ar.dx, MU)
                     fast.append(getattr(f, key) / scale)
-                if name == "mae_calibrated" and m in (1, 10):
+                if name == "mae_calibrated" and m in (CELLS_PER_STEP[0], CELLS_PER_STEP[2]):
                     local = TransientSolver(solver, far_field=False)
                     lfast = []
                     lstate = None
@@ -136,9 +137,9 @@ def main() -> None:
                                                ar.dy, *creep, m * ar.dx, MU)
                         lfast.append(getattr(f, key) / scale)
                     steps = m * ar.dx * np.arange(1, n + 1) / (2 * A)
-                    ax.plot(steps, fast, "o-" if m == 10 else "-", ms=4,
+                    ax.plot(steps, fast, "o-" if m == CELLS_PER_STEP[2] else "-", ms=4,
                             label=f"mae_calibrated, V dt/a = {m * ar.dx / A:.1f}")
-                    ax.plot(steps, lfast, "x--" if m == 10 else "--", ms=4, lw=0.8,
+                    ax.plot(steps, lfast, "x--" if m == CELLS_PER_STEP[2] else "--", ms=4, lw=0.8,
                             label=f"local model (Kalker), V dt/a = {m * ar.dx / A:.1f}")
                 gap = float(np.max(np.abs(np.array(fast) - np.array(exact))))
                 err = abs(steady - ex_steady)
@@ -158,7 +159,7 @@ def main() -> None:
              f"N = {N / 1e3:g} kN, G = {G:g} Pa, nu = {NU}, mu = {MU}; from zero traction "
              "(a contact just formed) at a step in one creepage (xi = 1.5e-3, eta = 1.5e-3 "
              "or phi = 3 1/m), rolled in steps of V dt over three diameters (the exact "
-             "solver in steps of one cell, dx = a/10, sampled at the fast methods' "
+             "solver in steps of one cell, dx = 2a / cells, sampled at the fast methods' "
              f"steps; its steady limit per step: {', '.join(steadies)}). Exact: "
              "`fastsim_ros/contact/exact_transient.py` (validated against CONTACT's "
              "catt_to_cart, `test/test_contact_exact_transient.py`); fast: "

@@ -134,3 +134,23 @@ def test_cattaneo_example_as_published() -> None:
     assert int(sol.slip.sum()) == 132
     slope = (force(shift + 1e-6) - force(shift - 1e-6)) / 2e-6
     assert slope == pytest.approx(-67.6, rel=0.01)
+
+
+def test_a_step_whose_newton_cycles_from_the_last_state_still_converges() -> None:
+    """An eta step on an ellipse a/b = 0.5: Newton from the previous tractions cycles at step 5.
+
+    The step restarts from full adhesion then (``transient_step``); the
+    answer rises monotonically to the steady one (the fifth step used to
+    raise ConvergenceError).
+    """
+    from fastsim_ros.contact import area as areas
+    nu, g, mu, load = 0.28, 8e10, 0.3, 4e4
+    ar = areas.ellipse(3e-3, 6e-3, nx=20, ny=20, load=load)
+    ops = TransientOperators.of(ar, 1, nu=nu, shear_modulus=g)
+    state, fy = None, []
+    for _ in range(12):
+        state = rolling_step(ar, ops, 0.0, 1.5e-3, 0.0, mu=mu, previous=state)
+        fy.append(state.fy)
+    assert all(b < a for a, b in zip(fy, fy[1:]))
+    steady = coulomb(ar, 0.0, 1.5e-3, 0.0, mu=mu, nu=nu, shear_modulus=g)
+    assert abs(fy[-1]) < abs(steady.fy) * 1.01
