@@ -207,7 +207,7 @@ def _readings() -> dict[str, tuple[str, Reading]]:
 
 
 def _chord(ar: areas.GridArea) -> tuple[float, float, float]:
-    """DLM's flexibilities levelled with every cell weighted by its strip's length."""
+    """Return the flexibilities of DLM levelled with every cell weighted by its strip's length."""
     it = dlm.dlm_iteration(ar, nu=NU, shear_modulus=1.0, steps=2, weighting="chord")
     return it.l1[-1], it.l2[-1], it.l3[-1]
 

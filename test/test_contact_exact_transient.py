@@ -100,7 +100,7 @@ def test_rolling_reaches_the_steady_state(area, sequence) -> None:
 
 
 def test_cattaneo_example_as_published() -> None:
-    """CONTACT's ``cattaneo`` example (Kalker 1990, section 5.2.1.1): a ball shifted in stick.
+    """The ``cattaneo`` example of CONTACT (Kalker 1990, 5.2.1.1): a ball shifted in stick.
 
     Polyethylene on polyethylene (G = 200 N/mm^2, nu = 0.42, mu = 0.4), the
     gap 0.01 (x^2 + y^2) (mm) under FN = 9.1954 N on 19 x 19 cells of
