@@ -476,3 +476,22 @@ def test_on_the_exact_theorys_forces_sigma_covers_the_model_error(solver, hertz,
     else:  # the filter of old: sigma knows the load cell only
         assert np.mean(covered[20:]) < 0.5
         assert max(errors[20:]) > 0.03
+
+
+@pytest.mark.parametrize("law, bound", [("constant", "given"), ("exponential", "given"),
+                                        ("constant", "parabolic")])
+@pytest.mark.parametrize("speed", [V, -V])
+def test_models_kernel_call_is_the_solvers_bit_for_bit(solver, hertz, law, bound, speed):
+    """The slope solves call the kernel directly: the forces solve_arrays gives, to the bit."""
+    model = CreepModel(solver, law, 0.4, 0.6, bound)
+    s = sample(hertz, 3e-3, 1e-3, 0.4, speed)
+    fx, fy, k = model._solve(s, 0.3)
+    p, x0, y0, phi = hertz.pressure, hertz.x0, hertz.y0, 0.4
+    if speed < 0.0:
+        p = p[::-1, ::-1]
+        x0 = -(x0 + (p.shape[1] - 1) * hertz.dx)
+        y0, phi = -(y0 + (p.shape[0] - 1) * hertz.dy), -phi
+    f = solver.solve_arrays(p, x0, y0, hertz.dx, hertz.dy, 3e-3, 1e-3, phi, bound=bound,
+                            friction=model.friction(0.3), speed=V)
+    sign = -1.0 if speed < 0.0 else 1.0
+    assert (fx, fy, k) == (sign * f.fx, sign * f.fy, f.slip_fraction)

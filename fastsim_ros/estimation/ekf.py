@@ -81,7 +81,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -96,8 +96,7 @@ UPDATED, UNOBSERVABLE = "updated", "unobservable"
 MODEL_BOUND_SIGMAS = 2.0
 
 
-@dataclass(frozen=True)
-class EkfStep:
+class EkfStep(NamedTuple):
     """One update: prior and posterior ``mu_s`` and sigma, slope, sensitivity, innovation.
 
     ``slope``: ``H = dh/dmu_s`` (N per unit mu, per measured component);
@@ -105,6 +104,7 @@ class EkfStep:
     (N); ``status``: :data:`UPDATED` or :data:`UNOBSERVABLE` (update skipped);
     ``step_seen``: the innovation opened the step gate; ``gain``: ``g = K H``
     (0 when skipped); ``model_bound``: ``c`` after the update (mu units).
+    A named tuple: one per rig cycle, it must cost little.
     """
 
     status: str
@@ -123,6 +123,8 @@ class EkfStep:
 def _floats(values: ArrayLike) -> tuple[float, ...]:
     """Return a scalar or a 1-D sequence of numbers as a tuple of floats."""
     if isinstance(values, (list, tuple)):
+        if len(values) == 1:
+            return (float(values[0]),)
         return tuple(float(v) for v in values)
     return tuple(np.asarray(values, dtype=np.float64).ravel().tolist())
 
@@ -198,12 +200,16 @@ class FrictionEkf:
         knows nothing of a dry rail's knee).
         """
         z = _floats(measured)
-        load = _positive("load", load)
-        s = _positive("model_error", model_error, zero_ok=True)
-        if not all(math.isfinite(v) for v in z):
-            raise InvalidInputError("measured forces must be finite")
+        if not (load > 0.0 and math.isfinite(load)):
+            load = _positive("load", load)
+        if not (model_error >= 0.0 and math.isfinite(model_error)):
+            model_error = _positive("model_error", model_error, zero_ok=True)
+        s = float(model_error)
+        for v in z:
+            if not math.isfinite(v):
+                raise InvalidInputError("measured forces must be finite")
         mu0, var0, c0 = self.mu, self.variance, self.model_bound
-        sigma0 = self.sigma
+        sigma0 = math.sqrt(var0 + c0 * c0)
         h0 = _floats(model(mu0) if predicted is None else predicted)
         if len(h0) != len(z):
             raise InvalidInputError(f"model gives {len(h0)} components, measured {len(z)}")
@@ -211,16 +217,25 @@ class FrictionEkf:
         if mu0 + step > self.mu_bounds[1]:
             step = -step  # stay inside the range the solver is asked about
         h1 = _floats(model(mu0 + step))
-        slope = tuple((b - a) / step for a, b in zip(h0, h1))
-        innovation = tuple(a - b for a, b in zip(z, h0))
-        h2 = math.fsum(v * v for v in slope)
+        slope: tuple[float, ...]
+        innovation: tuple[float, ...]
+        if len(z) == 1:  # one measured component (the node's force.x): no sums to make
+            slope = ((h1[0] - h0[0]) / step,)
+            innovation = (z[0] - h0[0],)
+            h2 = slope[0] * slope[0]
+            hv = slope[0] * innovation[0]
+        else:
+            slope = tuple((b - a) / step for a, b in zip(h0, h1))
+            innovation = tuple(a - b for a, b in zip(z, h0))
+            h2 = math.fsum(v * v for v in slope)
+            hv = math.fsum(a * b for a, b in zip(slope, innovation))
         sensitivity = math.sqrt(h2) / load
         if not sensitivity >= self.min_sensitivity:
             self.skipped += 1
             return EkfStep(UNOBSERVABLE, mu0, sigma0, mu0, sigma0, slope, sensitivity,
                            innovation, model_bound=c0)
         # in mu units: the implied correction, its noise variance and the model's error
-        d = math.fsum(a * b for a, b in zip(slope, innovation)) / h2
+        d = hv / h2
         noise = self.measurement_noise ** 2 / h2
         bias = s / math.sqrt(h2)
         # beyond what the noise (gate sigmas) and the model's error (its bounds) explain
