@@ -61,6 +61,13 @@ METHODS = ("mae_calibrated", "mae", "fastsim_ellipse")
 MODEL_ERROR_SHARE = 0.5
 
 
+def _positive_mu(mu_s: float) -> float:
+    """Return ``mu_s``; refuse one the friction laws refuse (not finite and > 0)."""
+    if not (mu_s > 0.0 and math.isfinite(mu_s)):
+        raise InvalidInputError(f"mu_s must be finite and > 0, got {mu_s}")
+    return mu_s
+
+
 def model_error(mu_s: float, adhesion_load: float, share: float = MODEL_ERROR_SHARE) -> float:
     """Return ``s = share mu_s sum (1 - k) N |projection|`` (N): the model error's scale.
 
@@ -201,6 +208,8 @@ class CreepModel:
         """Check the bound; keep the compiled MAE kernel's call (None: the solver's own)."""
         check_bound(self.bound)
         object.__setattr__(self, "_kernel", _mae_kernel(self.solver, self.bound))
+        # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
+        object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
 
     def contact_forces(self, sample: ContactSample, mu_s: float) -> tuple[float, float]:
         """Return the creep forces ``(Fx, Fy)`` (N, contact frame) of one sample at ``mu_s``."""
@@ -247,8 +256,13 @@ class CreepModel:
             raise InvalidInputError("no contact sample to predict")
         total = [0.0] * len(samples[0].projection)
         adhesion = 0.0
-        law = self.friction(mu_s)
-        kernel_law = self._kernel_law(law) if self._kernel is not None else None  # type: ignore
+        if self._kernel is not None:  # type: ignore[attr-defined]
+            # the kernel's law arguments at mu_s, as _kernel_law(self.friction(mu_s)) gives
+            code, prm, _, slip_dependent = self._law_template  # type: ignore[attr-defined]
+            law = None
+            kernel_law = (code, prm, float(_positive_mu(mu_s)), slip_dependent)
+        else:
+            law, kernel_law = self.friction(mu_s), None
         for s in samples:
             fx, fy, k = self._solve(s, mu_s, law, kernel_law)
             weight = 0.0
