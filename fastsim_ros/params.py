@@ -174,6 +174,12 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_min_sensitivity", "double", 0.02,
                   "observability threshold on |dF/dmu_s| / N: below it (the linear range) "
                   "the estimate holds and its sigma grows", low=0.0, high=1.0, dynamic=True),
+    ParameterSpec("friction_model_error", "double", 0.5,
+                  "the creep model's error against the rail, one sigma, as a share of its bound "
+                  "mu_s (1 - slip fraction) N (the load on the model's adhesion area): "
+                  "samples the model gets wrong weigh little and sigma covers it; 0: the "
+                  "model taken as exact (only the load cell's noise)",
+                  low=0.0, high=10.0, dynamic=True),
     ParameterSpec("rolling", "string", "steady",
                   "steady (each cycle at the steady state) or transient (each contact keeps "
                   "its traction between cycles, convected by |V| dt: Kalker's non-steady "

@@ -41,6 +41,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
+from fastsim_ros.estimation.model import model_error
 from fastsim_ros.contact.transient import RESET_REASONS, ContactMemory, TransientSolver
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
@@ -566,7 +567,7 @@ class Pipeline:
         self._last_cycle_ns = cycle.stamp_ns
         mu = self._mu
         samples: list[ContactSample] = []
-        normal_x = predicted = load = used = 0.0
+        normal_x = predicted = load = used = adhesion = 0.0
         for state in self._contacts.values():
             if state.solved is None:
                 continue
@@ -579,14 +580,18 @@ class Pipeline:
             predicted += ex[0] * f.fx + ey[0] * f.fy
             load += f.n
             used += math.hypot(f.fx, f.fy)
+            adhesion += (1.0 - f.slip_fraction) * f.n * math.hypot(ex[0], ey[0])
         utilisation = used / (mu * load) if load > 0.0 else 0.0
         measured = self._measurement(cycle.stamp_ns)
         status = "no_measurement"
         if measured is not None and samples and load > 0.0:
             model = self._creep_model
             try:
+                share = float(self.config["friction_model_error"])
                 step = ekf.update([measured[0] - normal_x],
-                                  lambda m: model.predict(samples, m), load, [predicted])
+                                  lambda m: model.predict(samples, m), load, [predicted],
+                                  model_error(mu, adhesion, share),
+                                  lambda m: model.predict_with_error(samples, m, share)[1])
                 status = step.status
                 self.estimation_counts["steps"] += int(step.step_seen)
             except ContactError:  # the solver refused the perturbed mu: hold

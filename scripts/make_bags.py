@@ -679,6 +679,117 @@ def transient_step() -> tuple[Bag, dict[str, Any]]:
     return bag, {"rolling": "transient"}
 
 
+#: adhesion_rig's truth (also in its params file, section ``truth``): the falling law's shape,
+#: the static coefficient's steps (from t, mu_s: dry, wet, dry), the spells in the linear
+#: range, the load cell's noise (N, one sigma) and its seed
+ADHESION_LAW = {"friction_law": "exponential", "friction_limit_ratio": 0.5,
+                "friction_decay": 0.5}
+ADHESION_STEPS = ((0.0, 0.4), (1.5, 0.2), (3.0, 0.4))
+ADHESION_LINEAR = ((0.0, 0.3), (2.2, 2.5))
+ADHESION_NOISE = 250.0
+ADHESION_SEED = 28
+
+
+def adhesion_mu(t: float) -> float:
+    """Return adhesion_rig's true static coefficient at ``t`` (s)."""
+    return [mu for start, mu in ADHESION_STEPS if t >= start][-1]
+
+
+def adhesion_xi(t: float) -> float:
+    """Return adhesion_rig's longitudinal creepage at ``t`` (s): ramps and steps, linear spells."""
+    if any(a <= t < b for a, b in ADHESION_LINEAR):
+        return 1.5e-4
+    if int(t * 4) % 3 == 0:  # a step to 6e-3 for a quarter second in every three
+        return 6.0e-3
+    return 3.0e-3 + 9.0e-3 * (t % 1.0)  # ramps 3e-3 -> 1.2e-2 in a second
+
+
+def adhesion_rig() -> tuple[Bag, dict[str, Any]]:
+    """Build (h): a wheelset on a traction rig, the measured wrench from the exact theory.
+
+    Hertzian treads (gap radii 0.46 m and 0.3 m, 50 kN each, 20 x 20
+    cells), v0 = 20 m/s, contact angle 0, 4 s: the creepage of
+    :func:`adhesion_xi`, the true friction the exponential law
+    :data:`ADHESION_LAW` with ``mu_s`` stepping dry -> wet -> dry
+    (:data:`ADHESION_STEPS`).  With each patch pair (100 Hz) a measured
+    wheelset wrench (``/wheelset/measured_wrench``, the patches' stamp,
+    logged before them): the sum of the two contacts' creep forces by
+    Kalker's exact theory (:func:`fastsim_ros.contact.exact.coulomb`) at the
+    true law, on the patch and creepages the node converts from these very
+    messages (the pipeline's own conversion), plus a load cell's Gaussian
+    noise of 250 N on ``force.x`` (seeded: the same bag every run).  The
+    two treads are mirror images under the same creepages: one exact solve
+    serves both.  About 400 exact solves (some seconds).
+    """
+    from fastsim_ros.contact import exact
+    from fastsim_ros.contact.friction import friction_law
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+
+    dur, v0 = 4.0, 20.0
+    bag = Bag("adhesion_rig")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/measured_wrench", WRENCH)
+    for c in ("left", "right"):
+        bag.topic(f"/contact/{c}/patch", CLOUD)
+    area = hertz_area(R, 0.3, 5.0e4, 20)
+    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
+           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
+    converter = Pipeline(PipelineConfig.from_values(dict(BASE_PARAMS, method="mae_calibrated")))
+    twists = {}
+    for t in twist_times(dur):
+        msg = twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, adhesion_xi(t), R), 0))
+        twists[stamp_ns(t)] = msg
+        bag.add("/wheelset/twist", stamp_ns(t), msg)
+    rng = np.random.default_rng(ADHESION_SEED)
+    law_shape = {"limit_ratio": ADHESION_LAW["friction_limit_ratio"],
+                 "decay": ADHESION_LAW["friction_decay"]}
+    for t in patch_times(dur):
+        ns = stamp_ns(t)
+        newest = max(k for k in twists if k <= ns)
+        converter.on_wheel_twist(TYPESTORE.serialize_cdr(twists[newest], TWIST))
+        total = np.zeros(3)
+        solved = None
+        for c in ("left", "right"):
+            cloud = cloud_msg(ns, pts[c])
+            out = converter.on_patch(c, TYPESTORE.serialize_cdr(cloud, CLOUD))
+            assert out.status == "solved", out.status
+            p, cr = out.patch, out.creepage
+            key = (p.pressure.tobytes(), p.x0, p.y0, p.dx, p.dy, cr.xi, cr.eta, abs(cr.phi),
+                   cr.speed)
+            if solved is None or solved[0] != key:
+                law = friction_law(ADHESION_LAW["friction_law"], adhesion_mu(t), **law_shape)
+                f = exact.coulomb(GridArea(p.x0, p.y0, p.dx, p.dy, p.pressure), cr.xi,
+                                  cr.eta, cr.phi, nu=NU, shear_modulus=G, friction=law,
+                                  speed=abs(cr.speed))
+                solved = (key, f.fx, f.fy)
+            total += p.frame.to_wheelset((solved[1], solved[2], p.load))
+            bag.add(f"/contact/{c}/patch", ns, cloud)
+        w = T[WRENCH](
+            header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
+                force=vec((total[0] + rng.normal(0.0, ADHESION_NOISE), total[1], total[2])),
+                torque=vec((0.0, 0.0, 0.0))))
+        bag.add("/wheelset/measured_wrench", ns, w)
+    return bag, {"method": "mae_calibrated", **ADHESION_LAW, "friction_coefficient": 0.3,
+                 "friction_estimation": "on", "friction_measurement_noise": ADHESION_NOISE,
+                 "friction_estimate_sigma": 0.1}
+
+
+def adhesion_truth_text() -> str:
+    """Return the ``truth`` section of adhesion_rig's params file (not a node's: tests read it)."""
+    lines = ["# The truth the measured wrench was made from (scripts/make_bags.py; no node of",
+             "# this name: the tests read it): Kalker's exact theory under the law below, mu_s",
+             "# = mu_static[i] from t = steps_from[i] s (after the first stamp), the load",
+             "# cell's noise (N, one sigma) on force.x, the spells in the linear range (s).",
+             "truth:", "  ros__parameters:", '    solver: "exact"']
+    lines += [f"    {k}: {_yaml_value(v)}" for k, v in ADHESION_LAW.items()]
+    lines += [f"    steps_from: {_yaml_value([float(a) for a, _ in ADHESION_STEPS])}",
+              f"    mu_static: {_yaml_value([float(m) for _, m in ADHESION_STEPS])}",
+              f"    linear_from: {_yaml_value([float(a) for a, _ in ADHESION_LINEAR])}",
+              f"    linear_to: {_yaml_value([float(b) for _, b in ADHESION_LINEAR])}",
+              f"    load_cell_noise: {_yaml_value(ADHESION_NOISE)}"]
+    return "\n".join(lines) + "\n"
+
+
 # ------------------------------------------------------------------ params, main
 
 SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
@@ -689,6 +800,7 @@ SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
     "bad_inputs": bad_inputs,
     "mbench_a22": mbench_a22,
     "transient_step": transient_step,
+    "adhesion_rig": adhesion_rig,
 }
 
 BASE_PARAMS: dict[str, Any] = {
@@ -743,7 +855,8 @@ def build(name: str, out: Path) -> Path:
     bag, extra = SCENARIOS[name]()
     params = dict(BASE_PARAMS, **extra)
     path = bag.write(out)
-    (out / f"{name}.params.yaml").write_text(params_text(name, params))
+    (out / f"{name}.params.yaml").write_text(
+        params_text(name, params) + (adhesion_truth_text() if name == "adhesion_rig" else ""))
     if bag.tags:
         outcomes = classify_bag(path, params)
         for contact in sorted({c for c, _, _ in outcomes}):

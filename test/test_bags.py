@@ -35,7 +35,11 @@ EXPECTED = {
                    "/contact/right/patch": (CLOUD, 300)},
     "mbench_a22": {"/wheelset/twist": (TWIST, 42), "/wheelset/load": (WRENCH, 42),
                    "/wheelset/pose": (POSE, 21)},
+    "adhesion_rig": {"/wheelset/twist": (TWIST, 800), "/wheelset/measured_wrench": (WRENCH, 400),
+                     "/contact/left/patch": (CLOUD, 400), "/contact/right/patch": (CLOUD, 400)},
 }
+#: made from hundreds of exact solves (seconds): shipped, never rebuilt by the tests
+SLOW = ("adhesion_rig",)
 
 
 def _generator():
@@ -152,8 +156,9 @@ def _assert_same(made, shipped, where=""):
 
 
 def test_generator_rebuilds_the_same_bags(tmp_path, decoded):
-    assert MB.main(["--out", str(tmp_path)]) == 0
-    for name in EXPECTED:
+    assert MB.main(["--out", str(tmp_path), "--only",
+                    *(n for n in MB.SCENARIOS if n not in SLOW)]) == 0
+    for name in (n for n in EXPECTED if n not in SLOW):
         again = _messages(tmp_path / name)
         assert len(again) == len(decoded[name])
         for (t1, ns1, m1), (t2, ns2, m2) in zip(again, decoded[name]):
@@ -196,7 +201,7 @@ def _check_layout(msg):
 
 
 #: the bags of hand-made patches (20 to 30 cells a side); flange_shift's come from profiles
-SYNTHETIC = ("hertz_ramp", "semi_ellipses_spin", "roller_rig")
+SYNTHETIC = ("hertz_ramp", "semi_ellipses_spin", "roller_rig", "adhesion_rig")
 
 
 @pytest.mark.parametrize("name", [n for n in sorted(EXPECTED)
@@ -205,7 +210,7 @@ def test_patches_follow_the_layout(name, decoded):
     loads = []
     for topic, ns, msg in decoded[name]:
         assert msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec == ns
-        if topic.endswith("/twist") or topic.endswith("/load"):
+        if topic.endswith(("/twist", "/load", "/measured_wrench")):
             assert msg.header.frame_id == "wheelset"
             continue
         if topic.endswith("/pose"):

@@ -384,3 +384,152 @@ def test_estimation_is_refused_in_profiles_mode():
     with pytest.raises(ParameterError, match="friction_estimation"):
         checked({"patch_source": "profiles", "friction_estimation": "on"})
     assert checked({"friction_estimation": "on"})["friction_estimation"] == "on"
+
+
+# ---------------------------------------------------------------- the model's own error
+
+
+def test_without_model_error_the_update_is_the_kalman_filters():
+    """s = 0, c = 0: g = P H^2 / (P H^2 + R) and the Joseph-form variance, as before."""
+    ekf = FrictionEkf(0.3, 0.1, process_noise=0.0, measurement_noise=NOISE)
+    slope = -0.8 * LOAD
+    step = ekf.update([-0.8 * LOAD * 0.35], lambda m: np.array([slope * m]), LOAD)
+    p, h2, r = 0.01, slope ** 2, NOISE ** 2
+    assert step.gain == pytest.approx(p * h2 / (p * h2 + r), rel=1e-9)
+    assert step.mu == pytest.approx(0.3 + p * slope * (slope * 0.05) / (p * h2 + r), rel=1e-9)
+    assert step.sigma ** 2 == pytest.approx(p * r / (p * h2 + r), rel=1e-9)
+    assert step.model_bound == 0.0
+
+
+def test_model_error_is_a_bound_that_does_not_average_down():
+    """Cycles at one operating point: the noise averages, c settles on that point's s / |H|."""
+    slope, s = -0.8 * LOAD, 0.02 * LOAD  # s' = 0.025 in mu
+    ekf = FrictionEkf(0.3, 0.1, process_noise=0.0, measurement_noise=NOISE)
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        z = slope * 0.35 + rng.normal(0.0, NOISE)
+        step = ekf.update([z], lambda m: np.array([slope * m]), LOAD, model_error=s)
+    # c rises towards s' (from the first cycle's g s') and never beyond it
+    assert 0.95 * s / abs(slope) < step.model_bound <= s / abs(slope)
+    # the noise part averages down below one cycle's (slowly while c < s': each gain adds
+    # model error, the gain that minimises P + c^2 weighs the two)
+    assert ekf.variance < (NOISE / slope) ** 2 / 2
+    assert ekf.sigma > 0.95 * s / abs(slope)
+    # a sample the model gets worse (s twice as large) teaches nothing: the estimate holds
+    mu = ekf.mu
+    worse = ekf.update([slope * 0.5], lambda m: np.array([slope * m]), LOAD, model_error=2 * s)
+    assert worse.gain == 0.0 and ekf.mu == mu and not worse.step_seen
+    # one it gets better pulls the estimate towards it (and the bound down)
+    better = ekf.update([slope * 0.36], lambda m: np.array([slope * m]), LOAD,
+                        model_error=0.2 * s)
+    assert better.gain > 0.5 and better.model_bound < step.model_bound
+
+
+def test_a_step_takes_the_model_error_at_the_new_level():
+    """Wet prior in full slip (s = 0), the rail dry: the sample's error is the dry knee's."""
+    slope = -0.9 * LOAD
+    ekf = FrictionEkf(0.2, 0.002, process_noise=0.0, measurement_noise=NOISE)
+    asked = []
+
+    def error_at(m):
+        asked.append(m)
+        return 0.5 * m * 0.1 * LOAD  # 10% of the load on the adhesion area at the new level
+
+    step = ekf.update([slope * 0.4], lambda m: np.array([slope * m]), LOAD, model_error=0.0,
+                      model_error_at=error_at)
+    assert step.step_seen and asked == [pytest.approx(0.4)]
+    assert step.mu == pytest.approx(0.4, rel=0.01)
+    assert step.model_bound == pytest.approx(step.gain * error_at(0.4) / abs(slope), rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def exact_curve(hertz):
+    """The exact theory's Fx at mu = 0.4 beyond the linear range (the knee to full slip)."""
+    from fastsim_ros.contact import exact
+    xis = (3e-3, 4e-3, 5e-3, 6e-3, 7e-3, 9e-3, 1.2e-2)
+    return xis, [exact.coulomb(hertz, xi, 0.0, 0.0, nu=NU, shear_modulus=G, mu=0.4).fx
+                 for xi in xis]
+
+
+@pytest.mark.parametrize("share", [0.5, 0.0])
+def test_on_the_exact_theorys_forces_sigma_covers_the_model_error(solver, hertz, exact_curve,
+                                                                  share):
+    """FastSim's knee error (up to 6% of mu N, systematic): carried, the 2-sigma band covers
+    the truth and the estimate leans on the full-slip samples; taken for noise, it does not."""
+    rng = np.random.default_rng(6)
+    model = CreepModel(solver)
+    ekf = FrictionEkf(0.3, 0.1, process_noise=2e-5, measurement_noise=NOISE)
+    xis, forces = exact_curve
+    errors, covered = [], []
+    for k in rng.integers(0, len(xis), 200):
+        s = sample(hertz, xis[k])
+        ekf.predict(DT)
+        h, error = model.predict_with_error([s], ekf.mu, share)
+        step = ekf.update([forces[k] + rng.normal(0.0, NOISE)],
+                          lambda m: model.predict([s], m), LOAD, h, error,
+                          lambda m: model.predict_with_error([s], m, share)[1])
+        errors.append(abs(step.mu - 0.4) / 0.4)
+        covered.append(abs(step.mu - 0.4) <= 2.0 * step.sigma)
+    if share:
+        assert np.mean(covered[20:]) >= 0.95
+        assert max(errors[20:]) < 0.02
+    else:  # the filter of old: sigma knows the load cell only
+        assert np.mean(covered[20:]) < 0.5
+        assert max(errors[20:]) > 0.03
+
+
+@pytest.mark.parametrize("law, bound", [("constant", "given"), ("exponential", "given"),
+                                        ("constant", "parabolic")])
+@pytest.mark.parametrize("speed", [V, -V])
+def test_models_kernel_call_is_the_solvers_bit_for_bit(solver, hertz, law, bound, speed):
+    """The slope solves call the kernel directly: the forces solve_arrays gives, to the bit."""
+    model = CreepModel(solver, law, 0.4, 0.6, bound)
+    s = sample(hertz, 3e-3, 1e-3, 0.4, speed)
+    fx, fy, k = model._solve(s, 0.3)
+    p, x0, y0, phi = hertz.pressure, hertz.x0, hertz.y0, 0.4
+    if speed < 0.0:
+        p = p[::-1, ::-1]
+        x0 = -(x0 + (p.shape[1] - 1) * hertz.dx)
+        y0, phi = -(y0 + (p.shape[0] - 1) * hertz.dy), -phi
+    f = solver.solve_arrays(p, x0, y0, hertz.dx, hertz.dy, 3e-3, 1e-3, phi, bound=bound,
+                            friction=model.friction(0.3), speed=V)
+    sign = -1.0 if speed < 0.0 else 1.0
+    assert (fx, fy, k) == (sign * f.fx, sign * f.fy, f.slip_fraction)
+
+
+def contact_curve():
+    """CONTACT's published exact traction curve (docs/data/contact_tractcurv.csv)."""
+    import csv
+    from pathlib import Path
+    path = Path(__file__).resolve().parents[1] / "docs" / "data" / "contact_tractcurv.csv"
+    with path.open(encoding="utf-8") as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    return (np.array([float(r["cksi"]) for r in rows]), np.array([float(r["fx"]) for r in rows]),
+            float(rows[0]["fn"]))
+
+
+@pytest.mark.parametrize("share", [0.5, 0.0])
+def test_on_contacts_published_curve_to_the_knee(share):
+    """Kalker's exact theory by CONTACT (mu 0.33), the curve up to the knee as measurements.
+
+    No point in full slip: the model's error (up to 6.5% of mu N) is all there is.  Carried,
+    the estimate is within 2% and its band covers the truth; taken for noise, it is 3.5% off
+    with a band that misses.
+    """
+    cksi, fx, load = contact_curve()
+    knee = cksi <= 6e-3
+    area = ellipse(6.304e-3, 12.61e-3, nx=24, ny=24, load=load)
+    model = CreepModel(CalibratedMaeSolver(NU, 8.2e10))
+    ekf = FrictionEkf(0.3, 0.1, process_noise=2e-5, measurement_noise=NOISE)
+    for _ in range(3):
+        for xi, z in zip(cksi[knee], fx[knee]):
+            s = sample(area, float(xi), speed=10.0)
+            ekf.predict(DT)
+            h, error = model.predict_with_error([s], ekf.mu, share)
+            ekf.update([z], lambda m, s=s: model.predict([s], m), load, h, error,
+                       lambda m, s=s: model.predict_with_error([s], m, share)[1])
+    covers = abs(ekf.mu - 0.33) <= 2.0 * ekf.sigma
+    if share:
+        assert abs(ekf.mu - 0.33) < 0.02 * 0.33 and covers
+    else:
+        assert abs(ekf.mu - 0.33) > 0.03 * 0.33 and not covers

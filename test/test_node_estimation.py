@@ -5,19 +5,25 @@ until the node counted both, then the patch; the node's ``friction/estimate``
 and wrenches must equal those of an in-process :class:`~fastsim_ros.pipeline.
 Pipeline` fed the same messages in the same order (the replay's code), and
 the estimate must move towards the friction the measurement came from.
+The bag ``adhesion_rig`` (the exact theory's forces) played to the node: its
+estimates and wrenches equal the offline replay's.
 """
 
 import numpy as np
 import pytest
 from geometry_msgs.msg import Vector3Stamped, WrenchStamped
+from rclpy.serialization import deserialize_message
+from rosbags.rosbag2 import Reader
 
+from fastsim_ros import replay
 from fastsim_ros.contact import area as areas
-from fastsim_ros.pipeline import Pipeline, PipelineConfig
-from ros_harness import NODE_SCRIPT, Client, NodeProcess, stamp_ns
+from fastsim_ros.pipeline import TWIST_HISTORY, Pipeline, PipelineConfig
+from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
 from ros_messages import cdr, cloud_msg, rolling_twist
 
 T0 = 1_700_000_000 * 1_000_000_000
 PERIOD = 5_000_000  # ns
+BAGS = PACKAGE_ROOT / "bags"
 
 pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
                                 reason="fastsim_node is not installed (run colcon build)")
@@ -79,3 +85,62 @@ def test_node_estimates_as_the_pipeline_does(tmp_path):
     finally:
         client.close()
         proc.stop()
+
+
+def offline_estimates(out):
+    """Return {stamp: (mu, sigma, utilisation)} and {(contact, stamp): Fx} of the replay."""
+    assert replay.main([str(BAGS / "adhesion_rig"), "-o", str(out), "--params",
+                        str(BAGS / "adhesion_rig.params.yaml"), "--no-progress"]) == 0
+    estimates, fx = {}, {}
+    with Reader(out / "adhesion_rig") as reader:
+        for conn, _, raw in reader.messages():
+            if conn.topic == "/friction/estimate":
+                m = deserialize_message(raw, Vector3Stamped)
+                estimates[stamp_ns(m)] = (m.vector.x, m.vector.y, m.vector.z)
+            elif conn.topic.startswith("/contact/") and conn.topic.endswith("/wrench"):
+                w = deserialize_message(raw, WrenchStamped)
+                fx[(conn.topic.split("/")[2], stamp_ns(w))] = w.wrench.force.x
+    return estimates, fx
+
+
+def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
+    """The bag over DDS: twists and measured wrenches first (counted), then the patches."""
+    want, want_fx = offline_estimates(tmp_path / "offline")
+    with Reader(BAGS / "adhesion_rig") as reader:
+        messages = [(conn.topic, bytes(raw)) for conn, _, raw in reader.messages()]
+    first = [m for m in messages if m[0].endswith(("/twist", "/measured_wrench"))]
+    patches = [m for m in messages if m[0].endswith("/patch")]
+    assert len(first) + len(patches) == len(messages) and len(first) <= 2 * TWIST_HISTORY
+    wrenches = sum(m[0].endswith("/measured_wrench") for m in first)
+    proc = NodeProcess("--params-file", str(BAGS / "adhesion_rig.params.yaml"),
+                       "-p", "patch_reliability:=reliable", "-p", "qos_depth:=1000",
+                       log_dir=tmp_path)
+    client = Client(("left", "right"), name="player")
+    try:
+        pubs = {"/wheelset/twist": client.twist,
+                "/wheelset/measured_wrench": client.publisher(WrenchStamped,
+                                                              "wheelset/measured_wrench")}
+        pubs.update({f"/contact/{c}/patch": p for c, p in client.patch.items()})
+        estimates = client.subscribe(Vector3Stamped, "friction/estimate")
+        client.wait_connected(proc)
+        for topic, raw in first:
+            pubs[topic].publish(raw)
+        client.wait_twists_handled(len(first) - wrenches)
+        assert client.wait_for(lambda: int(client.diagnostic_values("left").get(
+            "friction_estimation/measured", "0")) >= wrenches, 20.0)
+        for k in range(0, len(patches), 2):  # a cycle at a time: both patches, then its estimate
+            for topic, raw in patches[k:k + 2]:
+                pubs[topic].publish(raw)
+            assert client.wait_for(lambda k=k: len(estimates) >= k // 2 + 1, 10.0)
+        got = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in estimates}
+        got_fx = {(c, stamp_ns(w)): w.wrench.force.x for c, ws in client.wrenches.items()
+                  for w in ws}
+    finally:
+        client.close()
+        assert proc.stop() == 0
+    assert len(want) == 400 and got.keys() == want.keys()
+    for stamp, value in want.items():
+        assert got[stamp] == pytest.approx(value, rel=1e-12), stamp
+    assert got_fx.keys() == want_fx.keys()
+    for key, value in want_fx.items():
+        assert got_fx[key] == pytest.approx(value, rel=1e-12), key

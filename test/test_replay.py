@@ -48,7 +48,7 @@ from msg_adapters.patch import patch_from_cloud  # noqa: E402
 BAGS = ROOT / "bags"
 GOLDEN = BAGS / "golden"
 NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_inputs",
-         "mbench_a22", "transient_step")
+         "mbench_a22", "transient_step", "adhesion_rig")
 TYPES = get_typestore(Stores.ROS2_JAZZY)
 WRENCH, VECTOR = "geometry_msgs/msg/WrenchStamped", "geometry_msgs/msg/Vector3Stamped"
 POSE, DIAG = "geometry_msgs/msg/PoseStamped", "diagnostic_msgs/msg/DiagnosticArray"
@@ -304,6 +304,61 @@ def test_flange_shift_two_point_contact(replayed):
     for c in ("left", "right"):
         f = np.hypot(column(by[c], "Fx"), column(by[c], "Fy"))
         assert np.all(f <= MU * n[c] * (1 + 1e-9))
+
+
+def adhesion_truth():
+    """Return adhesion_rig's truth (its params file's ``truth`` section) as a mu_s of t (s)."""
+    truth = yaml.safe_load((BAGS / "adhesion_rig.params.yaml").read_text())
+    truth = truth["truth"]["ros__parameters"]
+    steps = list(zip(truth["steps_from"], truth["mu_static"]))
+    spells = list(zip(truth["linear_from"], truth["linear_to"]))
+    return truth, steps, spells
+
+
+def test_adhesion_rig_estimates_the_exact_theorys_friction(contents):
+    """The replay's friction/estimate against the truth the bag was made from.
+
+    Issue 28's target: beyond the linear range mu within 2% of the truth
+    within 0.2 s of each step and the 2-sigma band covering it at least 95%
+    of the time; in the linear range the estimate moves less than 1% while
+    sigma grows.  Measured by the exact theory, the model's error at the
+    knee of the curve (3-8% of mu there, docs/validation_estimation.md) is
+    what the estimate can be trusted to until the creepage reaches full
+    slip: there the 2% holds where the bag's creepage gets beyond the knee
+    within 0.2 s (the dry -> wet step at 1.5 s) and from the ramp's full
+    slip on (the last 0.5 s of each dry stretch), and where it does not
+    (after the wet -> dry step at 3 s the creepage stays at the dry knee
+    for 0.5 s: up to 4.7% off) sigma says so: the band still covers the
+    truth and sigma is above 2% of mu wherever the error is.
+    """
+    truth, steps, spells = adhesion_truth()
+    _, msgs = contents["adhesion_rig"][0]["/friction/estimate"]
+    t0 = msgs[0][1].header.stamp.sec * 10**9 + msgs[0][1].header.stamp.nanosec - 2_500_000
+    t = np.array([(m.header.stamp.sec * 10**9 + m.header.stamp.nanosec - t0) * 1e-9
+                  for _, m in msgs])
+    mu = np.array([m.vector.x for _, m in msgs])
+    sigma = np.array([m.vector.y for _, m in msgs])
+    assert all(m.header.frame_id == "wheelset" for _, m in msgs) and len(msgs) == 400
+    true = np.array([[m for start, m in steps if x >= start][-1] for x in t])
+    linear = np.array([any(a <= x < b for a, b in spells) for x in t])
+    error = np.abs(mu - true) / true
+    covered = np.abs(mu - true) <= 2.0 * sigma
+    assert covered[~linear].mean() >= 0.95 and covered.mean() >= 0.95
+    ends = [start for start, _ in steps[1:]] + [t[-1] + 1.0]
+    for (start, mu_s), end in zip(steps, ends):
+        settled = (t >= start + 0.2) & (t < end) & ~linear
+        # where the estimate is off by more than 2%, its sigma says it may be
+        assert np.all((error[settled] < 0.02) | (sigma[settled] > 0.02 * mu[settled]))
+        assert np.all(error[(t >= end - 0.5) & (t < end) & ~linear] < 0.02), start
+    wet = (t >= steps[1][0] + 0.2) & (t < steps[2][0]) & ~linear
+    assert error[wet].max() < 0.02  # the dry -> wet step: within 2% from 0.2 s on
+    for a, b in spells:
+        inside = np.nonzero((t >= a) & (t < b))[0]
+        before = inside[0] - 1
+        mu0 = mu[before] if before >= 0 else 0.3  # the params file's start
+        assert abs(mu[inside[-1]] - mu0) < 0.01 * mu0
+        assert np.all(np.diff(sigma[inside]) > 0.0)
+    assert truth["solver"] == "exact" and truth["friction_law"] == "exponential"
 
 
 def test_roller_rig_is_served_with_its_rail_twist(replayed):
@@ -736,12 +791,12 @@ def test_bad_params_file_exits_before_work(tmp_path, capsys):
 
 # ------------------------------------------------------------------------ golden files
 
-def write_golden() -> None:
+def write_golden(names=NAMES) -> None:
     """Regenerate ``bags/golden/<name>.csv.gz`` from the replay's own CSV output."""
     import tempfile
     GOLDEN.mkdir(exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
-        for name in NAMES:
+        for name in names:
             status = replay.main([str(BAGS / name), "-o", tmp, "--csv", "--params",
                                   str(BAGS / f"{name}.params.yaml")])
             if status != 0:
@@ -754,6 +809,6 @@ def write_golden() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] != ["--write-golden"]:
-        raise SystemExit("usage: python test/test_replay.py --write-golden")
-    write_golden()
+    if sys.argv[1:2] != ["--write-golden"] or not set(sys.argv[2:]) <= set(NAMES):
+        raise SystemExit("usage: python test/test_replay.py --write-golden [NAME ...]")
+    write_golden(tuple(sys.argv[2:]) or NAMES)

@@ -10,6 +10,9 @@ solver (default ``mae_calibrated``) under the configured friction law:
   slope ``dF/dmu_s`` by a forward difference (one extra solve per contact).
   Where the force does not depend on ``mu_s`` (the linear range: small
   creepage) the update is skipped: the estimate holds, its variance grows.
+  The model's own error against the rail (largest at the knee of the creep
+  curve, nil in full slip) is carried as a bound, not as noise: samples the
+  model gets wrong weigh little, and sigma covers it.
 - :func:`~fastsim_ros.estimation.fit.fit_friction`: batch, over a measured
   creep curve (``fastsim_contact estimate``): Gauss-Newton (SciPy's
   trust-region least squares) over ``mu_s`` and, for the exponential law,
@@ -22,6 +25,7 @@ creepages, a law's shape) as a function of the law's parameters.
 from __future__ import annotations
 
 from fastsim_ros.estimation.ekf import EkfStep, FrictionEkf
-from fastsim_ros.estimation.model import ContactSample, CreepModel, solver_for
+from fastsim_ros.estimation.model import ContactSample, CreepModel, model_error, solver_for
 
-__all__ = ["ContactSample", "CreepModel", "EkfStep", "FrictionEkf", "solver_for"]
+__all__ = ["ContactSample", "CreepModel", "EkfStep", "FrictionEkf", "model_error",
+           "solver_for"]

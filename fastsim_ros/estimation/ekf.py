@@ -2,13 +2,15 @@
 
 State: ``mu_s`` (dimensionless), a random walk ``d mu_s = w``, ``E[w^2] =
 q dt`` (``q``, :attr:`FrictionEkf.process_noise`, in 1/s: how fast ``mu_s``
-may change).  Measurement: ``z = h(mu_s) + v``, ``h`` the package's solver
-summed over the cycle's contacts and projected on the measured components
-(:class:`~fastsim_ros.estimation.model.CreepModel`), ``v`` the load cell's
-noise of standard deviation :attr:`FrictionEkf.measurement_noise` (N).
-The slope ``H = dh/dmu_s`` is a forward difference with the step
-``relative_step * mu_s``: one solve per contact beyond the one at the prior
-(which the caller may pass: the published forces are that solve).
+may change).  Measurement: ``z = h(mu_s) + b + v``, ``h`` the package's
+solver summed over the cycle's contacts and projected on the measured
+components (:class:`~fastsim_ros.estimation.model.CreepModel`), ``v`` the
+load cell's noise of standard deviation :attr:`FrictionEkf.measurement_noise`
+(N, white), ``b`` the model's own error against the rail (N, of scale ``s``
+given with each measurement, see below: not white).  The slope ``H =
+dh/dmu_s`` is a forward difference with the step ``relative_step * mu_s``:
+one solve per contact beyond the one at the prior (which the caller may
+pass: the published forces are that solve).
 
 Observability.  With constant friction FastSim's forces are homogeneous,
 ``F(mu, c) = mu F(1, c/mu)``, so ``dF/dmu = (F - c . dF/dc)/mu``: zero in
@@ -24,24 +26,62 @@ value, ``r = f - s f'``: about ``s^2/3`` for ``f = s - s^2/3 + s^3/27``
 why): the estimate holds exactly and its variance grows by ``q dt`` per
 cycle (bounded by :attr:`FrictionEkf.sigma_max`), instead of a gain
 ``K ~ 1/H`` that would turn load-cell noise into a drifting ``mu``.  Above
-it the Kalman gain weighs the information as usual; the estimate is kept in
+it the gain weighs the information (below); the estimate is kept in
 :attr:`FrictionEkf.mu_bounds`.
+
+The model's error.  The fast method is not the exact theory: against it
+(docs/validation_estimation.md) the creep force is off by up to some 6% of
+``mu N`` at the knee of the curve, and that error is systematic (the same
+creepage gives the same error, cycle after cycle), not noise: a filter that
+took it for noise would average it down, report a sigma far too small, and
+read a force error ``db`` as a friction error ``db / H``, largest where the
+slope ``H`` is small.  Its scale ``s`` (N, one sigma) comes with each
+measurement (:func:`~fastsim_ros.estimation.model.model_error`: the traction
+bound times the load on the model's adhesion area, a share of it), and the
+filter carries two parts of its uncertainty: ``P`` the variance from noise
+(averages down, grows by ``q dt``) and ``c`` a bound on the error from the
+model (mu units; any correlation and sign between cycles: it never averages
+down below the samples' own).  The reported ``sigma = sqrt(P + c^2)``.  In
+``mu`` units a cycle implies the correction ``d = H.y / |H|^2`` (``y = z -
+h(mu)`` the innovation) with noise ``n' = sigma_v / |H|`` and model error
+``s' = s / |H|``; an update with the scalar gain ``g = K H`` gives
+
+    mu+ = mu + g d,   P+ = (1 - g)^2 P + g^2 n'^2,   c+ = (1 - g) c + g s'
+
+(the bound by the triangle inequality: the old error and the new sample's
+may add), and ``g`` minimises ``P+ + c+^2``:
+
+    g = (P + c (c - s')) / (P + n'^2 + (c - s')^2),   clipped to [0, 1].
+
+With ``s = 0`` and ``c = 0`` this is the Kalman gain ``P H^2 / (P H^2 +
+sigma_v^2)`` and the Joseph-form variance.  Repeated cycles at one operating
+point average the noise (``g -> P / (P + n'^2)``) while ``c`` settles on
+that point's ``s'``; a cycle whose model error is smaller than the
+estimate's (``s' < c``) pulls it harder; one whose error is larger (``s' >
+c + P / c``: the knee, partial slip, where ``H`` is small) moves it little
+or not at all.  So the estimate leans on the samples the model gets right
+(full slip) and its sigma states what the model can be trusted to.
 
 Steps of mu (dry -> wet rail).  A random walk slow enough for a quiet
 estimate follows a step only slowly; so an innovation beyond
-:attr:`FrictionEkf.step_gate` standard deviations of its prediction (``|z -
-h| > gate sqrt(S)``, ``S = H P H + R``) is taken as a change of the rail:
-the variance grows by the square of the step it implies, ``(|z - h| /
-|H|)^2``, before the gain is computed, so the estimate jumps to the new
-level within a cycle and then averages the noise down again.  With a 4-sigma
-gate, noise alone opens it once in some 16,000 cycles.
+:attr:`FrictionEkf.step_gate` standard deviations of its noise plus the
+model's bounds (``|d| > gate sqrt(P + n'^2) + 2 (c + s')``) is taken as a
+change of the rail: the
+variance grows by the square of the step it implies, ``d^2``, before the
+gain is computed, so the estimate jumps to the new level within a cycle and
+then averages the noise down again; the sample's model error is then the
+model's at the new level (``model_error_at(mu + d)``).  The gate adds the
+model error's bounds (:data:`MODEL_BOUND_SIGMAS` times ``c`` and ``s'``:
+an error the model may make is no evidence of a step) to ``gate`` standard
+deviations of the noise.  With a 4-sigma gate, noise alone opens
+it once in some 16,000 cycles.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -52,16 +92,19 @@ FloatArray = NDArray[np.float64]
 
 #: why an update was or was not made (:attr:`EkfStep.status`)
 UPDATED, UNOBSERVABLE = "updated", "unobservable"
+#: the model's error is at most this many of its scales s (the bound taken as two sigma)
+MODEL_BOUND_SIGMAS = 2.0
 
 
-@dataclass(frozen=True)
-class EkfStep:
+class EkfStep(NamedTuple):
     """One update: prior and posterior ``mu_s`` and sigma, slope, sensitivity, innovation.
 
     ``slope``: ``H = dh/dmu_s`` (N per unit mu, per measured component);
     ``sensitivity``: ``r = |H| / N``; ``innovation``: ``z - h(mu_prior)``
     (N); ``status``: :data:`UPDATED` or :data:`UNOBSERVABLE` (update skipped);
-    ``step_seen``: the innovation opened the step gate.
+    ``step_seen``: the innovation opened the step gate; ``gain``: ``g = K H``
+    (0 when skipped); ``model_bound``: ``c`` after the update (mu units).
+    A named tuple: one per rig cycle, it must cost little.
     """
 
     status: str
@@ -73,11 +116,15 @@ class EkfStep:
     sensitivity: float
     innovation: tuple[float, ...]
     step_seen: bool = False
+    gain: float = 0.0
+    model_bound: float = 0.0
 
 
 def _floats(values: ArrayLike) -> tuple[float, ...]:
     """Return a scalar or a 1-D sequence of numbers as a tuple of floats."""
     if isinstance(values, (list, tuple)):
+        if len(values) == 1:
+            return (float(values[0]),)
         return tuple(float(v) for v in values)
     return tuple(np.asarray(values, dtype=np.float64).ravel().tolist())
 
@@ -101,7 +148,8 @@ class FrictionEkf:
     standard deviation (what "nothing known" means); ``relative_step``: the
     forward difference's step relative to ``mu_s``; ``step_gate``: the
     innovation (in its standard deviations) taken as a step of mu (``inf``:
-    never).
+    never).  :attr:`variance` is the noise part ``P`` of the estimate's
+    variance, :attr:`model_bound` the model part's bound ``c``.
     """
 
     def __init__(self, mu: float, sigma: float, *, process_noise: float,
@@ -115,6 +163,7 @@ class FrictionEkf:
         self.mu = min(max(_positive("mu", mu), lo), hi)
         self.sigma_max = _positive("sigma_max", sigma_max)
         self.variance = min(_positive("sigma", sigma), self.sigma_max) ** 2
+        self.model_bound = 0.0
         self.process_noise = _positive("process_noise", process_noise, zero_ok=True)
         self.measurement_noise = _positive("measurement_noise", measurement_noise)
         self.min_sensitivity = _positive("min_sensitivity", min_sensitivity, zero_ok=True)
@@ -127,27 +176,40 @@ class FrictionEkf:
 
     @property
     def sigma(self) -> float:
-        """Return the standard deviation of the estimate."""
-        return math.sqrt(self.variance)
+        """Return the standard deviation of the estimate, ``sqrt(P + c^2)``."""
+        return math.sqrt(self.variance + self.model_bound * self.model_bound)
 
     def predict(self, dt: float) -> None:
-        """Advance by ``dt`` seconds: the variance grows by ``q dt`` (up to ``sigma_max^2``)."""
+        """Advance by ``dt`` seconds: ``P`` grows by ``q dt`` (the total up to ``sigma_max^2``)."""
         dt = _positive("dt", dt, zero_ok=True)
-        self.variance = min(self.variance + self.process_noise * dt, self.sigma_max ** 2)
+        self.variance = min(self.variance + self.process_noise * dt,
+                            max(self.sigma_max ** 2 - self.model_bound ** 2, 0.0))
 
     def update(self, measured: ArrayLike, model: Callable[[float], ArrayLike], load: float,
-               predicted: ArrayLike | None = None) -> EkfStep:
+               predicted: ArrayLike | None = None, model_error: float = 0.0,
+               model_error_at: Callable[[float], float] | None = None) -> EkfStep:
         """Take one measurement ``measured`` (N, ``(m,)``) of the model ``model(mu_s)`` (N).
 
         ``load``: the cycle's total normal load (N, for the sensitivity);
-        ``predicted``: ``model(self.mu)`` if already known (saves a solve).
+        ``predicted``: ``model(self.mu)`` if already known (saves a solve);
+        ``model_error``: ``s``, the scale (N, one sigma, each component) of
+        the model's error at the prior (0: the model taken as exact);
+        ``model_error_at``: ``s`` at another ``mu_s``, asked once when a
+        step of mu is seen (the sample's error is the model's at the new
+        level, ``mu + d``, not at the prior's: a wet prior in full slip
+        knows nothing of a dry rail's knee).
         """
         z = _floats(measured)
-        load = _positive("load", load)
-        if not all(math.isfinite(v) for v in z):
-            raise InvalidInputError("measured forces must be finite")
-        mu0, var0 = self.mu, self.variance
-        sigma0 = math.sqrt(var0)
+        if not (load > 0.0 and math.isfinite(load)):
+            load = _positive("load", load)
+        if not (model_error >= 0.0 and math.isfinite(model_error)):
+            model_error = _positive("model_error", model_error, zero_ok=True)
+        s = float(model_error)
+        for v in z:
+            if not math.isfinite(v):
+                raise InvalidInputError("measured forces must be finite")
+        mu0, var0, c0 = self.mu, self.variance, self.model_bound
+        sigma0 = math.sqrt(var0 + c0 * c0)
         h0 = _floats(model(mu0) if predicted is None else predicted)
         if len(h0) != len(z):
             raise InvalidInputError(f"model gives {len(h0)} components, measured {len(z)}")
@@ -155,29 +217,43 @@ class FrictionEkf:
         if mu0 + step > self.mu_bounds[1]:
             step = -step  # stay inside the range the solver is asked about
         h1 = _floats(model(mu0 + step))
-        slope = tuple((b - a) / step for a, b in zip(h0, h1))
-        innovation = tuple(a - b for a, b in zip(z, h0))
-        h2 = math.fsum(v * v for v in slope)
+        slope: tuple[float, ...]
+        innovation: tuple[float, ...]
+        if len(z) == 1:  # one measured component (the node's force.x): no sums to make
+            slope = ((h1[0] - h0[0]) / step,)
+            innovation = (z[0] - h0[0],)
+            h2 = slope[0] * slope[0]
+            hv = slope[0] * innovation[0]
+        else:
+            slope = tuple((b - a) / step for a, b in zip(h0, h1))
+            innovation = tuple(a - b for a, b in zip(z, h0))
+            h2 = math.fsum(v * v for v in slope)
+            hv = math.fsum(a * b for a, b in zip(slope, innovation))
         sensitivity = math.sqrt(h2) / load
         if not sensitivity >= self.min_sensitivity:
             self.skipped += 1
             return EkfStep(UNOBSERVABLE, mu0, sigma0, mu0, sigma0, slope, sensitivity,
-                           innovation)
-        r = self.measurement_noise ** 2
-        hv = math.fsum(a * b for a, b in zip(slope, innovation))
-        # the innovation's size in its predicted standard deviations (along H)
-        nis = hv * hv / h2 / (var0 * h2 + r)
-        step_seen = nis > self.step_gate ** 2
+                           innovation, model_bound=c0)
+        # in mu units: the implied correction, its noise variance and the model's error
+        d = hv / h2
+        noise = self.measurement_noise ** 2 / h2
+        bias = s / math.sqrt(h2)
+        # beyond what the noise (gate sigmas) and the model's error (its bounds) explain
+        step_seen = abs(d) > (self.step_gate * math.sqrt(var0 + noise)
+                              + MODEL_BOUND_SIGMAS * (c0 + bias))
         if step_seen:  # the rail changed: what the innovation implies of mu is unknown
-            var0 = min(var0 + hv * hv / (h2 * h2), self.sigma_max ** 2)
+            var0 = min(var0 + d * d, self.sigma_max ** 2)
             self.steps += 1
-        # scalar state, isotropic R = r I: S = P H H^T + r I, so S^-1 H = H / (P |H|^2 + r)
-        # (Sherman-Morrison) and K = P H / (P |H|^2 + r); Joseph form for the variance
-        denominator = var0 * h2 + r
-        kh = var0 * h2 / denominator
-        mu = mu0 + var0 * hv / denominator
-        self.variance = (1.0 - kh) ** 2 * var0 + r * var0 * var0 * h2 / denominator ** 2
-        self.mu = min(max(mu, self.mu_bounds[0]), self.mu_bounds[1])
+            if model_error_at is not None:
+                level = min(max(mu0 + d, self.mu_bounds[0]), self.mu_bounds[1])
+                bias = _positive("model_error", model_error_at(level), zero_ok=True) \
+                    / math.sqrt(h2)
+        # the gain that minimises P+ + c+^2 (the module's docstring), in [0, 1]
+        g = (var0 + c0 * (c0 - bias)) / (var0 + noise + (c0 - bias) ** 2)
+        g = min(max(g, 0.0), 1.0)
+        self.variance = (1.0 - g) ** 2 * var0 + g * g * noise
+        self.model_bound = min((1.0 - g) * c0 + g * bias, self.sigma_max)
+        self.mu = min(max(mu0 + g * d, self.mu_bounds[0]), self.mu_bounds[1])
         self.updates += 1
         return EkfStep(UPDATED, mu0, sigma0, self.mu, self.sigma, slope, sensitivity,
-                       innovation, step_seen)
+                       innovation, step_seen, g, self.model_bound)

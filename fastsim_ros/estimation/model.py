@@ -8,6 +8,26 @@ A :class:`CreepModel` holds the solver and the friction law's shape (name,
 limit ratio ``A``, decay ``B`` in s/m); :meth:`CreepModel.predict` gives the
 measured components' model values (N) at a static coefficient ``mu_s``.
 
+The model's error (:func:`model_error`): where the fast method and the
+exact theory differ.  Both bound the traction by ``mu p``; in the model's
+slip area both are at the bound along the slip (the same force, up to the
+slip's direction and, under a falling law, its speed), so the difference
+lives in the model's adhesion area, where FastSim's traction rises from zero
+at the leading edge while the exact one is already near the bound.  It is
+at most ``mu_s`` times the load on that area, about ``(1 - k) N`` (``k`` the
+slip fraction, the share of cells on the bound: the adhesion area is the
+leading edge, where the pressure is below average, so this over-states the
+load a little).  :data:`MODEL_ERROR_SHARE` of that bound is taken as the
+error's standard deviation (the bound as two sigma): ``s = 0.5 mu_s (1 - k)
+N`` per contact, the contacts' added (the same sign at worst).  Measured
+(Hertzian 6 x 4 mm ellipse under xi, under eta, the 20-cell flange-root
+patch under xi, ``mae_calibrated`` against :func:`fastsim_ros.contact.exact.
+coulomb`, mu = 0.4 under the exponential law A = B = 0.5 at 20 m/s): the
+error is 0.10-0.21 of ``mu (1 - k) N`` from ``k`` = 0.64 to full slip (the
+knee's 5.9% of mu N at k = 0.67, 1% at k = 0.92), below 0.05 of it in
+partial slip (``k`` < 0.55), so the 0.5 is an honest bound.  In full slip
+``s`` vanishes and the load cell's noise is left.
+
 Reverse running (rolling speed ``V < 0``) is solved as the pipeline solves
 it (INTERFACE.md "Creepages"): the patch turned by 180 degrees about ``z``,
 spin negated, ``(-Fx', -Fy')`` reported, so the model's forces are the
@@ -16,21 +36,47 @@ published ones bit for bit.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fastsim_ros.contact import kernels
+from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipseSolver,
-                                          MaeSolver)
+                                          MaeSolver, _raise)
+from fastsim_ros.contact.compiled import _law as _kernel_law
 from fastsim_ros.contact.errors import InvalidInputError
-from fastsim_ros.contact.friction import FrictionLaw, friction_law
+from fastsim_ros.contact.friction import FrictionLaw, check_speed, friction_law
 
 FloatArray = NDArray[np.float64]
 Solver = MaeSolver | EquivalentEllipseSolver
 #: the solvers the estimators may use as their measurement model
 METHODS = ("mae_calibrated", "mae", "fastsim_ellipse")
+#: the model error's standard deviation as a share of its bound mu_s (1 - k) N (the bound as
+#: two sigma; the module's docstring)
+MODEL_ERROR_SHARE = 0.5
+
+
+def _positive_mu(mu_s: float) -> float:
+    """Return ``mu_s``; refuse one the friction laws refuse (not finite and > 0)."""
+    if not (mu_s > 0.0 and math.isfinite(mu_s)):
+        raise InvalidInputError(f"mu_s must be finite and > 0, got {mu_s}")
+    return mu_s
+
+
+def model_error(mu_s: float, adhesion_load: float, share: float = MODEL_ERROR_SHARE) -> float:
+    """Return ``s = share mu_s sum (1 - k) N |projection|`` (N): the model error's scale.
+
+    ``adhesion_load``: ``sum_c (1 - k_c) N_c |e_c|`` over the cycle's
+    contacts (``k_c`` the slip fraction, ``N_c`` the load, ``|e_c|`` the
+    length of the contact's projection row on the measured component);
+    ``share`` 0: the model taken as exact.
+    """
+    return float(share) * float(mu_s) * float(adhesion_load)
 
 
 def solver_for(method: str, nu: float, shear_modulus: float) -> Solver:
@@ -77,14 +123,14 @@ class ExactSolver:
         return out
 
 
-@dataclass(frozen=True, eq=False)
-class ContactSample:
+class ContactSample(NamedTuple):
     """One contact of one cycle: grid, creepages, speed and the force's projection.
 
     ``pressure[j, i]`` (Pa) on the grid ``x0, y0, dx, dy`` (m, cell ``[0, 0]``'s
     centre and the cell sizes, contact frame); ``xi``, ``eta`` (1), ``phi``
     (1/m); ``speed``: the signed rolling speed ``V`` (m/s); ``projection``:
-    ``(m, 2)``, the measured components as ``projection @ (Fx, Fy)``.
+    ``(m, 2)``, the measured components as ``projection @ (Fx, Fy)``.  A
+    named tuple: made per contact per rig cycle, it must cost little.
     """
 
     pressure: FloatArray
@@ -102,6 +148,38 @@ class ContactSample:
     def load(self) -> float:
         """Return the normal load ``sum p dA`` (N)."""
         return float(self.pressure.sum()) * self.dx * self.dy
+
+
+def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float, float]] | None:
+    """Return ``solve(p, x0, y0, dx, dy, xi, eta, phi, law, speed) -> (Fx, Fy, k)`` for MAE.
+
+    The compiled kernel :meth:`MaeSolver.solve_arrays` calls, with the same
+    arguments (bit for bit its forces), without the wrapping the estimator
+    pays per solve (argument checks, the result object): the EKF's slope
+    solves.  None for the other solvers.
+    """
+    if not isinstance(solver, MaeSolver):
+        return None
+    parabolic = check_bound(bound)
+    rule, shear, knots, polys = solver._rule, solver.shear_modulus, solver._knots, solver._polys
+    calibrated, pair_knots, pair_values = (solver._calibrated, solver._pair_knots,
+                                           solver._pair_values)
+    no_float, no_bool = np.empty((0, 0)), np.empty((0, 0), dtype=np.bool_)
+
+    def solve(p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+              eta: float, phi: float, law: tuple[int, FloatArray, float, bool],
+              speed: float) -> tuple[float, float, float]:
+        code, prm, mu, slip_dependent = law
+        if not p.flags.c_contiguous:
+            p = np.ascontiguousarray(p)
+        status, info, fx, fy, _, _, nslip, ncontact = kernels.mae_solve(
+            p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule, parabolic, shear, knots, polys,
+            code, prm, check_speed(speed) if slip_dependent else 0.0, no_float, no_float,
+            no_bool, False, calibrated, pair_knots, pair_values)
+        if status:
+            _raise(status, info, knots)
+        return fx, fy, nslip / ncontact
+    return solve
 
 
 @dataclass(frozen=True)
@@ -126,8 +204,25 @@ class CreepModel:
                             limit_ratio=self.limit_ratio if limit_ratio is None else limit_ratio,
                             decay=self.decay if decay is None else decay)
 
+    def __post_init__(self) -> None:
+        """Check the bound; keep the compiled MAE kernel's call (None: the solver's own)."""
+        check_bound(self.bound)
+        object.__setattr__(self, "_kernel", _mae_kernel(self.solver, self.bound))
+        # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
+        object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
+
     def contact_forces(self, sample: ContactSample, mu_s: float) -> tuple[float, float]:
         """Return the creep forces ``(Fx, Fy)`` (N, contact frame) of one sample at ``mu_s``."""
+        return self._solve(sample, mu_s)[:2]
+
+    def _solve(self, sample: ContactSample, mu_s: float,
+               law: FrictionLaw | None = None,
+               kernel_law: tuple[int, FloatArray, float, bool] | None = None
+               ) -> tuple[float, float, float]:
+        """Return ``(Fx, Fy, slip fraction)`` of one sample at ``mu_s`` (``law``: its law).
+
+        ``kernel_law``: the law's kernel arguments (:meth:`_kernel_law`), if known.
+        """
         p, x0, y0, phi = sample.pressure, sample.x0, sample.y0, sample.phi
         reverse = sample.speed < 0.0
         if reverse:  # as Pipeline._solve: the leading edge at +x
@@ -135,19 +230,51 @@ class CreepModel:
             x0 = -(x0 + (p.shape[1] - 1) * sample.dx)
             y0 = -(y0 + (p.shape[0] - 1) * sample.dy)
             phi = -phi
-        law = self.friction(mu_s)
-        f = self.solver.solve_arrays(p, x0, y0, sample.dx, sample.dy, sample.xi, sample.eta,
-                                     phi, bound=self.bound,  # type: ignore[arg-type]
-                                     friction=law, speed=abs(sample.speed))
-        return (-f.fx, -f.fy) if reverse else (f.fx, f.fy)
+        kernel = self._kernel  # type: ignore[attr-defined]
+        if kernel is not None:  # the kernel solve_arrays calls, without its wrapping
+            if kernel_law is None:
+                kernel_law = self._kernel_law(self.friction(mu_s) if law is None else law)
+            fx, fy, k = kernel(p, x0, y0, sample.dx, sample.dy, sample.xi, sample.eta, phi,
+                               kernel_law, abs(sample.speed))
+        else:
+            law = self.friction(mu_s) if law is None else law
+            f = self.solver.solve_arrays(p, x0, y0, sample.dx, sample.dy, sample.xi,
+                                         sample.eta, phi,
+                                         bound=self.bound,  # type: ignore[arg-type]
+                                         friction=law, speed=abs(sample.speed))
+            fx, fy, k = f.fx, f.fy, f.slip_fraction
+        return (-fx, -fy, k) if reverse else (fx, fy, k)
 
     def predict(self, samples: Sequence[ContactSample], mu_s: float) -> FloatArray:
         """Return the measured components' model values (N): ``sum projection @ (Fx, Fy)``."""
+        return self.predict_with_error(samples, mu_s, 0.0)[0]
+
+    def predict_with_error(self, samples: Sequence[ContactSample], mu_s: float,
+                           share: float = MODEL_ERROR_SHARE) -> tuple[FloatArray, float]:
+        """Return :meth:`predict`'s values and the model error's scale (N) there."""
         if not samples:
             raise InvalidInputError("no contact sample to predict")
         total = [0.0] * len(samples[0].projection)
+        adhesion = 0.0
+        if self._kernel is not None:  # type: ignore[attr-defined]
+            # the kernel's law arguments at mu_s, as _kernel_law(self.friction(mu_s)) gives
+            code, prm, _, slip_dependent = self._law_template  # type: ignore[attr-defined]
+            law = None
+            kernel_law = (code, prm, float(_positive_mu(mu_s)), slip_dependent)
+        else:
+            law, kernel_law = self.friction(mu_s), None
         for s in samples:
-            fx, fy = self.contact_forces(s, mu_s)
+            fx, fy, k = self._solve(s, mu_s, law, kernel_law)
+            weight = 0.0
             for i, (px, py) in enumerate(s.projection):
                 total[i] += float(px) * fx + float(py) * fy
-        return np.array(total)
+                weight = max(weight, math.hypot(px, py))
+            if share:
+                adhesion += (1.0 - k) * s.load * weight
+        return np.array(total), model_error(mu_s, adhesion, share)
+
+    @staticmethod
+    def _kernel_law(law: FrictionLaw) -> tuple[int, FloatArray, float, bool]:
+        """Return the kernel's ``(law code, params, mu_s, slip dependent)`` of ``law``."""
+        code, prm, mu, _ = _kernel_law(None, law, 1.0)
+        return code, prm, mu, law.slip_dependent
