@@ -390,7 +390,7 @@ def test_estimation_is_refused_in_profiles_mode():
 
 
 def test_without_model_error_the_update_is_the_kalman_filters():
-    """s = 0, c = 0: g = P H^2 / (P H^2 + R) and the Joseph-form variance, as before."""
+    """With s = 0, c = 0: g = P H^2 / (P H^2 + R) and the Joseph-form variance, as before."""
     ekf = FrictionEkf(0.3, 0.1, process_noise=0.0, measurement_noise=NOISE)
     slope = -0.8 * LOAD
     step = ekf.update([-0.8 * LOAD * 0.35], lambda m: np.array([slope * m]), LOAD)
@@ -444,7 +444,7 @@ def test_a_step_takes_the_model_error_at_the_new_level():
 
 @pytest.fixture(scope="module")
 def exact_curve(hertz):
-    """The exact theory's Fx at mu = 0.4 beyond the linear range (the knee to full slip)."""
+    """Return the exact theory's Fx at mu = 0.4 beyond the linear range (knee to full slip)."""
     from fastsim_ros.contact import exact
     xis = (3e-3, 4e-3, 5e-3, 6e-3, 7e-3, 9e-3, 1.2e-2)
     return xis, [exact.coulomb(hertz, xi, 0.0, 0.0, nu=NU, shear_modulus=G, mu=0.4).fx
@@ -454,8 +454,11 @@ def exact_curve(hertz):
 @pytest.mark.parametrize("share", [0.5, 0.0])
 def test_on_the_exact_theorys_forces_sigma_covers_the_model_error(solver, hertz, exact_curve,
                                                                   share):
-    """FastSim's knee error (up to 6% of mu N, systematic): carried, the 2-sigma band covers
-    the truth and the estimate leans on the full-slip samples; taken for noise, it does not."""
+    """The knee error of FastSim (up to 6% of mu N, systematic) carried as a bound.
+
+    Carried, the 2-sigma band covers the truth and the estimate leans on the
+    full-slip samples; taken for noise, it does not.
+    """
     rng = np.random.default_rng(6)
     model = CreepModel(solver)
     ekf = FrictionEkf(0.3, 0.1, process_noise=2e-5, measurement_noise=NOISE)
@@ -498,7 +501,7 @@ def test_models_kernel_call_is_the_solvers_bit_for_bit(solver, hertz, law, bound
 
 
 def contact_curve():
-    """CONTACT's published exact traction curve (docs/data/contact_tractcurv.csv)."""
+    """Return the published exact traction curve of CONTACT (docs/data/contact_tractcurv.csv)."""
     import csv
     from pathlib import Path
     path = Path(__file__).resolve().parents[1] / "docs" / "data" / "contact_tractcurv.csv"
