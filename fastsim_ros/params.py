@@ -307,9 +307,6 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
             raise ParameterError("parameter 'contacts': in profiles mode the contacts are "
                                  "fixed: " + ", ".join(PROFILE_CONTACTS))
         out["contacts"] = PROFILE_CONTACTS
-        if out["friction_estimation"] == "on":
-            raise ParameterError("parameter 'friction_estimation': on needs patch_source "
-                                 "topics (profiles mode does not take the measured wrench yet)")
     return out
 
 

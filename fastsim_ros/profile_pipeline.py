@@ -276,7 +276,7 @@ class ProfilePipeline:
 
     def outputs(self) -> dict[str, str]:
         """Return every topic profiles mode publishes: the pipeline's and the patches."""
-        return output_topics(self.config.contacts, patches=True)
+        return {**self.pipeline.outputs(), **output_topics(self.config.contacts, patches=True)}
 
     def inputs(self) -> tuple[InputTopic, ...]:
         """Return the input topics of profiles mode: the twists, the pose and the load."""
@@ -290,13 +290,15 @@ class ProfilePipeline:
             return self.on_pose(raw).outcomes
 
         twist = "geometry_msgs/msg/TwistStamped"
+        # friction estimation on: the measured wheelset wrench, taken as in topics mode
+        measured = tuple(i for i in self.pipeline.inputs() if i.kind == "measured_wrench")
         return (InputTopic(WHEEL_TWIST_TOPIC, twist, "wheel_twist", None,
                            kinematics(self.on_wheel_twist)),
                 InputTopic(RAIL_TWIST_TOPIC, twist, "rail_twist", None,
                            kinematics(self.on_rail_twist)),
                 InputTopic(LOAD_TOPIC, "geometry_msgs/msg/WrenchStamped", "load", None,
-                           kinematics(self.on_load)),
-                InputTopic(POSE_TOPIC, "geometry_msgs/msg/PoseStamped", "pose", None, pose))
+                           kinematics(self.on_load))) + measured + (
+                InputTopic(POSE_TOPIC, "geometry_msgs/msg/PoseStamped", "pose", None, pose),)
 
     def messages(self, outcome: Outcome,
                  wanted: Container[str] | None = None) -> list[tuple[str, Any]]:

@@ -101,12 +101,14 @@ def refusals() -> dict[str, subprocess.CompletedProcess[str]]:
 
 
 def test_a_bare_on_starts_the_estimator():
-    # YAML reads `on` as true: the switch takes it (then refuses profiles mode, one line)
+    # YAML reads `on` as true: the switch takes it (profiles mode too); the start then stops
+    # at the next parameter's bad value, which it names alone
     done = subprocess.run([str(NODE_SCRIPT), "--ros-args", *PROFILES,
-                           "-p", "friction_estimation:=on"],
+                           "-p", "friction_estimation:=on", "-p", "friction_process_noise:=-1.0"],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 2
-    assert "needs patch_source" in done.stderr and "friction_estimation" in done.stderr
+    assert "friction_process_noise" in done.stderr
+    assert "friction_estimation'" not in done.stderr
 
 
 def test_every_parameter_has_a_bad_start_here():
