@@ -152,9 +152,8 @@ def compute() -> dict[str, Any]:
     path = Path(str(config["table_cache"])).expanduser() / f"contact_table_{key}.npz"
     results: dict[str, Any] = {"machine": machine(), "table_seconds": runner.table_seconds,
                                "nodes": len(table.nodes),
-                               "window_nodes": sum((i1 - i0) * (len(w.grid.yaws) - 2)
-                                                   for v in table.refined.values()
-                                                   for i0, i1, w in v),
+                               "window_nodes": sum(len(w.nodes) for v in table.refined.values()
+                                                   for w in v),
                                "windows_count": sum(len(v) for v in table.refined.values()),
                                "version": table_module.TABLE_VERSION,
                                "file_bytes": path.stat().st_size if path.exists() else None,
@@ -225,10 +224,10 @@ def compute() -> dict[str, Any]:
     # 2b. near the flange's take-over, between yaw nodes and between the windows' columns;
     # with the yaw-refined windows (now) and with the grid's nodes alone (before)
     before = ContactTable(table.grid, table.load, table.nodes)
-    results["windows"] = [{"yaw0": table.grid.yaws[j], "dy0": table.grid.dys[i0],
-                           "dy1": table.grid.dys[i1 - 1], "yaws": list(w.grid.yaws),
+    results["windows"] = [{"yaw0": table.grid.yaws[j], "dy0": w.grid.dys[0],
+                           "dy1": w.grid.dys[-1], "yaws": list(w.grid.yaws),
                            "events": w.events}
-                          for j in sorted(table.refined) for i0, i1, w in table.refined[j]]
+                          for j in sorted(table.refined) for w in table.refined[j]]
     results["takeover"] = []
     yaws = table.grid.yaws
     for j in range(len(yaws) - 1):

@@ -829,7 +829,7 @@ class ContactTable:
     """The wheelset's patches on a grid of ``(dy, yaw)`` at a reference wheel load."""
 
     def __init__(self, grid: TableGrid, load: float, nodes: Sequence[TableNode],
-                 refined: dict[int, list[tuple[int, int, ContactTable]]] | None = None) -> None:
+                 refined: dict[int, list[ContactTable]] | None = None) -> None:
         if len(nodes) != len(grid.dys) * len(grid.yaws):
             raise TableError("the table's nodes do not fill its grid")
         self.grid = grid
@@ -859,9 +859,9 @@ class ContactTable:
             self.events.append([sum(0.5 * (grid.dys[i] + grid.dys[i + 1]) for i in c) / len(c)
                                 for c in clusters])
             self.turns.append([_event_turn(column, c[0], c[-1] + 1) for c in clusters])
-        #: yaw interval j -> windows ``(i0, i1, table)``: around a flange's take-over, the
-        #: shifts ``dys[i0:i1]`` solved at yaws between columns j and j + 1 (assumption 4)
-        self.refined: dict[int, list[tuple[int, int, ContactTable]]] = dict(refined or {})
+        #: yaw interval j -> the tables of its windows (assumption 4): around a flange's
+        #: take-over, shifts at the finest step solved at yaws between columns j and j + 1
+        self.refined: dict[int, list[ContactTable]] = dict(refined or {})
 
     def weights(self, dy: float, yaw: float) -> list[tuple[int, int, float]]:
         """Return the weights ``(i_dy, i_yaw, w)`` of a pose's nodes, largest first.
@@ -980,21 +980,18 @@ class ContactTable:
         # own nodes; with the mirror, the mirrored window's too: the right wheel's patches)
         windows = table.yaw_windows()
         wanted: dict[tuple[int, int], tuple[float, float]] = {}
-        for _, i0, i1, inner in windows:
-            for d in grid.dys[i0:i1]:
-                for y in inner:
+        for _, window_dys, window_yaws in windows:
+            for d in window_dys:
+                for y in window_yaws:
                     for dd, yy in (((d, y), (-d, -y)) if mirror else ((d, y),)):
                         if key(dd, yy) not in solved:
                             wanted.setdefault(key(dd, yy), (dd, yy))
         if wanted:
             solve([wanted[k] for k in sorted(wanted)])
-        for j, i0, i1, inner in windows:
-            yaws = (grid.yaws[j], *inner, grid.yaws[j + 1])
-            sub = [table.node(i, j) if k == 0 else table.node(i, j + 1)
-                   if k == len(yaws) - 1 else assembled(grid.dys[i], y)
-                   for i in range(i0, i1) for k, y in enumerate(yaws)]
+        for j, window_dys, window_yaws in windows:
             table.refined.setdefault(j, []).append(
-                (i0, i1, cls(TableGrid(grid.dys[i0:i1], yaws), load, sub)))
+                cls(TableGrid(window_dys, window_yaws), load,
+                    [assembled(d, y) for d in window_dys for y in window_yaws]))
         return table
 
     def node(self, i_dy: int, i_yaw: int) -> TableNode:
@@ -1005,24 +1002,30 @@ class ContactTable:
         """Return the yaw-refined window's table that holds ``(dy, yaw)``, or ``None``."""
         if not self.refined:
             return None
-        yaws, dys = self.grid.yaws, self.grid.dys
+        yaws = self.grid.yaws
         j = min(max(bisect.bisect_right(yaws, yaw) - 1, 0), len(yaws) - 2)
-        for i0, i1, table in self.refined.get(j, ()):
-            if dys[i0] <= dy <= dys[i1 - 1] and yaws[j] <= yaw <= yaws[j + 1]:
+        for table in self.refined.get(j, ()):
+            if (table.grid.dys[0] <= dy <= table.grid.dys[-1]
+                    and yaws[j] <= yaw <= yaws[j + 1]):
                 return table
         return None
 
-    def yaw_windows(self) -> list[tuple[int, int, int, tuple[float, ...]]]:
-        """Return the windows to refine in yaw: ``(j, i0, i1, yaws)`` (assumption 4).
+    def yaw_windows(self) -> list[tuple[int, tuple[float, ...], tuple[float, ...]]]:
+        """Return the windows to refine in yaw: ``(j, dys, yaws)`` (assumption 4).
 
         For each yaw interval ``j`` and each event paired between its columns
         that turns the contact angle by YAW_EVENT_TURN or more (a flange
-        taking over): the shifts ``dys[i0:i1]`` within YAW_WINDOW of both
-        columns' events, and the yaws between the columns that halve the
-        interval YAW_REFINE times.
+        taking over): the shifts at the grid's finest step within YAW_WINDOW of
+        both columns' events (every one, not only the grid's: between the two
+        columns' take-overs the grid's refinement may have stopped at a
+        coarser step) and the yaws that halve the interval YAW_REFINE times,
+        its end columns included.
         """
-        out = []
+        out: list[tuple[int, tuple[float, ...], tuple[float, ...]]] = []
         yaws, dys = self.grid.yaws, self.grid.dys
+        if len(dys) < 2:
+            return out
+        step = float(np.diff(np.asarray(dys)).min())
         parts = 2 ** YAW_REFINE
         for j in range(len(yaws) - 1):
             for a, b in _event_pairs(self.events[j], self.events[j + 1]):
@@ -1030,12 +1033,22 @@ class ContactTable:
                            self.turns[j + 1][self.events[j + 1].index(b)])
                 if turn < YAW_EVENT_TURN:
                     continue
-                i0 = bisect.bisect_left(dys, min(a, b) - YAW_WINDOW)
-                i1 = bisect.bisect_right(dys, max(a, b) + YAW_WINDOW)
-                if i1 - i0 >= 2:
-                    inner = tuple(yaws[j] + k * (yaws[j + 1] - yaws[j]) / parts
-                                  for k in range(1, parts))
-                    out.append((j, i0, i1, inner))
+                # on the lattice of the finest step from the grid's first shift (the grid's
+                # own shifts are on it; on a symmetric grid it is symmetric: the mirror's
+                # windows are these, mirrored)
+                lo, hi = min(a, b) - YAW_WINDOW, max(a, b) + YAW_WINDOW
+                k0 = max(int(math.ceil((lo - dys[0]) / step - 1e-6)), 0)
+                k1 = min(int(math.floor((hi - dys[0]) / step + 1e-6)),
+                         int(round((dys[-1] - dys[0]) / step)))
+                if k1 <= k0:
+                    continue
+                # rounded to picometres (the nodes' keys): a window and its mirror image are
+                # then exact negatives of one another
+                window_dys = tuple(round((dys[0] + k * step) * 1e12) / 1e12
+                                   for k in range(k0, k1 + 1))
+                window_yaws = tuple(yaws[j] + k * (yaws[j + 1] - yaws[j]) / parts
+                                    for k in range(parts + 1))
+                out.append((j, window_dys, window_yaws))
         return out
 
     def lookup(self, dy: float, yaw: float) -> TableLookup:
@@ -1079,17 +1092,25 @@ class ContactTable:
 
     def save(self, path: Path, key: str) -> None:
         """Write the table to ``path`` (``.npz``) atomically, with its ``key``."""
-        # the windows' inner columns follow the grid's nodes (their end columns are the grid's)
-        windows: list[tuple[int, int, int, int]] = []
-        window_yaws: list[float] = []
+        # the windows' nodes follow the grid's; a window's node that is one of the grid's (its
+        # end columns' shifts on the grid) is stored as a reference to it
+        index = {(round(d * 1e12), round(y * 1e12)): i * len(self.grid.yaws) + j
+                 for i, d in enumerate(self.grid.dys) for j, y in enumerate(self.grid.yaws)}
+        windows: list[tuple[int, int, int]] = []
+        window_axes: list[float] = []
+        refs: list[int] = []
         stored = list(self.nodes)
         for j in sorted(self.refined):
-            for i0, i1, sub in self.refined[j]:
-                inner = sub.grid.yaws[1:-1]
-                windows.append((j, i0, i1, len(inner)))
-                window_yaws.extend(inner)
-                stored.extend(sub.node(i, k) for i in range(i1 - i0)
-                              for k in range(1, len(inner) + 1))
+            for sub in self.refined[j]:
+                windows.append((j, len(sub.grid.dys), len(sub.grid.yaws)))
+                window_axes.extend(sub.grid.dys)
+                window_axes.extend(sub.grid.yaws)
+                for i, d in enumerate(sub.grid.dys):
+                    for c, y in enumerate(sub.grid.yaws):
+                        k = index.get((round(d * 1e12), round(y * 1e12)), -1)
+                        refs.append(k)
+                        if k < 0:
+                            stored.append(sub.node(i, c))
         meta, floats, pressure = [], [], []
         offset = 0
         for k, node in enumerate(stored):
@@ -1109,8 +1130,9 @@ class ContactTable:
                          dys=np.array(self.grid.dys), yaws=np.array(self.grid.yaws),
                          load=np.array(self.load),
                          nodes=np.array([(n.roll, n.dz, float(n.derailed)) for n in stored]),
-                         windows=np.array(windows, dtype=np.int64).reshape(-1, 4),
-                         window_yaws=np.array(window_yaws, dtype=float),
+                         windows=np.array(windows, dtype=np.int64).reshape(-1, 3),
+                         window_axes=np.array(window_axes, dtype=float),
+                         window_refs=np.array(refs, dtype=np.int64),
                          meta=np.array(meta, dtype=np.int64).reshape(-1, 5),
                          floats=np.array(floats, dtype=float).reshape(-1, 18),
                          pressure=np.concatenate(pressure) if pressure else np.zeros(0))
@@ -1134,7 +1156,7 @@ class ContactTable:
                 load = float(f["load"])
                 node_rows, meta = f["nodes"], f["meta"]
                 floats, pressure = f["floats"], f["pressure"]
-                windows, window_yaws = f["windows"], f["window_yaws"]
+                windows, axes, refs = f["windows"], f["window_axes"], f["window_refs"]
         except (OSError, KeyError, ValueError) as e:
             raise TableError(f"{path}: not a contact table ({e})") from None
         patches: list[tuple[list[TablePatch], list[TablePatch]]] = [
@@ -1149,19 +1171,22 @@ class ContactTable:
                  for (r, z, d), ps in zip(node_rows, patches)]
         n_grid = len(grid.dys) * len(grid.yaws)
         table = cls(grid, load, nodes[:n_grid])
-        k, y = n_grid, 0
-        for j, i0, i1, n_inner in (tuple(int(v) for v in w) for w in windows):
-            yaws = (grid.yaws[j], *(float(v) for v in window_yaws[y:y + n_inner]),
-                    grid.yaws[j + 1])
-            inner = nodes[k:k + (i1 - i0) * n_inner]
-            sub = [table.node(i0 + i, j) if c == 0 else table.node(i0 + i, j + 1)
-                   if c == n_inner + 1 else inner[i * n_inner + c - 1]
-                   for i in range(i1 - i0) for c in range(n_inner + 2)]
+        k, a, r = n_grid, 0, 0
+        for j, n_dys, n_yaws in (tuple(int(v) for v in w) for w in windows):
+            window_dys = tuple(float(v) for v in axes[a:a + n_dys])
+            window_yaws = tuple(float(v) for v in axes[a + n_dys:a + n_dys + n_yaws])
+            a += n_dys + n_yaws
+            sub = []
+            for ref in refs[r:r + n_dys * n_yaws]:
+                if ref >= 0:
+                    sub.append(table.nodes[int(ref)])
+                else:
+                    sub.append(nodes[k])
+                    k += 1
+            r += n_dys * n_yaws
             table.refined.setdefault(j, []).append(
-                (i0, i1, cls(TableGrid(grid.dys[i0:i1], yaws), load, sub)))
-            k += (i1 - i0) * n_inner
-            y += n_inner
-        if k != len(nodes):
+                cls(TableGrid(window_dys, window_yaws), load, sub))
+        if k != len(nodes) or r != len(refs):
             raise TableError(f"{path}: not a contact table (its windows do not fill it)")
         return table
 
@@ -1239,7 +1264,7 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
                                progress=BuildProgress(log) if log else None)
     if log and refine:
         windows = [w for v in table.refined.values() for w in v]
-        inner = sum((i1 - i0) * (len(w.grid.yaws) - 2) for i0, i1, w in windows)
+        inner = sum(len(w.nodes) for w in windows)
         log(f"contact table: {len(table.grid.dys) - len(grid.dys)} shifts added where "
             f"neighbouring nodes differed ({len(table.nodes)} nodes in all), {inner} nodes "
             f"in {len(windows)} windows refined in yaw around the flanges' take-overs")
