@@ -22,7 +22,8 @@ Prints medians and p99 (ms) with the machine.  Usage:
 built): ``pose (table)``, :meth:`ProfilePipeline.on_pose` on ``POSES``
 poses drawn over the range of A-2.2 (shift -10..10 mm, yaw within 24 mrad,
 10 kN per wheel, the twist of A-2.2), each its own (no two poses alike, so
-every one blends between nodes); ``table lookup`` (the nodes' weights,
+every one blends between nodes; ``--windows``: drawn inside the table's
+yaw-refined windows around the flanges' take-overs instead); ``table lookup`` (the nodes' weights,
 matching and blend plans, no resampling); and beside them, on a few of those
 poses, ``pose (per pose)`` (the same pipeline without the table).
 """
@@ -63,8 +64,12 @@ def timed(fn: Callable[[], object], repeat: int) -> np.ndarray:
     return out * 1e3
 
 
-def table_rows(poses: int, per_pose: int) -> None:
-    """Time the table's path on ``poses`` poses and the per-pose path on ``per_pose`` of them."""
+def table_rows(poses: int, per_pose: int, windows: bool = False) -> None:
+    """Time the table's path on ``poses`` poses and the per-pose path on ``per_pose`` of them.
+
+    ``windows``: the poses drawn inside the table's yaw-refined windows (a
+    rig dwelling at a flange's take-over) instead of over A-2.2's range.
+    """
     from fastsim_ros.params import load_params_file
     from msg_adapters.cdr import StampedTwist
 
@@ -77,6 +82,13 @@ def table_rows(poses: int, per_pose: int) -> None:
     rng = np.random.default_rng(7)
     dys = rng.uniform(-10e-3, 10e-3, poses)
     yaws = -2.4 * dys * rng.uniform(0.5, 1.0, poses)   # A-2.2 yaws as much as 2.4 mrad/mm
+    if windows:
+        assert tabled.table is not None
+        boxes = [w.grid for v in tabled.table.refined.values() for w in v]
+        print(f"poses inside the {len(boxes)} yaw-refined windows")
+        pick = rng.integers(0, len(boxes), poses)
+        dys = np.array([rng.uniform(boxes[k].dys[0], boxes[k].dys[-1]) for k in pick])
+        yaws = np.array([rng.uniform(boxes[k].yaws[0], boxes[k].yaws[-1]) for k in pick])
     stamp = [0]
 
     def cycle(p: ProfilePipeline, dy: float, yaw: float) -> str:
@@ -123,12 +135,14 @@ def main() -> int:
     parser.add_argument("--cell", type=float, default=2e-4)
     parser.add_argument("--table", type=int, default=0, metavar="POSES",
                         help="time the contact table's path on POSES poses instead")
+    parser.add_argument("--windows", action="store_true",
+                        help="with --table: the poses inside the yaw-refined windows")
     parser.add_argument("--per-pose", type=int, default=20, metavar="N",
                         help="with --table: N of the poses also solved without the table")
     args = parser.parse_args()
     if args.table:
         print(f"machine: {machine()}")
-        table_rows(args.table, args.per_pose)
+        table_rows(args.table, args.per_pose, args.windows)
         return 0
     print(f"machine: {machine()}; cell {args.cell * 1e3:g} mm; {args.repeat} repeats, "
           "interleaved; times in ms")

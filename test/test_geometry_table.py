@@ -340,31 +340,123 @@ def test_refinement_keeps_the_grid_symmetric_for_the_mirror(wheelset):
         np.testing.assert_allclose(q.origin, p.origin * np.array([1.0, -1.0, 1.0]), atol=1e-12)
 
 
-def test_yaw_columns_are_aligned_on_the_flanges_take_over(wheelset):
+@pytest.fixture(scope="module")
+def flange_table(wheelset):
+    """Shifts -6.4..-6.0 mm by 0.1 mm at yaws 10 and 15 mrad, refined (the right flange's
+    take-over: no mirror on this grid, both wheels solved)."""
+    grid = TableGrid((-6.4e-3, -6.3e-3, -6.2e-3, -6.1e-3, -6.0e-3), (10e-3, 15e-3))
+    return ContactTable.build(wheelset, grid, LOAD, refine=4)
+
+
+def _normal_force(patches):
+    return sum((p.load * p.normal for p in patches), np.zeros(3))
+
+
+def test_yaw_columns_are_aligned_on_the_flanges_take_over(wheelset, flange_table):
     # the right flange takes over at -6.222 mm at 10 mrad and -6.181 mm at 15 mrad; at 12.5
     # mrad, around its own take-over (interpolated: -6.2015 mm), the two columns are read at
     # the same distance from their own take-overs: the wheel's normal force (its size and
     # direction, 0.55 rad on the gauge corner, 1.2 on the flange) comes out far closer to
-    # the wheel solved there than when both are read at the pose's own shift
-    grid = TableGrid((-6.4e-3, -6.3e-3, -6.2e-3, -6.1e-3, -6.0e-3), (10e-3, 15e-3))
-    table = ContactTable.build(wheelset, grid, LOAD, refine=4)
-    (e10,), (e15,) = table.events
+    # the wheel solved there than when both are read at the pose's own shift (both tables
+    # without the yaw-refined window, which holds 12.5 mrad as a column of its own)
+    (e10,), (e15,) = flange_table.events
     assert e10 == pytest.approx(-6.222e-3, abs=0.01e-3)
     assert e15 == pytest.approx(-6.181e-3, abs=0.01e-3)
-    plain = ContactTable(table.grid, table.load, table.nodes)
+    aligned = ContactTable(flange_table.grid, flange_table.load, flange_table.nodes)
+    plain = ContactTable(flange_table.grid, flange_table.load, flange_table.nodes)
     plain.events = [[], []]
-
-    def normal_force(patches):
-        return sum((p.load * p.normal for p in patches), np.zeros(3))
 
     aligned_err, plain_err = [], []
     for dy in np.linspace(-6.26e-3, -6.14e-3, 13):
-        exact = normal_force(solve_node(wheelset, LOAD, float(dy), 12.5e-3).patches[1])
-        for t, errs in ((table, aligned_err), (plain, plain_err)):
-            got = normal_force(t.lookup(float(dy), 12.5e-3).patches("right"))
+        exact = _normal_force(solve_node(wheelset, LOAD, float(dy), 12.5e-3).patches[1])
+        for t, errs in ((aligned, aligned_err), (plain, plain_err)):
+            got = _normal_force(t.lookup(float(dy), 12.5e-3).patches("right"))
             errs.append(float(np.linalg.norm(got - exact) / np.linalg.norm(exact)))
     assert max(aligned_err) < 0.5 * max(plain_err)
     assert np.mean(aligned_err) < 0.5 * np.mean(plain_err)
+
+
+def test_yaw_is_refined_around_the_flanges_take_over(wheelset, flange_table):
+    # the flange's take-over is an event of both columns (the contact angle turns by 0.6
+    # rad): the shifts within 40 um of both take-overs are solved at 11.25, 12.5 and 13.75
+    # mrad too, each such column with its own take-over between its neighbours'; the
+    # gauge corner's patches elsewhere are not refined in yaw
+    assert all(t > 0.5 for turns in flange_table.turns for t in turns)
+    (window,) = flange_table.refined[0]
+    (e10,), (e15,) = flange_table.events
+    lo, hi = min(e10, e15) - 40e-6, max(e10, e15) + 40e-6   # every shift in 40 um of both
+    dys = np.asarray(window.grid.dys)
+    step = float(np.diff(flange_table.grid.dys).min())   # the grid's finest: 6.25 um
+    assert step == pytest.approx(0.1e-3 / 16, rel=1e-9)
+    np.testing.assert_allclose(np.diff(dys), step, rtol=1e-9)
+    assert lo <= dys[0] < lo + step and hi - step < dys[-1] <= hi
+    assert window.grid.yaws == pytest.approx((10e-3, 11.25e-3, 12.5e-3, 13.75e-3, 15e-3),
+                                             abs=1e-15)
+    # each column's take-over between its neighbours', the end columns' as the grid's
+    takeovers = [e for (e,) in window.events]
+    assert takeovers == sorted(takeovers)
+    assert takeovers[0] == pytest.approx(e10, abs=step) and takeovers[-1] == pytest.approx(
+        e15, abs=step)
+    # the window's columns are nodes solved there, both wheels, at their own levelled roll
+    node = window.node(3, 2)
+    solved = solve_node(wheelset, LOAD, window.grid.dys[3], 12.5e-3)
+    assert node.roll == solved.roll
+    for k in range(2):
+        for p, q in zip(node.patches[k], solved.patches[k], strict=True):
+            np.testing.assert_array_equal(p.pressure, q.pressure)
+    # a pose in the window takes the window's table; outside it, the grid's
+    assert flange_table.window(-6.2e-3, 11.9e-3) is window
+    assert flange_table.window(-6.3e-3, 11.9e-3) is None
+    assert flange_table.window(-6.2e-3, 15.0e-3) is window   # its end column: the grid's
+    # between the window's columns the wheel's normal force is closer to the wheel solved at
+    # the pose than the grid's alone gives (10-40 um either side of the take-over)
+    grid_only = ContactTable(flange_table.grid, flange_table.load, flange_table.nodes)
+    errs: dict[str, list[float]] = {"window": [], "grid": []}
+    for yaw, dy in ((11.9e-3, -6.236e-3), (11.9e-3, -6.186e-3), (13.1e-3, -6.225e-3),
+                    (13.1e-3, -6.168e-3)):
+        exact = _normal_force(solve_node(wheelset, LOAD, dy, yaw).patches[1])
+        for name, t in (("window", flange_table), ("grid", grid_only)):
+            got = _normal_force(t.lookup(dy, yaw).patches("right"))
+            errs[name].append(float(np.linalg.norm(got - exact) / np.linalg.norm(exact)))
+    assert np.mean(errs["window"]) < 0.5 * np.mean(errs["grid"])
+
+
+def test_a_table_with_windows_round_trips_and_an_older_version_is_rebuilt(
+        wheelset, flange_table, tmp_path, monkeypatch):
+    from fastsim_ros.geometry import table as table_module
+    path = tmp_path / "t.npz"
+    flange_table.save(path, "k")
+    back = ContactTable.read(path, "k")
+    (window,) = flange_table.refined[0]
+    (again,) = back.refined[0]
+    assert again.grid == window.grid and again.events == window.events
+    for n, m in zip(window.nodes, again.nodes, strict=True):
+        assert n.roll == m.roll
+        for side in range(2):
+            for p, q in zip(n.patches[side], m.patches[side], strict=True):
+                np.testing.assert_array_equal(p.pressure, q.pressure)
+    # a file of the previous layout (no windows) is refused by its version, not misread
+    with np.load(path) as f:
+        old = {k: f[k] for k in f.files if k not in ("windows", "window_yaws")}
+    old["version"] = np.array(table_module.TABLE_VERSION - 1)
+    np.savez(tmp_path / "old.npz", **old)
+    with pytest.raises(TableError, match="version"):
+        ContactTable.read(tmp_path / "old.npz", "k")
+
+
+def test_windows_built_in_worker_processes_equal_those_built_in_process(
+        wheelset, flange_table):
+    serial = flange_table   # built in this process
+    grid = TableGrid((-6.4e-3, -6.3e-3, -6.2e-3, -6.1e-3, -6.0e-3), (10e-3, 15e-3))
+    parallel = ContactTable.build(wheelset, grid, LOAD, refine=4, workers=2)
+    assert serial.grid == parallel.grid and serial.refined and parallel.refined
+    for a, b in zip(serial.refined[0], parallel.refined[0], strict=True):
+        assert a.grid == b.grid
+        for n, m in zip(a.nodes, b.nodes, strict=True):
+            assert n.roll == m.roll
+            for side in range(2):
+                for p, q in zip(n.patches[side], m.patches[side], strict=True):
+                    np.testing.assert_array_equal(p.pressure, q.pressure)
 
 
 def test_build_progress_logs_the_time_left_of_each_pass(monkeypatch):

@@ -31,11 +31,19 @@ Assumptions, each stated because the interpolation rests on it:
    contact plane and trimmed to the blended number of cells in contact.  A
    patch present at only some of the nodes fades in with their weights (a
    flange contact that starts between two nodes grows from zero load).
-4. **Events aligned in yaw.**  The shift at which a flange or gauge corner
-   takes over moves with the yaw; between two yaw nodes each column is read
-   at the pose's distance from its own take-over (interpolated between the
-   columns), so that the two columns blend the same contact.  In the shift
-   the nodes are refined by bisection where neighbours differ instead.
+4. **Events aligned in yaw, the flange's refined in yaw.**  The shift at
+   which a flange or gauge corner takes over moves with the yaw; between two
+   yaw nodes each column is read at the pose's distance from its own
+   take-over (interpolated between the columns), so that the two columns
+   blend the same contact.  In the shift the nodes are refined by bisection
+   where neighbours differ.  Around a flange's take-over (an event of both
+   columns turning the contact angle by 0.5 rad or more: the flange's 0.6-0.7,
+   not the gauge corner's 0.4) the yaw is refined too: the
+   shifts within 40 um of both columns' take-overs are solved at yaws that
+   halve the interval twice (1.25 mrad), a window with a table of its own
+   (aligned in the same way between its columns) that the lookup takes for
+   the poses in it; at the window's edges, 40 um from the take-overs, the
+   grid's blend and the window's differ by what the grid's errs there.
 5. **Mirror symmetry.**  With the right wheel and rail the mirror images of
    the left ones and a grid symmetric about ``dy = 0`` and ``yaw = 0``, the
    right wheel's patches at ``(dy, yaw)`` are the left wheel's at ``(-dy,
@@ -74,7 +82,7 @@ from fastsim_ros.geometry.wheelset import (MAX_PATCHES, MIN_PATCH_CELLS, SIDES, 
 FloatArray = NDArray[np.float64]
 
 #: bump when the stored layout or the physics of a node changes: old files are rebuilt
-TABLE_VERSION = 2
+TABLE_VERSION = 3
 #: patches of neighbouring nodes are the same contact if their pressure centroids lie
 #: within this distance (m) and their normals within this angle (rad).  On S1002/UIC60 the
 #: tread contact runs 10.6 mm for a 1 mm shift near the centre, while the patches of one
@@ -99,6 +107,13 @@ REFINE_SHAPE = 0.05
 #: than at 0)
 EVENT_CLUSTER = 0.05e-3
 EVENT_MATCH = 0.5e-3
+#: yaw refinement around a flange's take-over (assumption 4): an event paired between two
+#: yaw columns whose contact angle turns by at least YAW_EVENT_TURN (rad: the flange's
+#: 0.6-0.7, not the gauge corner's 0.4) gets the shifts within YAW_WINDOW (m) of both
+#: columns' events solved at the yaws halving the interval YAW_REFINE times (5 mrad -> 1.25)
+YAW_REFINE = 2
+YAW_WINDOW = 40e-6
+YAW_EVENT_TURN = 0.5
 #: a pose this close to a node (in units of the step) takes that node alone
 NODE_SNAP = 1e-9
 #: the roll that levels both rigid wheels is solved to this height difference (m)
@@ -604,6 +619,27 @@ def _event_pairs(a: list[float], b: list[float]) -> list[tuple[float, float]]:
     return out
 
 
+def _contact_angles(node: TableNode) -> tuple[float, float]:
+    """Return each wheel's contact angle (rad, from the wheelset's z), weighed by load."""
+    out = []
+    for patches in node.patches:
+        load = sum(p.load for p in patches)
+        out.append(sum(p.load * math.atan2(abs(float(p.normal[1])), float(p.normal[2]))
+                       for p in patches) / load if load > 0.0 else 0.0)
+    return out[0], out[1]
+
+
+def _event_turn(column: Sequence[TableNode], first: int, last: int) -> float:
+    """Return how far a column's contact angle turns across the nodes ``first`` to ``last``.
+
+    The larger of the two wheels' load-weighted contact angles' changes (rad):
+    a flange taking over from the gauge corner turns it by 0.6-0.7 rad, a
+    gauge corner from the tread by about 0.4.
+    """
+    a, b = _contact_angles(column[first]), _contact_angles(column[last])
+    return max(abs(b[0] - a[0]), abs(b[1] - a[1]))
+
+
 def _pairs(a: TableNode, b: TableNode) -> list[tuple[TablePatch, TablePatch]] | None:
     """Return the matching patch pairs of two nodes (both wheels), or ``None`` if any is unmatched.
 
@@ -792,7 +828,8 @@ def _solve_in_children(wheelset: Wheelset, load: float,
 class ContactTable:
     """The wheelset's patches on a grid of ``(dy, yaw)`` at a reference wheel load."""
 
-    def __init__(self, grid: TableGrid, load: float, nodes: Sequence[TableNode]) -> None:
+    def __init__(self, grid: TableGrid, load: float, nodes: Sequence[TableNode],
+                 refined: dict[int, list[ContactTable]] | None = None) -> None:
         if len(nodes) != len(grid.dys) * len(grid.yaws):
             raise TableError("the table's nodes do not fill its grid")
         self.grid = grid
@@ -801,21 +838,30 @@ class ContactTable:
         # each yaw column's events: where its contact jumps (a flange or gauge corner taking
         # over), i.e. where the refinement went down to its finest step and the nodes still
         # differ; the jumps within EVENT_CLUSTER of one another are one event, at their mean
+        # (``turns``: how far the contact angle turns across it, _event_turn)
         dys = np.asarray(grid.dys)
         finest = 1.5 * float(np.diff(dys).min()) if dys.size > 1 else 0.0
         self.events: list[list[float]] = []
+        self.turns: list[list[float]] = []
         for j in range(len(grid.yaws)):
             column = [self.nodes[i * len(grid.yaws) + j] for i in range(len(grid.dys))]
-            jumps = [0.5 * (grid.dys[i] + grid.dys[i + 1]) for i in range(len(column) - 1)
+            jumps = [i for i in range(len(column) - 1)
                      if grid.dys[i + 1] - grid.dys[i] < finest
                      and _differ(column[i], column[i + 1])]
-            clusters: list[list[float]] = []
-            for e in jumps:
-                if clusters and e - clusters[-1][-1] < EVENT_CLUSTER:
-                    clusters[-1].append(e)
+            clusters: list[list[int]] = []
+            for i in jumps:
+                if clusters and (0.5 * (grid.dys[i] + grid.dys[i + 1])
+                                 - 0.5 * (grid.dys[clusters[-1][-1]]
+                                          + grid.dys[clusters[-1][-1] + 1])) < EVENT_CLUSTER:
+                    clusters[-1].append(i)
                 else:
-                    clusters.append([e])
-            self.events.append([sum(c) / len(c) for c in clusters])
+                    clusters.append([i])
+            self.events.append([sum(0.5 * (grid.dys[i] + grid.dys[i + 1]) for i in c) / len(c)
+                                for c in clusters])
+            self.turns.append([_event_turn(column, c[0], c[-1] + 1) for c in clusters])
+        #: yaw interval j -> the tables of its windows (assumption 4): around a flange's
+        #: take-over, shifts at the finest step solved at yaws between columns j and j + 1
+        self.refined: dict[int, list[ContactTable]] = dict(refined or {})
 
     def weights(self, dy: float, yaw: float) -> list[tuple[int, int, float]]:
         """Return the weights ``(i_dy, i_yaw, w)`` of a pose's nodes, largest first.
@@ -917,30 +963,106 @@ class ContactTable:
                               if (round(d0 * 1e12), round(d1 * 1e12)) not in seen]
             looking = following
         grid = TableGrid(tuple(sorted(dys.values())), grid.yaws)
-        nodes = []
-        for d in grid.dys:
-            for y in grid.yaws:
-                node = solved[key(d, y)]
-                if mirror:
-                    twin = solved[key(-d, -y)]
-                    right = tuple(p.mirrored() for p in twin.patches[0])
-                    node = TableNode(node.roll, node.dz, (node.patches[0], right),
-                                     node.derailed or twin.derailed)
-                nodes.append(node)
-        return cls(grid, load, nodes)
+
+        def assembled(d: float, y: float) -> TableNode:
+            node = solved[key(d, y)]
+            if mirror:
+                twin = solved[key(-d, -y)]
+                right = tuple(p.mirrored() for p in twin.patches[0])
+                node = TableNode(node.roll, node.dz, (node.patches[0], right),
+                                 node.derailed or twin.derailed)
+            return node
+
+        table = cls(grid, load, [assembled(d, y) for d in grid.dys for y in grid.yaws])
+        if refine <= 0 or YAW_REFINE <= 0:
+            return table
+        # assumption 4: around a flange's take-over, yaws between the columns (the window's
+        # own nodes; with the mirror, the mirrored window's too: the right wheel's patches)
+        windows = table.yaw_windows()
+        wanted: dict[tuple[int, int], tuple[float, float]] = {}
+        for _, window_dys, window_yaws in windows:
+            for d in window_dys:
+                for y in window_yaws:
+                    for dd, yy in (((d, y), (-d, -y)) if mirror else ((d, y),)):
+                        if key(dd, yy) not in solved:
+                            wanted.setdefault(key(dd, yy), (dd, yy))
+        if wanted:
+            solve([wanted[k] for k in sorted(wanted)])
+        for j, window_dys, window_yaws in windows:
+            table.refined.setdefault(j, []).append(
+                cls(TableGrid(window_dys, window_yaws), load,
+                    [assembled(d, y) for d in window_dys for y in window_yaws]))
+        return table
 
     def node(self, i_dy: int, i_yaw: int) -> TableNode:
         """Return the node at grid indices ``(i_dy, i_yaw)``."""
         return self.nodes[i_dy * len(self.grid.yaws) + i_yaw]
 
+    def window(self, dy: float, yaw: float) -> ContactTable | None:
+        """Return the yaw-refined window's table that holds ``(dy, yaw)``, or ``None``."""
+        if not self.refined:
+            return None
+        yaws = self.grid.yaws
+        j = min(max(bisect.bisect_right(yaws, yaw) - 1, 0), len(yaws) - 2)
+        for table in self.refined.get(j, ()):
+            if (table.grid.dys[0] <= dy <= table.grid.dys[-1]
+                    and yaws[j] <= yaw <= yaws[j + 1]):
+                return table
+        return None
+
+    def yaw_windows(self) -> list[tuple[int, tuple[float, ...], tuple[float, ...]]]:
+        """Return the windows to refine in yaw: ``(j, dys, yaws)`` (assumption 4).
+
+        For each yaw interval ``j`` and each event paired between its columns
+        that turns the contact angle by YAW_EVENT_TURN or more (a flange
+        taking over): the shifts at the grid's finest step within YAW_WINDOW of
+        both columns' events (every one, not only the grid's: between the two
+        columns' take-overs the grid's refinement may have stopped at a
+        coarser step) and the yaws that halve the interval YAW_REFINE times,
+        its end columns included.
+        """
+        out: list[tuple[int, tuple[float, ...], tuple[float, ...]]] = []
+        yaws, dys = self.grid.yaws, self.grid.dys
+        if len(dys) < 2:
+            return out
+        step = float(np.diff(np.asarray(dys)).min())
+        parts = 2 ** YAW_REFINE
+        for j in range(len(yaws) - 1):
+            for a, b in _event_pairs(self.events[j], self.events[j + 1]):
+                turn = min(self.turns[j][self.events[j].index(a)],
+                           self.turns[j + 1][self.events[j + 1].index(b)])
+                if turn < YAW_EVENT_TURN:
+                    continue
+                # on the lattice of the finest step from the grid's first shift (the grid's
+                # own shifts are on it; on a symmetric grid it is symmetric: the mirror's
+                # windows are these, mirrored)
+                lo, hi = min(a, b) - YAW_WINDOW, max(a, b) + YAW_WINDOW
+                k0 = max(int(math.ceil((lo - dys[0]) / step - 1e-6)), 0)
+                k1 = min(int(math.floor((hi - dys[0]) / step + 1e-6)),
+                         int(round((dys[-1] - dys[0]) / step)))
+                if k1 <= k0:
+                    continue
+                # rounded to picometres (the nodes' keys): a window and its mirror image are
+                # then exact negatives of one another
+                window_dys = tuple(round((dys[0] + k * step) * 1e12) / 1e12
+                                   for k in range(k0, k1 + 1))
+                window_yaws = tuple(yaws[j] + k * (yaws[j + 1] - yaws[j]) / parts
+                                    for k in range(parts + 1))
+                out.append((j, window_dys, window_yaws))
+        return out
+
     def lookup(self, dy: float, yaw: float) -> TableLookup:
         """Return the roll and both wheels' blended patches at ``(dy, yaw)`` (reference load).
 
-        Each patch comes with its fade (its nodes' share of the weight).
-        Raises :class:`TableRangeError` outside the grid and
+        Each patch comes with its fade (its nodes' share of the weight).  A
+        pose in a yaw-refined window (:attr:`refined`) is that window's
+        table's lookup.  Raises :class:`TableRangeError` outside the grid and
         :class:`~fastsim_ros.geometry.errors.DerailmentError` next to a
         derailed node.
         """
+        window = self.window(dy, yaw)
+        if window is not None:
+            return window.lookup(dy, yaw)
         weights = self.weights(dy, yaw)
         nodes = [(w, self.node(i, j)) for i, j, w in weights]
         if any(n.derailed for _, n in nodes):
@@ -970,9 +1092,28 @@ class ContactTable:
 
     def save(self, path: Path, key: str) -> None:
         """Write the table to ``path`` (``.npz``) atomically, with its ``key``."""
+        # the windows' nodes follow the grid's; a window's node that is one of the grid's (its
+        # end columns' shifts on the grid) is stored as a reference to it
+        index = {(round(d * 1e12), round(y * 1e12)): i * len(self.grid.yaws) + j
+                 for i, d in enumerate(self.grid.dys) for j, y in enumerate(self.grid.yaws)}
+        windows: list[tuple[int, int, int]] = []
+        window_axes: list[float] = []
+        refs: list[int] = []
+        stored = list(self.nodes)
+        for j in sorted(self.refined):
+            for sub in self.refined[j]:
+                windows.append((j, len(sub.grid.dys), len(sub.grid.yaws)))
+                window_axes.extend(sub.grid.dys)
+                window_axes.extend(sub.grid.yaws)
+                for i, d in enumerate(sub.grid.dys):
+                    for c, y in enumerate(sub.grid.yaws):
+                        k = index.get((round(d * 1e12), round(y * 1e12)), -1)
+                        refs.append(k)
+                        if k < 0:
+                            stored.append(sub.node(i, c))
         meta, floats, pressure = [], [], []
         offset = 0
-        for k, node in enumerate(self.nodes):
+        for k, node in enumerate(stored):
             for side in range(2):
                 for p in node.patches[side]:
                     nb, na = p.pressure.shape
@@ -988,7 +1129,10 @@ class ContactTable:
                 np.savez(f, version=np.array(TABLE_VERSION), key=np.array(key),
                          dys=np.array(self.grid.dys), yaws=np.array(self.grid.yaws),
                          load=np.array(self.load),
-                         nodes=np.array([(n.roll, n.dz, float(n.derailed)) for n in self.nodes]),
+                         nodes=np.array([(n.roll, n.dz, float(n.derailed)) for n in stored]),
+                         windows=np.array(windows, dtype=np.int64).reshape(-1, 3),
+                         window_axes=np.array(window_axes, dtype=float),
+                         window_refs=np.array(refs, dtype=np.int64),
                          meta=np.array(meta, dtype=np.int64).reshape(-1, 5),
                          floats=np.array(floats, dtype=float).reshape(-1, 18),
                          pressure=np.concatenate(pressure) if pressure else np.zeros(0))
@@ -1012,6 +1156,7 @@ class ContactTable:
                 load = float(f["load"])
                 node_rows, meta = f["nodes"], f["meta"]
                 floats, pressure = f["floats"], f["pressure"]
+                windows, axes, refs = f["windows"], f["window_axes"], f["window_refs"]
         except (OSError, KeyError, ValueError) as e:
             raise TableError(f"{path}: not a contact table ({e})") from None
         patches: list[tuple[list[TablePatch], list[TablePatch]]] = [
@@ -1024,13 +1169,33 @@ class ContactTable:
                                                float(fl[17])))
         nodes = [TableNode(float(r), float(z), (tuple(ps[0]), tuple(ps[1])), bool(d))
                  for (r, z, d), ps in zip(node_rows, patches)]
-        return cls(grid, load, nodes)
+        n_grid = len(grid.dys) * len(grid.yaws)
+        table = cls(grid, load, nodes[:n_grid])
+        k, a, r = n_grid, 0, 0
+        for j, n_dys, n_yaws in (tuple(int(v) for v in w) for w in windows):
+            window_dys = tuple(float(v) for v in axes[a:a + n_dys])
+            window_yaws = tuple(float(v) for v in axes[a + n_dys:a + n_dys + n_yaws])
+            a += n_dys + n_yaws
+            sub = []
+            for ref in refs[r:r + n_dys * n_yaws]:
+                if ref >= 0:
+                    sub.append(table.nodes[int(ref)])
+                else:
+                    sub.append(nodes[k])
+                    k += 1
+            r += n_dys * n_yaws
+            table.refined.setdefault(j, []).append(
+                cls(TableGrid(window_dys, window_yaws), load, sub))
+        if k != len(nodes) or r != len(refs):
+            raise TableError(f"{path}: not a contact table (its windows do not fill it)")
+        return table
 
 
 def table_key(wheelset: Wheelset, grid: TableGrid, load: float, refine: int = 0) -> str:
     """Return a digest of everything a table's nodes depend on (``grid``: before refining)."""
     h = hashlib.sha256()
-    h.update(f"v{TABLE_VERSION};{grid.dys!r};{grid.yaws!r};{load!r};r{refine};{wheelset.cell!r};"
+    h.update(f"v{TABLE_VERSION};{grid.dys!r};{grid.yaws!r};{load!r};r{refine};"
+             f"y{YAW_REFINE},{YAW_WINDOW!r},{YAW_EVENT_TURN!r};{wheelset.cell!r};"
              f"{wheelset.shear_modulus!r};{wheelset.poisson_ratio!r};{wheelset.separation!r};"
              f"{wheelset.placement!r}".encode())
     for side in SIDES:
@@ -1098,8 +1263,11 @@ def cached_table(wheelset: Wheelset, grid: TableGrid, load: float, cache_dir: Pa
     table = ContactTable.build(wheelset, grid, load, workers=workers, refine=refine,
                                progress=BuildProgress(log) if log else None)
     if log and refine:
+        windows = [w for v in table.refined.values() for w in v]
+        inner = sum(len(w.nodes) for w in windows)
         log(f"contact table: {len(table.grid.dys) - len(grid.dys)} shifts added where "
-            f"neighbouring nodes differed ({len(table.nodes)} nodes in all)")
+            f"neighbouring nodes differed ({len(table.nodes)} nodes in all), {inner} nodes "
+            f"in {len(windows)} windows refined in yaw around the flanges' take-overs")
     if path is not None:
         try:
             table.save(path, key)
