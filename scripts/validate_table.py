@@ -250,7 +250,7 @@ def compute() -> dict[str, Any]:
 
 
 def takeover(runner: Runner) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """The right flange's take-over between yaw nodes, at every yaw interval (section 2b).
+    """Measure the right flange's take-over between yaw nodes, at every yaw interval (2b).
 
     The left flange's at the opposite yaws is its mirror image.  With the
     yaw-refined windows (now) and with the grid's nodes alone (before).

@@ -342,8 +342,11 @@ def test_refinement_keeps_the_grid_symmetric_for_the_mirror(wheelset):
 
 @pytest.fixture(scope="module")
 def flange_table(wheelset):
-    """Shifts -6.4..-6.0 mm by 0.1 mm at yaws 10 and 15 mrad, refined (the right flange's
-    take-over: no mirror on this grid, both wheels solved)."""
+    """Return a table over the right flange's take-over, refined.
+
+    Shifts -6.4..-6.0 mm by 0.1 mm at yaws 10 and 15 mrad (no mirror on
+    this grid: both wheels solved).
+    """
     grid = TableGrid((-6.4e-3, -6.3e-3, -6.2e-3, -6.1e-3, -6.0e-3), (10e-3, 15e-3))
     return ContactTable.build(wheelset, grid, LOAD, refine=4)
 
