@@ -379,10 +379,11 @@ def test_pipeline_holds_without_a_fresh_measurement(hertz):
     assert pipe.estimation_counts["dropped"] == 2
 
 
-def test_estimation_is_refused_in_profiles_mode():
-    from fastsim_ros.params import ParameterError, checked
-    with pytest.raises(ParameterError, match="friction_estimation"):
-        checked({"patch_source": "profiles", "friction_estimation": "on"})
+def test_estimation_is_taken_in_both_patch_sources():
+    # profiles mode too (test_profile_estimation.py runs it)
+    from fastsim_ros.params import checked
+    assert checked({"patch_source": "profiles",
+                    "friction_estimation": "on"})["friction_estimation"] == "on"
     assert checked({"friction_estimation": "on"})["friction_estimation"] == "on"
 
 
