@@ -97,12 +97,23 @@ class Strips:
     x_l: FloatArray
 
 
-def area_strips(area: GridArea) -> Strips:
-    """Return the strips of ``area``: each run of cells in contact along a row, face to face."""
-    mask = area.mask
+Runs = tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.intp]]
+
+
+def strip_runs(mask: NDArray[np.bool_]) -> Runs:
+    """Return each run of cells in contact along a row: its row, first and one-past-last column.
+
+    Row-major, as :func:`numpy.nonzero` walks (so the starts and ends pair up).
+    """
     edges = np.diff(np.pad(mask.astype(np.int8), ((0, 0), (1, 1))), axis=1)
     rows, starts = np.nonzero(edges == 1)
     _, ends = np.nonzero(edges == -1)
+    return rows, starts, ends
+
+
+def area_strips(area: GridArea) -> Strips:
+    """Return the strips of ``area``: each run of cells in contact along a row, face to face."""
+    rows, starts, ends = strip_runs(area.mask)
     x0 = area.x0 - 0.5 * area.dx
     return Strips(area.y[rows], np.full(rows.size, area.dy),
                   (x0 + area.dx * starts).astype(np.float64),

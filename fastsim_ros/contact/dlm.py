@@ -45,7 +45,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.asm import CalibratedFlexibility, FlexibilityMethod, centroid
+from fastsim_ros.contact.asm import (CalibratedFlexibility, FlexibilityMethod, centroid,
+                                     strip_runs)
 from fastsim_ros.contact.checks import check_material
 from fastsim_ros.contact.fastsim import sweep_integrals
 from fastsim_ros.contact.influence import influence_kernel
@@ -114,12 +115,8 @@ WEIGHTINGS = ("area", "chord")
 
 def strip_chords(area: GridArea) -> FloatArray:
     """Return, on every cell in contact, the length of its strip (its run along ``x``, m)."""
-    mask = area.mask
-    out = np.zeros(mask.shape)
-    edges = np.diff(np.pad(mask.astype(np.int8), ((0, 0), (1, 1))), axis=1)
-    rows, starts = np.nonzero(edges == 1)
-    _, ends = np.nonzero(edges == -1)
-    for j, i0, i1 in zip(rows, starts, ends):
+    out = np.zeros(area.mask.shape)
+    for j, i0, i1 in zip(*strip_runs(area.mask)):
         out[j, i0:i1] = (i1 - i0) * area.dx
     return out
 

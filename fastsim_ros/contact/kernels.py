@@ -410,20 +410,21 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
         slip[:, :] = False
     nslip = 0
     ncontact = 0
-    # the far field's share since entry of the n-th cell of a segment (d = half + n dx)
+    # the far field's share since entry at the front face (column 0: none) and at the n-th
+    # cell of a segment (column n + 1, d = half + n dx)
     far = shift_x != 0.0 or shift_y != 0.0
-    share = np.zeros((2, nx + 1 if far else 1))
+    share = np.zeros((2, nx + 2 if far else 1))
     if far:
         for c in range(2):
             relax = relax_x if c == 0 else relax_y
             for n in range(nx + 1):
                 d = half + n * dx
                 if d >= rolled:
-                    share[c, n] = 1.0
+                    share[c, n + 1] = 1.0
                 elif rolled > 50.0 * relax:
-                    share[c, n] = math.exp((d - rolled) / relax)
+                    share[c, n + 1] = math.exp((d - rolled) / relax)
                 else:
-                    share[c, n] = math.expm1(d / relax) / math.expm1(rolled / relax)
+                    share[c, n + 1] = math.expm1(d / relax) / math.expm1(rolled / relax)
     # slip-dependent laws: |V| per metre of a full step and of a segment's first half step
     v_full = speed / dx
     v_half = speed / half
@@ -454,13 +455,9 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
             if far and dist[j] <= rolled:
                 # entered during the step: the far field's increment over this cell's march
                 n = int((dist[j] - half) / dx + 0.5)
-                if n == 0:
-                    g_x = shift_x * share[0, 0]
-                    g_y = shift_y * share[1, 0]
-                else:
-                    g_x = shift_x * (share[0, n] - share[0, n - 1])
-                    g_y = shift_y * (share[1, n] - share[1, n - 1])
-            if dist[j] > rolled:
+                g_x = shift_x * (share[0, n + 1] - share[0, n])
+                g_y = shift_y * (share[1, n + 1] - share[1, n])
+            elif dist[j] > rolled:
                 g_x = shift_x
                 g_y = shift_y
                 # in the contact before the step: from the previous state at x + rolled

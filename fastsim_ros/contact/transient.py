@@ -311,19 +311,16 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
         m_x, m_y, k_x, k_y, l_x, l_y, length = far_field(
             p, env, flex, dx, dy, geo[k.G_ELLIPSE + 2], geo[k.G_ELLIPSE + 3], nu,
             shear_modulus)
-    bound_total = mu * geo[k.G_LOAD]
+    # the traction bound: mu p as given (shape p, outer mu), or the finished parabolic one
+    shape, outer = p, mu
     if parabolic:
-        bound = np.empty((ny, nx))
-        k.parabolic_bound(p, dx, dy, mu, geo[k.G_LOAD], bound)
-        fx, fy, mz, nslip, _ = elastic_sweep(
-            bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-            law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
-            m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total)
-    else:
-        fx, fy, mz, nslip, _ = elastic_sweep(
-            p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-            law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
-            m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total)
+        shape = np.empty((ny, nx))
+        k.parabolic_bound(p, dx, dy, mu, geo[k.G_LOAD], shape)
+        outer = 1.0
+    fx, fy, mz, nslip, _ = elastic_sweep(
+        shape, outer, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
+        law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
+        m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, mu * geo[k.G_LOAD])
     return k.OK, 0.0, fx, fy, mz, geo[k.G_LOAD], nslip, int(geo[k.G_NCONTACT])
 
 
