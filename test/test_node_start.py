@@ -13,6 +13,7 @@ own: about half a second to the refusal), once for the whole module.
 from __future__ import annotations
 
 import subprocess
+import warnings
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -82,6 +83,33 @@ def _cases() -> list[tuple[str, str, list[str]]]:
 CASES = _cases()
 
 
+#: a refusal takes about a second; a start still running after this long is hung
+HANG_SECONDS = 60
+
+
+def _start(args: list[str]) -> subprocess.CompletedProcess[str]:
+    """Start the node with ``args``; a start that hangs is killed and started once more.
+
+    A refusal is over in about a second, but one start in a full suite's worth of
+    them was once seen to hang past two minutes (in CI, not reproduced in 270 starts
+    here: DDS's participant set-up is the only thing a refusal waits on).  That
+    hang is the middleware's, not the refusal's; it is retried once and reported
+    as a warning, and a second hang fails the case with what the node had printed,
+    instead of taking every other case down with it.
+    """
+    command = [str(NODE_SCRIPT), "--ros-args", *args]
+    try:
+        return subprocess.run(command, capture_output=True, text=True, timeout=HANG_SECONDS)
+    except subprocess.TimeoutExpired as first:
+        warnings.warn(f"start {args} hung for {HANG_SECONDS} s (stderr so far: "
+                      f"{first.stderr!r}); started once more")
+    try:
+        return subprocess.run(command, capture_output=True, text=True, timeout=HANG_SECONDS)
+    except subprocess.TimeoutExpired as second:
+        stderr = second.stderr.decode() if isinstance(second.stderr, bytes) else second.stderr
+        return subprocess.CompletedProcess(command, -9, "", f"hung twice: {stderr or ''}")
+
+
 @pytest.fixture(scope="module")
 def refusals() -> dict[str, subprocess.CompletedProcess[str]]:
     """Start the node once per case, two at a time; return each case's process."""
@@ -89,8 +117,7 @@ def refusals() -> dict[str, subprocess.CompletedProcess[str]]:
         GARBAGE.with_suffix(suffix).write_bytes(bytes(range(256)) * 8)
 
     def start(case: tuple[str, str, list[str]]) -> subprocess.CompletedProcess[str]:
-        return subprocess.run([str(NODE_SCRIPT), "--ros-args", *case[2]],
-                              capture_output=True, text=True, timeout=120)
+        return _start(case[2])
     try:
         with ThreadPoolExecutor(2) as pool:
             done = list(pool.map(start, CASES))
@@ -103,9 +130,8 @@ def refusals() -> dict[str, subprocess.CompletedProcess[str]]:
 def test_a_bare_on_starts_the_estimator():
     # YAML reads `on` as true: the switch takes it (profiles mode too); the start then stops
     # at the next parameter's bad value, which it names alone
-    done = subprocess.run([str(NODE_SCRIPT), "--ros-args", *PROFILES,
-                           "-p", "friction_estimation:=on", "-p", "friction_process_noise:=-1.0"],
-                          capture_output=True, text=True, timeout=120)
+    done = _start([*PROFILES, "-p", "friction_estimation:=on",
+                   "-p", "friction_process_noise:=-1.0"])
     assert done.returncode == 2
     assert "friction_process_noise" in done.stderr
     assert "friction_estimation'" not in done.stderr
