@@ -5,13 +5,15 @@ cycle.  Two pipelines (``fastsim_ros.pipeline.Pipeline``), two contacts
 (``left``, ``right``) of the 30-cell flange-root patch, the default method,
 constant friction: one with ``friction_estimation: off``, one ``on`` (fed a
 measured wrench each cycle, creepage beyond the linear range so every cycle
-updates), and one ``on`` whose slope solves go through ``solve_arrays``
-(the model before it called the kernel itself).  One timed call is one rig
+updates, the slope ``dF/dmu_s`` from the march's own derivative), and one
+``on`` whose slope is the forward difference of a second solve per contact
+(the model before it had the derivative).  One timed call is one rig
 cycle: the wheelset twist, (the measured wrench,) both patches, as CDR
 bytes, through the pipeline's handlers.  They are interleaved in rounds
 (``bench_fastsim.per_call``).  Also timed: one
-``solve_arrays`` of that patch (what "one solve" costs) and one call of the
-kernel it wraps, as the estimator makes it.  Prints medians and
+``solve_arrays`` of that patch (what "one solve" costs), one call of the
+kernel it wraps, as the estimator makes it, and one call of the slope
+kernel.  Prints medians and
 p99 (us) and the machine line.  About 10 s.
 
     PYTHONPATH=. .venv/bin/python benchmarks/bench_estimation.py [--calls 5000]
@@ -57,16 +59,16 @@ def stamped(raw: bytes, stamp_ns: int) -> bytearray:
     return b
 
 
-def cycle_runner(estimation: str, wrapped: bool = False):
+def cycle_runner(estimation: str, differenced: bool = False):
     """Return a function that runs the next rig cycle through a pipeline.
 
-    ``wrapped``: the estimator's slope solves through ``solve_arrays`` (its
-    checks and result object, as before the model called the kernel itself).
+    ``differenced``: the estimator's slope a forward difference (a second
+    solve per contact), as before the march's derivative.
     """
     pipe = Pipeline(PipelineConfig.from_values(
         {"contacts": ["left", "right"], "friction_estimation": estimation}))
-    if wrapped:
-        object.__setattr__(pipe._creep_model, "_kernel", None)
+    if differenced:
+        object.__setattr__(pipe._creep_model, "_slope_kernel", None)
     area = samples.flange_root_patch(cells=30)
     twist = cdr(rolling_twist(4e-3))
     measured = wrench(-2.0e4)
@@ -93,7 +95,7 @@ def main() -> None:
     warm_up()
     off, _ = cycle_runner("off")
     on, pipe_on = cycle_runner("on")
-    wrapped, _ = cycle_runner("on", wrapped=True)
+    differenced, _ = cycle_runner("on", differenced=True)
     area = samples.flange_root_patch(cells=30)
     solver = CalibratedMaeSolver(0.28, 8e10)
 
@@ -101,17 +103,21 @@ def main() -> None:
         solver.solve_arrays(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0,
                             0.3)
     direct = CreepModel(solver)._kernel  # type: ignore[attr-defined]
+    march = CreepModel(solver)._slope_kernel  # type: ignore[attr-defined]
     law = CreepModel._kernel_law(friction_law("constant", 0.3))
 
     def kernel() -> None:
         direct(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, law, 20.0)
+
+    def slope() -> None:
+        march(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, law, 20.0)
     times = per_call({"cycle, estimation off": off, "cycle, estimation on": on,
-                      "on, slopes via solve_arrays": wrapped, "one solve_arrays": solve,
-                      "one kernel call": kernel}, args.calls)
+                      "on, slopes differenced": differenced, "one solve_arrays": solve,
+                      "one kernel call": kernel, "one slope kernel call": slope}, args.calls)
     print(f"machine: {machine()}")
     for name, (p50, p99) in times.items():
         print(f"{name:24s} median {p50:8.1f} us   p99 {p99:8.1f} us")
-    for name in ("cycle, estimation on", "on, slopes via solve_arrays"):
+    for name in ("cycle, estimation on", "on, slopes differenced"):
         extra = times[name][0] - times["cycle, estimation off"][0]
         print(f"estimator per cycle ({name}; difference of medians): {extra:.1f} us = "
               f"{extra / times['one solve_arrays'][0]:.2f} solves")

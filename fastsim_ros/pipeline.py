@@ -241,7 +241,7 @@ class ContactReport:
 
 class _ContactState:
     __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
-                 "wrench_fresh", "stats", "reader", "frame_out", "result", "solved")
+                 "wrench_fresh", "stats", "reader", "frame_out", "result", "solved", "slope")
 
     def __init__(self) -> None:
         self.reader = CloudReader()  # the topic's header parsed once
@@ -258,6 +258,8 @@ class _ContactState:
         self.stats = ContactStats()
         # the latest solve (friction estimation's measurement model): patch, creepages, forces
         self.solved: tuple[ContactPatch, Creepage, ContactForces] | None = None
+        # that solve's dFx/dmu_s, dFy/dmu_s (N, contact frame) where its march gave them
+        self.slope: tuple[float, float] | None = None
 
 
 class _ContactTopics:
@@ -557,8 +559,10 @@ class Pipeline:
         Measurement model (:mod:`fastsim_ros.estimation`): the wheelset
         frame's ``x`` component of the contacts' wrenches, ``sum_c e_x,c[0]
         Fx_c + e_y,c[0] Fy_c + e_z,c[0] N_c``, the creep forces solved at
-        ``mu_s`` (the published ones are those at the prior: one more solve
-        per contact gives the slope).
+        ``mu_s`` (the published ones are those at the prior; the slope is the
+        march's derivative, from the published solve's own march on the
+        compiled path, else one march more per contact; with the equivalent
+        ellipse a forward difference, one more solve per contact).
         """
         ekf = self._ekf
         assert ekf is not None
@@ -567,12 +571,17 @@ class Pipeline:
         self._last_cycle_ns = cycle.stamp_ns
         mu = self._mu
         samples: list[ContactSample] = []
-        normal_x = predicted = load = used = adhesion = 0.0
+        normal_x = predicted = load = used = adhesion = slope = 0.0
+        marched = True  # every contact's slope came with its solve
         for state in self._contacts.values():
             if state.solved is None:
                 continue
             patch, creep, f = state.solved
             ex, ey, ez = patch.frame.axes
+            if state.slope is None:
+                marched = False
+            else:
+                slope += ex[0] * state.slope[0] + ey[0] * state.slope[1]
             samples.append(ContactSample(patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy,
                                          creep.xi, creep.eta, creep.phi, creep.speed,
                                          ((ex[0], ey[0]),)))
@@ -591,7 +600,10 @@ class Pipeline:
                 step = ekf.update([measured[0] - normal_x],
                                   lambda m: model.predict(samples, m), load, [predicted],
                                   model_error(mu, adhesion, share),
-                                  lambda m: model.predict_with_error(samples, m, share)[1])
+                                  lambda m: model.predict_with_error(samples, m, share)[1],
+                                  (lambda m: [slope] if marched and m == mu
+                                   else model.slope(samples, m)) if model.has_slope
+                                  else None)
                 status = step.status
                 self.estimation_counts["steps"] += int(step.step_seen)
             except ContactError:  # the solver refused the perturbed mu: hold
@@ -669,6 +681,7 @@ class Pipeline:
                                     f"{state.last_stamp_ns} ns")
             state.last_stamp_ns = stamp
             done = None
+            state.slope = None
             if given is not None:
                 patch, creep, forces, seconds = given
                 stats.add_solve_time(seconds)
@@ -748,16 +761,18 @@ class Pipeline:
             words, ny, nx, row, step, cols, pressure, frame_out,
             self._twist_array("wheel", wheel), self._twist_array("rail", rail),
             self._min_speed, rule, parabolic, shear_modulus, knots, polys, law, prm, mu,
-            slip_dependent, calibrated, pair_knots, pair_values, result)
+            slip_dependent, calibrated, pair_knots, pair_values, self._ekf is not None, result)
         elapsed = time.perf_counter() - start
         if status != fast.SOLVED:
             return None
+        if self._ekf is not None:  # friction estimation's slope, from the same march
+            state.slope = (float(result[fast.DFX_DMU]), float(result[fast.DFY_DMU]))
         # the adapter's loop and the solve, timed together on this path
         state.stats.add_solve_time(elapsed)
         (o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2, ez0, ez1, ez2) = frame_out[
             patch_kernels.ORIGIN:patch_kernels.E_Z + 3].tolist()
         (x0, y0, dx, dy, load, cells, row_order, column_order, xi, eta, phi, speed, fx, fy,
-         mz, n, slip_fraction, f0, f1, f2, t0, t1, t2) = result.tolist()
+         mz, n, slip_fraction, f0, f1, f2, t0, t1, t2) = result[:fast.DFX_DMU].tolist()
         frame = _new_frame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
         patch = _new_patch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, int(cells),
                            int(row_order), int(column_order))

@@ -30,9 +30,9 @@ from msg_adapters.patch import GRID_TOLERANCE, MIN_CELL_SIZE, MIN_CONTACT_CELLS
 SOLVED, DEFER = 0, 1
 #: the indices of :func:`solve_cloud`'s ``result`` (the frame stays in the adapter's ``out``)
 (X0, Y0, DX, DY, LOAD, CELLS, ROW_ORDER, COLUMN_ORDER, XI, ETA, PHI, SPEED, FX, FY, MZ, N,
- SLIP_FRACTION, FORCE_WS, TORQUE_WS) = (0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15,
-                                        16, 17, 20)
-RESULT_SIZE = 23
+ SLIP_FRACTION, FORCE_WS, TORQUE_WS, DFX_DMU, DFY_DMU) = (
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20, 23, 24)
+RESULT_SIZE = 25
 
 
 @njit(cache=True, inline="always")
@@ -54,7 +54,7 @@ def _grid_axis(first, step, worst, n, result, at):
 @njit(cache=True)
 def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, min_speed, rule,
                 parabolic, shear_modulus, knots, polys, law, prm, mu, slip_dependent,
-                calibrated, pair_knots, pair_values, result):
+                calibrated, pair_knots, pair_values, slope, result):
     """Convert one patch cloud, derive its creepages, solve it (MAE + FastSim); no tractions.
 
     ``words .. cols``: the cloud's points as :func:`msg_adapters.patch._words`
@@ -67,7 +67,11 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
     :data:`SOLVED` with ``result`` filled (indices above: the grid, load,
     cells, row and column order, the creepages and rolling speed, the
     forces and slip fraction, and the wrench in the wheelset frame about
-    its origin), or :data:`DEFER` where the Python path decides.
+    its origin), or :data:`DEFER` where the Python path decides.  ``slope``:
+    also ``dFx/dmu_s``, ``dFy/dmu_s`` (N, contact frame; friction
+    estimation's slope) from the same march
+    (:func:`fastsim_ros.contact.kernels.mae_solve_mu_slope`, the forces
+    to the bit); else those slots are NaN.
     """
     adapter.adapt(words, ny, nx, row, step, cols, pressure, frame)
     cells = int(frame[adapter.CELLS])
@@ -131,15 +135,26 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
         sphi = -phi
     no_float = np.empty((0, 0))
     no_bool = np.empty((0, 0), dtype=np.bool_)
-    r = contact.mae_solve(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule, parabolic,
-                          shear_modulus, knots, polys, law, prm,
-                          abs(speed) if slip_dependent else 0.0, no_float, no_float, no_bool,
-                          False, calibrated, pair_knots, pair_values)
+    dfx = dfy = math.nan
+    if slope:
+        q = contact.mae_solve_mu_slope(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule,
+                                       parabolic, shear_modulus, knots, polys, law, prm,
+                                       abs(speed) if slip_dependent else 0.0, calibrated,
+                                       pair_knots, pair_values)
+        r = (q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7])
+        dfx, dfy = q[8], q[9]
+    else:
+        r = contact.mae_solve(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule, parabolic,
+                              shear_modulus, knots, polys, law, prm,
+                              abs(speed) if slip_dependent else 0.0, no_float, no_float,
+                              no_bool, False, calibrated, pair_knots, pair_values)
     if r[0] != contact.OK:
         return DEFER
     fx, fy, mz, n = r[2], r[3], r[4], r[5]
     if reverse:
         fx, fy = -fx, -fy
+        dfx, dfy = -dfx, -dfy
+    result[DFX_DMU], result[DFY_DMU] = dfx, dfy
     if not (math.isfinite(fx) and math.isfinite(fy) and math.isfinite(mz)
             and math.isfinite(n)):
         return DEFER
@@ -182,4 +197,5 @@ def warm_up() -> None:
                         np.empty(adapter.OUT_SIZE), np.zeros(6), np.zeros(6), 0.0,
                         solver._rule, False, solver.shear_modulus, solver._knots,
                         solver._polys, contact.LAW_CONSTANT, np.zeros(2), 0.3, False, True,
-                        solver._pair_knots, solver._pair_values, np.empty(RESULT_SIZE))
+                        solver._pair_knots, solver._pair_values, writeable,
+                        np.empty(RESULT_SIZE))

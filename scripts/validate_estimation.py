@@ -101,7 +101,8 @@ def run(truth: str, cycles: list[tuple[float, float, float]], share: float) -> N
             ekf.predict(1.0 / RATE)
         h, error = model.predict_with_error([s], ekf.mu, share)
         step = ekf.update([z], lambda m: model.predict([s], m), LOAD, h, error,
-                          lambda m: model.predict_with_error([s], m, share)[1])
+                          lambda m: model.predict_with_error([s], m, share)[1],
+                          lambda m: model.slope([s], m))
         rows.append((t, xi, truth_mu(t), step.mu, step.sigma, step.status, step.sensitivity))
     t, xi, mu_true, mu, sigma = (np.array([r[k] for r in rows]) for k in range(5))
     status = [r[5] for r in rows]
@@ -257,7 +258,8 @@ def contact_curve() -> None:
                     ekf.predict(1.0 / RATE)
                     h, error = model.predict_with_error([s], ekf.mu, share)
                     ekf.update([z], lambda m, s=s: model.predict([s], m), load, h, error,
-                               lambda m, s=s: model.predict_with_error([s], m, share)[1])
+                               lambda m, s=s: model.predict_with_error([s], m, share)[1],
+                               lambda m, s=s: model.slope([s], m))
                     covered.append(abs(ekf.mu - mu_true) <= 2.0 * ekf.sigma)
             assert math.isfinite(ekf.mu)
             print(f"| {label} | filter, share {share:g} | {ekf.mu:.4f} | "

@@ -537,3 +537,101 @@ def test_on_contacts_published_curve_to_the_knee(share):
         assert abs(ekf.mu - 0.33) < 0.02 * 0.33 and covers
     else:
         assert abs(ekf.mu - 0.33) > 0.03 * 0.33 and not covers
+
+
+# ---------------------------------------------------------------- the march's own slope
+
+@pytest.mark.parametrize("calibrated", [True, False], ids=["mae_calibrated", "mae"])
+@pytest.mark.parametrize("law, limit_ratio, decay", [("constant", 1.0, 0.0),
+                                                     ("exponential", 0.4, 0.6)])
+@pytest.mark.parametrize("bound", ["given", "parabolic"])
+@pytest.mark.parametrize("xi, eta, phi, speed", [
+    (2e-3, 0.0, 0.0, 20.0),      # partial slip, longitudinal
+    (4e-3, 1e-3, 0.5, 20.0),     # partial slip, combined with spin
+    (1e-3, -2e-3, 2.0, -15.0),   # reverse running, large spin
+    (3e-2, 0.0, 0.0, 20.0),      # full slip: dF/dmu = N (constant law)
+])
+def test_the_slope_is_the_derivative_of_the_forces(calibrated, law, limit_ratio, decay, bound,
+                                                   xi, eta, phi, speed):
+    # tangent-linear FastSim against a central difference of the solve itself: the forces are
+    # smooth in mu_s away from cells on their bound, so the two agree to the difference's
+    # own error (h^2 F''' / 6, h = 1e-6: far below 1e-8 N per N of load)
+    from fastsim_ros.contact.compiled import MaeSolver
+    from fastsim_ros.contact.samples import flange_root_patch
+
+    area = flange_root_patch(cells=30)
+    solver = CalibratedMaeSolver(0.28, 8.2e10) if calibrated else MaeSolver(0.28, 8.2e10)
+    model = CreepModel(solver, law, limit_ratio, decay, bound)
+    assert model.has_slope
+    sample = [ContactSample(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,
+                            speed, ((1.0, 0.0), (0.0, 1.0)))]
+    load = sample[0].load
+    h = 1e-6
+    central = (model.predict(sample, 0.3 + h) - model.predict(sample, 0.3 - h)) / (2 * h)
+    slope = model.slope(sample, 0.3)
+    assert np.abs(slope - central).max() < 1e-8 * load
+    if xi == 3e-2 and law == "constant":  # full slip along x: F = -mu N
+        assert slope[0] == pytest.approx(-load, rel=1e-9)
+
+
+def test_the_ekf_takes_the_models_slope_in_place_of_a_second_solve():
+    area = ellipse(6e-3, 4e-3, nx=20, ny=20, load=LOAD)
+    model = CreepModel(CalibratedMaeSolver(0.28, 8.2e10))
+    sample = [ContactSample(area.pressure, area.x0, area.y0, area.dx, area.dy, 6e-3, 0.0, 0.0,
+                            V, ((1.0, 0.0),))]
+    asked: list[float] = []
+
+    def predict(mu: float) -> np.ndarray:
+        asked.append(mu)
+        return model.predict(sample, mu)
+
+    with_slope = FrictionEkf(0.3, 0.1, process_noise=1e-3, measurement_noise=NOISE)
+    differenced = FrictionEkf(0.3, 0.1, process_noise=1e-3, measurement_noise=NOISE)
+    z = model.predict(sample, 0.35)
+    a = with_slope.update(z, predict, LOAD, model.predict(sample, 0.3),
+                          slope_at=lambda m: model.slope(sample, m))
+    assert asked == []  # the prior's forces given, the slope from the march: no solve asked
+    b = differenced.update(z, predict, LOAD, model.predict(sample, 0.3))
+    assert asked == [pytest.approx(0.303)]  # the forward difference's one solve
+    assert a.status == b.status == UPDATED
+    # the same step of mu to the forward difference's O(h) (1% of mu) in the slope
+    assert with_slope.mu == pytest.approx(differenced.mu, rel=5e-3)
+    assert abs(a.slope[0]) > 0.0
+
+
+@pytest.mark.parametrize("speed", [20.0, -20.0], ids=["forward", "reverse"])
+@pytest.mark.parametrize("law", ["constant", "exponential"])
+def test_the_published_solve_carries_the_slope(speed, law):
+    # the compiled path solves and differentiates in one march: its forces are those of the
+    # pipeline with estimation off to the bit, its slope the model's central difference
+    from fastsim_ros.contact.samples import flange_root_patch
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from ros_messages import cdr, cloud_msg, rolling_twist
+
+    def make(estimation: str) -> Pipeline:
+        return Pipeline(PipelineConfig.from_values(
+            {"contacts": ["left"], "friction_estimation": estimation, "friction_law": law,
+             "friction_coefficient": 0.3, "friction_limit_ratio": 0.5,
+             "friction_decay": 0.5}))
+    area = flange_root_patch(cells=30)
+    twist = cdr(rolling_twist(4e-3, speed=speed, stamp_ns=1000))
+    patch = cdr(cloud_msg(area, origin=(0.0, 0.75, -0.46), stamp_ns=1000, dtype="<f8"))
+    outs = []
+    for pipe in (make("off"), make("on")):
+        assert pipe.on_wheel_twist(twist) == "ok"
+        outs.append(pipe.on_patch("left", patch))
+    off, on = outs
+    assert on.forces.fx == off.forces.fx and on.forces.fy == off.forces.fy
+    assert on.forces.mz == off.forces.mz and on.wheelset.force == off.wheelset.force
+    state = pipe._contacts["left"]
+    assert state.slope is not None  # the compiled path ran
+    creep = on.creepage
+    model = pipe._creep_model  # the configured method and law
+    assert model.law == law and model.has_slope
+    p = on.patch
+    s = [ContactSample(p.pressure, p.x0, p.y0, p.dx, p.dy, creep.xi, creep.eta, creep.phi,
+                       creep.speed, ((1.0, 0.0), (0.0, 1.0)))]
+    h = 1e-6
+    central = (model.predict(s, 0.3 + h) - model.predict(s, 0.3 - h)) / (2 * h)
+    assert np.abs(np.array(state.slope) - central).max() < 1e-8 * s[0].load
+    assert abs(state.slope[0]) > 0.1 * s[0].load  # beyond the linear range: observable

@@ -610,6 +610,259 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     return fx * da, fy * da, mz * da, nslip, ncontact
 
 
+# ---------------------------------------------------------------- the slope in mu_s
+
+
+@njit(cache=True, error_model="numpy")
+def law_ratio_slope(law, prm, v):
+    """``d(mu(v)/mu_s)/dv`` (s/m) of :func:`law_ratio`: ``-(1 - A) B exp(-B v)``, or 0."""
+    if law == LAW_EXPONENTIAL:
+        return -(1.0 - prm[0]) * prm[1] * math.exp(-prm[1] * v)
+    return 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def rigid_slip_return_slope(px, py, dpx, dpy, wxh, wyh, l1, l2, g, dg):
+    """:func:`rigid_slip_return` (its operations in order) and its derivative.
+
+    The derivative along ``(dpx, dpy, dg)`` (the upstream traction's and the
+    bound's in ``mu_s``).  Return ``(tau_x, tau_y, d tau_x, d tau_y,
+    applies)``: the chain rule through ``U = L tau_p - w h``, ``V = U - g D
+    U/|U|``, ``tau = g V/|V|`` (``w h`` does not depend on ``mu_s``).
+    """
+    ux = l1 * px - wxh
+    uy = l2 * py - wyh
+    n = math.sqrt(ux * ux + uy * uy)
+    if not n > 0.0:
+        return 0.0, 0.0, 0.0, 0.0, False
+    gd = g * 0.5 * (l1 - l2) / n
+    vx = ux - gd * ux
+    vy = uy + gd * uy
+    m = math.sqrt(vx * vx + vy * vy)
+    if not m > g * 0.5 * (l1 + l2):
+        return 0.0, 0.0, 0.0, 0.0, False
+    r = g / m
+    # the derivatives: one division per square root, the reciprocals carry the quotients'
+    inv_n = 1.0 / n
+    inv_m = 1.0 / m
+    dux = l1 * dpx
+    duy = l2 * dpy
+    dn = (ux * dux + uy * duy) * inv_n
+    dgd = 0.5 * (l1 - l2) * (dg - g * dn * inv_n) * inv_n
+    dvx = dux - (dgd * ux + gd * dux)
+    dvy = duy + (dgd * uy + gd * duy)
+    dm = (vx * dvx + vy * dvy) * inv_m
+    dr = (dg - r * dm) * inv_m
+    return r * vx, r * vy, dr * vx + r * dvx, dr * vy + r * dvy, True
+
+
+@njit(cache=True, error_model="numpy")
+def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s,
+                   xp, yp, law, prm, speed, rigid, mu):
+    """March as the steady :func:`sweep` does, differentiating the forces in ``mu_s``.
+
+    Return ``(Fx, Fy, Mz, dFx/dmu_s, dFy/dmu_s, slipping, in contact)``
+    (N, N, N m, N, N): the first three and the counts are :func:`sweep`'s to
+    the bit (the same operations in the same order; without tractions
+    stored), the derivatives by forward-mode differentiation of the march
+    (tangent-linear FastSim).  Every bound is ``mu_s`` times a field that
+    does not depend on it (``mu p``, or the parabolic ``mu N p^2 / sum p^2
+    dA``), so ``dg/dmu_s = g / mu_s``.  A cell in adhesion carries the
+    derivative of its upstream neighbour's traction (``tau = tau_p - rates
+    h``, the rates free of ``mu_s``); a cell on the radial return ``tau = r
+    e``, ``e = t*/|t*|``, has ``d tau = dr e + (r/|t*|) (I - e e^T) d t*``;
+    the rigid-slip return and the slip-dependent kinetic level (``r = g
+    k(v)``, ``k`` the law's ratio at the cell's slip speed ``v``, the next
+    cell's level) follow by the chain rule (:func:`rigid_slip_return_slope`,
+    :func:`law_ratio_slope`).  The forces are piecewise smooth in ``mu_s``
+    (a cell changing state is continuous in its traction), so this is the
+    derivative everywhere but on the measure-zero set where a cell sits on
+    its bound; a central difference of the solve agrees with it to 1e-11 of
+    the load (test_estimation).  The steady state only (the transient
+    march's state would carry a derivative of its own); ``mu``: the
+    ``mu_s`` of the bound (> 0).
+    """
+    ny, nx = shape.shape
+    da = dx * dy
+    half = 0.5 * dx
+    inv_mu = 1.0 / mu
+    w = np.empty((15, ny))
+    tx, ty, dtx, dty, sx, sy, sm, dsx, dsy = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8]
+    rate_x, rate_y0, rate_yx, yr, w_x, dlevel = w[9], w[10], w[11], w[12], w[13], w[14]
+    level = np.ones(ny)
+    cont = np.empty(ny, dtype=np.int64)
+    for j in range(ny):
+        y = y0 + dy * j
+        rate_x[j] = xi / flex[0, j] - phi * (y - y_s) / flex[3, j]
+        rate_y0[j] = eta / flex[1, j]
+        rate_yx[j] = phi / flex[2, j]
+        yr[j] = y - yp
+        w_x[j] = xi - phi * (y - y_s)
+        sx[j] = 0.0
+        sy[j] = 0.0
+        sm[j] = 0.0
+        dsx[j] = 0.0
+        dsy[j] = 0.0
+        dlevel[j] = 0.0
+        cont[j] = -2
+    nslip = 0
+    ncontact = 0
+    v_full = speed / dx
+    v_half = speed / half
+    for i in range(nx - 1, -1, -1):
+        x = x0 + dx * i
+        x_rel = x - x_c
+        xr = x - xp
+        for j in range(env[0, i], env[1, i]):
+            g = outer * (shape[j, i] * inner)
+            if not g > 0.0:
+                continue
+            dg = g * inv_mu
+            if cont[j] == i:
+                s = dx
+                t_x = tx[j]
+                t_y = ty[j]
+                d_x = dtx[j]
+                d_y = dty[j]
+            else:
+                s = half
+                t_x = 0.0
+                t_y = 0.0
+                d_x = 0.0
+                d_y = 0.0
+                level[j] = 1.0
+                dlevel[j] = 0.0
+            cont[j] = i - 1
+            l1 = flex[0, j]
+            l2 = flex[1, j]
+            x_mid = x_rel + 0.5 * s
+            p_x = t_x
+            p_y = t_y
+            dp_x = d_x
+            dp_y = d_y
+            t_x = t_x - rate_x[j] * s
+            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s
+            over = False
+            m2 = t_x * t_x + t_y * t_y
+            if law == LAW_CONSTANT:
+                if not m2 <= _NO_SLIP * g * g:
+                    mag = math.sqrt(m2)
+                    if abs(mag - g) <= _ON_BOUND * g:
+                        mag = math.hypot(t_x, t_y)
+                    if mag > g:
+                        done = False
+                        if rigid:
+                            r_x, r_y, dr_x, dr_y, done = rigid_slip_return_slope(
+                                p_x, p_y, dp_x, dp_y, w_x[j] * s, (eta + phi * x_rel) * s,
+                                l1, l2, g, dg)
+                            if done:
+                                t_x = r_x
+                                t_y = r_y
+                                d_x = dr_x
+                                d_y = dr_y
+                        if not done:
+                            if rigid:
+                                mag = math.sqrt(m2)
+                            scale = g / mag
+                            inv = 1.0 / mag
+                            e_x = t_x * inv
+                            e_y = t_y * inv
+                            dmag = e_x * d_x + e_y * d_y
+                            d_x = dg * e_x + scale * (d_x - e_x * dmag)
+                            d_y = dg * e_y + scale * (d_y - e_y * dmag)
+                            t_x = t_x * scale
+                            t_y = t_y * scale
+                        over = True
+                        nslip += 1
+            else:
+                gk = g * level[j]
+                dgk = dg * level[j] + g * dlevel[j]
+                if not m2 <= _NO_SLIP * gk * gk:
+                    mag = math.sqrt(m2)
+                    if abs(mag - gk) <= _ON_BOUND * gk:
+                        mag = math.hypot(t_x, t_y)
+                    if mag > gk:
+                        inv = 1.0 / mag
+                        lx = l1 * t_x
+                        ly = l2 * t_y
+                        vs = v_full if s == dx else (v_half if s == half else speed / s)
+                        e_x = t_x * inv
+                        e_y = t_y * inv
+                        dmag = e_x * d_x + e_y * d_y
+                        done = False
+                        r_x = r_y = dr_x = dr_y = 0.0
+                        k = 1.0
+                        dv = 0.0
+                        if rigid:
+                            wxh = w_x[j] * s
+                            wyh = (eta + phi * x_rel) * s
+                            r_x, r_y, dr_x, dr_y, done = rigid_slip_return_slope(
+                                p_x, p_y, dp_x, dp_y, wxh, wyh, l1, l2, gk, dgk)
+                            if done:
+                                s_x = wxh + l1 * (r_x - p_x)
+                                s_y = wyh + l2 * (r_y - p_y)
+                                sn = math.sqrt(s_x * s_x + s_y * s_y)
+                                v = speed * sn / s
+                                k = law_ratio(law, prm, v)
+                                if sn > 0.0:
+                                    dv = speed * (s_x * l1 * (dr_x - dp_x)
+                                                  + s_y * l2 * (dr_y - dp_y)) / (sn * s)
+                        if not done:
+                            q = math.sqrt(lx * lx + ly * ly)
+                            u = (mag - gk) * inv
+                            v = vs * q * u
+                            k = law_ratio(law, prm, v)
+                            dq = (lx * l1 * d_x + ly * l2 * d_y) / q if q > 0.0 else 0.0
+                            du = -(dgk - gk * dmag * inv) * inv
+                            dv = vs * (dq * u + q * du)
+                        dk = law_ratio_slope(law, prm, v) * dv
+                        r = g * k
+                        if r < mag:
+                            dr = dg * k + g * dk
+                            if done:
+                                scale = r / gk
+                                dscale = (dr - scale * dgk) / gk
+                                t_x = r_x * scale
+                                t_y = r_y * scale
+                                d_x = dr_x * scale + r_x * dscale
+                                d_y = dr_y * scale + r_y * dscale
+                            else:
+                                scale = r * inv
+                                t_x = t_x * scale
+                                t_y = t_y * scale
+                                d_x = dr * e_x + scale * (d_x - e_x * dmag)
+                                d_y = dr * e_y + scale * (d_y - e_y * dmag)
+                            over = True
+                            nslip += 1
+                            level[j] = k
+                            dlevel[j] = dk
+                if not over:
+                    level[j] = 1.0
+                    dlevel[j] = 0.0
+            tx[j] = t_x
+            ty[j] = t_y
+            dtx[j] = d_x
+            dty[j] = d_y
+            sx[j] += t_x
+            sy[j] += t_y
+            sm[j] += xr * t_y - yr[j] * t_x
+            dsx[j] += d_x
+            dsy[j] += d_y
+            ncontact += 1
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    dfx = 0.0
+    dfy = 0.0
+    for j in range(ny):
+        fx += sx[j]
+        fy += sy[j]
+        mz += sm[j]
+        dfx += dsx[j]
+        dfy += dsy[j]
+    return fx * da, fy * da, mz * da, dfx * da, dfy * da, nslip, ncontact
+
+
 # ---------------------------------------------------------------- MAE geometry
 
 
@@ -1186,6 +1439,49 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                                      xi, eta, phi, xp, yp, law, prm, speed, out_x, out_y,
                                      slip, store, calibrated)
     return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT])
+
+
+@njit(cache=True, error_model="numpy")
+def mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                       shear_modulus, knots, polys, law, prm, speed, calibrated, pair_knots,
+                       pair_values):
+    """:func:`mae_solve` (no tractions) and the forces' derivatives in ``mu_s``, one march.
+
+    Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells in
+    contact, dFx/dmu_s, dFy/dmu_s)``: the first eight :func:`mae_solve`'s
+    to the bit, the derivatives (N) :func:`sweep_mu_slope`'s; the arguments
+    as :func:`mae_solve`'s.  The zones, flexibilities and the point ``S``
+    do not depend on ``mu_s``.
+    """
+    status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
+    if status != OK:
+        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, 0.0
+    ny, nx = p.shape
+    geo = np.empty(GEO_SIZE)
+    env = np.empty((2, nx), dtype=np.int64)
+    strips = np.empty((3, ny), dtype=np.int64)
+    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
+                               strips, calibrated, pair_knots, pair_values)
+    if status != OK:
+        return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, 0.0
+    flex = np.empty((4, ny))
+    mae_strip_flexibility(geo, flex)
+    # as mae_sweep: the creepages moved to S = (x_c, y_s)
+    x_c = geo[G_XC]
+    y_s = geo[G_YS]
+    xi_s = xi + phi * (yp - y_s)
+    eta_s = eta - phi * (xp - x_c)
+    if parabolic:
+        bound = np.empty((ny, nx))
+        parabolic_bound(p, dx, dy, mu, geo[G_LOAD], bound)
+        fx, fy, mz, dfx, dfy, nslip, _ = sweep_mu_slope(
+            bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
+            law, prm, speed, calibrated, mu)
+    else:
+        fx, fy, mz, dfx, dfy, nslip, _ = sweep_mu_slope(
+            p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp, law,
+            prm, speed, calibrated, mu)
+    return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT]), dfx, dfy
 
 
 #: :func:`fastsim_ros.contact.rules.ellipse_cells` and

@@ -7,7 +7,9 @@ solver (default ``mae_calibrated``) under the configured friction law:
 - :class:`~fastsim_ros.estimation.ekf.FrictionEkf`: recursive, per rig cycle
   (the node and the replay): an extended Kalman filter on the static
   coefficient ``mu_s`` (a random walk of rate ``q``), the measurement model's
-  slope ``dF/dmu_s`` by a forward difference (one extra solve per contact).
+  slope ``dF/dmu_s`` the march's own derivative (the MAE solvers; the
+  node's is computed in the march of the forces it publishes), else a
+  forward difference (one extra solve per contact).
   Where the force does not depend on ``mu_s`` (the linear range: small
   creepage) the update is skipped: the estimate holds, its variance grows.
   The model's own error against the rail (largest at the knee of the creep

@@ -8,9 +8,11 @@ components (:class:`~fastsim_ros.estimation.model.CreepModel`), ``v`` the
 load cell's noise of standard deviation :attr:`FrictionEkf.measurement_noise`
 (N, white), ``b`` the model's own error against the rail (N, of scale ``s``
 given with each measurement, see below: not white).  The slope ``H =
-dh/dmu_s`` is a forward difference with the step ``relative_step * mu_s``:
-one solve per contact beyond the one at the prior (which the caller may
-pass: the published forces are that solve).
+dh/dmu_s`` is the model's own derivative where it has one (the MAE
+solvers: the march differentiated, one march per contact), else a forward
+difference with the step ``relative_step * mu_s``: one solve per contact
+beyond the one at the prior (which the caller may pass: the published
+forces are that solve).
 
 Observability.  With constant friction FastSim's forces are homogeneous,
 ``F(mu, c) = mu F(1, c/mu)``, so ``dF/dmu = (F - c . dF/dc)/mu``: zero in
@@ -187,7 +189,8 @@ class FrictionEkf:
 
     def update(self, measured: ArrayLike, model: Callable[[float], ArrayLike], load: float,
                predicted: ArrayLike | None = None, model_error: float = 0.0,
-               model_error_at: Callable[[float], float] | None = None) -> EkfStep:
+               model_error_at: Callable[[float], float] | None = None,
+               slope_at: Callable[[float], ArrayLike] | None = None) -> EkfStep:
         """Take one measurement ``measured`` (N, ``(m,)``) of the model ``model(mu_s)`` (N).
 
         ``load``: the cycle's total normal load (N, for the sensitivity);
@@ -197,7 +200,10 @@ class FrictionEkf:
         ``model_error_at``: ``s`` at another ``mu_s``, asked once when a
         step of mu is seen (the sample's error is the model's at the new
         level, ``mu + d``, not at the prior's: a wet prior in full slip
-        knows nothing of a dry rail's knee).
+        knows nothing of a dry rail's knee);
+        ``slope_at``: ``dh/dmu_s`` (N) at a ``mu_s``, if the model knows it
+        (:meth:`~fastsim_ros.estimation.model.CreepModel.slope`: one march
+        per contact, in place of the forward difference's second solve).
         """
         z = _floats(measured)
         if not (load > 0.0 and math.isfinite(load)):
@@ -213,19 +219,24 @@ class FrictionEkf:
         h0 = _floats(model(mu0) if predicted is None else predicted)
         if len(h0) != len(z):
             raise InvalidInputError(f"model gives {len(h0)} components, measured {len(z)}")
-        step = self.relative_step * mu0
-        if mu0 + step > self.mu_bounds[1]:
-            step = -step  # stay inside the range the solver is asked about
-        h1 = _floats(model(mu0 + step))
         slope: tuple[float, ...]
+        if slope_at is not None:
+            slope = _floats(slope_at(mu0))
+            if len(slope) != len(z):
+                raise InvalidInputError(f"slope gives {len(slope)} components, "
+                                        f"measured {len(z)}")
+        else:
+            step = self.relative_step * mu0
+            if mu0 + step > self.mu_bounds[1]:
+                step = -step  # stay inside the range the solver is asked about
+            h1 = _floats(model(mu0 + step))
+            slope = tuple((b - a) / step for a, b in zip(h0, h1))
         innovation: tuple[float, ...]
         if len(z) == 1:  # one measured component (the node's force.x): no sums to make
-            slope = ((h1[0] - h0[0]) / step,)
             innovation = (z[0] - h0[0],)
             h2 = slope[0] * slope[0]
             hv = slope[0] * innovation[0]
         else:
-            slope = tuple((b - a) / step for a, b in zip(h0, h1))
             innovation = tuple(a - b for a, b in zip(z, h0))
             h2 = math.fsum(v * v for v in slope)
             hv = math.fsum(a * b for a, b in zip(slope, innovation))

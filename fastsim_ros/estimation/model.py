@@ -150,13 +150,18 @@ class ContactSample(NamedTuple):
         return float(self.pressure.sum()) * self.dx * self.dy
 
 
-def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float, float]] | None:
-    """Return ``solve(p, x0, y0, dx, dy, xi, eta, phi, law, speed) -> (Fx, Fy, k)`` for MAE.
+Kernel = Callable[..., tuple[float, float, float]]
 
-    The compiled kernel :meth:`MaeSolver.solve_arrays` calls, with the same
-    arguments (bit for bit its forces), without the wrapping the estimator
-    pays per solve (argument checks, the result object): the EKF's slope
-    solves.  None for the other solvers.
+
+def _mae_kernel(solver: Solver, bound: str) -> tuple[Kernel, Kernel] | None:
+    """Return ``solve`` and ``slope`` ``(p, x0, y0, dx, dy, xi, eta, phi, law, speed)`` for MAE.
+
+    ``solve -> (Fx, Fy, k)``: the compiled kernel :meth:`MaeSolver.solve_arrays`
+    calls, with the same arguments (bit for bit its forces), without the
+    wrapping the estimator pays per solve (argument checks, the result
+    object).  ``slope -> (dFx/dmu_s, dFy/dmu_s, k)``: the march's own
+    derivative (:func:`fastsim_ros.contact.kernels.sweep_mu_slope`), the
+    EKF's slope.  None for the other solvers.
     """
     if not isinstance(solver, MaeSolver):
         return None
@@ -179,7 +184,21 @@ def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float,
         if status:
             _raise(status, info, knots)
         return fx, fy, nslip / ncontact
-    return solve
+
+    def slope(p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+              eta: float, phi: float, law: tuple[int, FloatArray, float, bool],
+              speed: float) -> tuple[float, float, float]:
+        code, prm, mu, slip_dependent = law
+        if not p.flags.c_contiguous:
+            p = np.ascontiguousarray(p)
+        status, info, _, _, _, _, nslip, ncontact, dfx, dfy = kernels.mae_solve_mu_slope(
+            p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule, parabolic, shear, knots, polys,
+            code, prm, check_speed(speed) if slip_dependent else 0.0, calibrated, pair_knots,
+            pair_values)
+        if status:
+            _raise(status, info, knots)
+        return dfx, dfy, nslip / ncontact
+    return solve, slope
 
 
 @dataclass(frozen=True)
@@ -207,7 +226,9 @@ class CreepModel:
     def __post_init__(self) -> None:
         """Check the bound; keep the compiled MAE kernel's call (None: the solver's own)."""
         check_bound(self.bound)
-        object.__setattr__(self, "_kernel", _mae_kernel(self.solver, self.bound))
+        kernel = _mae_kernel(self.solver, self.bound)
+        object.__setattr__(self, "_kernel", kernel[0] if kernel is not None else None)
+        object.__setattr__(self, "_slope_kernel", kernel[1] if kernel is not None else None)
         # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
         object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
 
@@ -217,11 +238,12 @@ class CreepModel:
 
     def _solve(self, sample: ContactSample, mu_s: float,
                law: FrictionLaw | None = None,
-               kernel_law: tuple[int, FloatArray, float, bool] | None = None
-               ) -> tuple[float, float, float]:
+               kernel_law: tuple[int, FloatArray, float, bool] | None = None,
+               slope: bool = False) -> tuple[float, float, float]:
         """Return ``(Fx, Fy, slip fraction)`` of one sample at ``mu_s`` (``law``: its law).
 
-        ``kernel_law``: the law's kernel arguments (:meth:`_kernel_law`), if known.
+        ``kernel_law``: the law's kernel arguments (:meth:`_kernel_law`), if known;
+        ``slope``: ``(dFx/dmu_s, dFy/dmu_s)`` (N) instead of the forces (MAE only).
         """
         p, x0, y0, phi = sample.pressure, sample.x0, sample.y0, sample.phi
         reverse = sample.speed < 0.0
@@ -230,7 +252,8 @@ class CreepModel:
             x0 = -(x0 + (p.shape[1] - 1) * sample.dx)
             y0 = -(y0 + (p.shape[0] - 1) * sample.dy)
             phi = -phi
-        kernel = self._kernel  # type: ignore[attr-defined]
+        kernel = (self._slope_kernel if slope  # type: ignore[attr-defined]
+                  else self._kernel)  # type: ignore[attr-defined]
         if kernel is not None:  # the kernel solve_arrays calls, without its wrapping
             if kernel_law is None:
                 kernel_law = self._kernel_law(self.friction(mu_s) if law is None else law)
@@ -244,6 +267,31 @@ class CreepModel:
                                          friction=law, speed=abs(sample.speed))
             fx, fy, k = f.fx, f.fy, f.slip_fraction
         return (-fx, -fy, k) if reverse else (fx, fy, k)
+
+    @property
+    def has_slope(self) -> bool:
+        """Whether :meth:`slope` is the march's own derivative (MAE solvers), not a difference."""
+        return self._slope_kernel is not None  # type: ignore[attr-defined]
+
+    def slope(self, samples: Sequence[ContactSample], mu_s: float) -> FloatArray:
+        """Return ``d/dmu_s`` of :meth:`predict` (N): the march's derivative (:attr:`has_slope`).
+
+        The steady sweep differentiated (tangent-linear FastSim,
+        :func:`fastsim_ros.contact.kernels.sweep_mu_slope`): one march per
+        contact, where a forward difference needs a second solve.
+        """
+        if not self.has_slope:
+            raise InvalidInputError("the slope in mu_s is the MAE solvers' only")
+        if not samples:
+            raise InvalidInputError("no contact sample to differentiate")
+        code, prm, _, slip_dependent = self._law_template  # type: ignore[attr-defined]
+        kernel_law = (code, prm, float(_positive_mu(mu_s)), slip_dependent)
+        total = [0.0] * len(samples[0].projection)
+        for s in samples:
+            dfx, dfy, _ = self._solve(s, mu_s, None, kernel_law, slope=True)
+            for i, (px, py) in enumerate(s.projection):
+                total[i] += float(px) * dfx + float(py) * dfy
+        return np.array(total)
 
     def predict(self, samples: Sequence[ContactSample], mu_s: float) -> FloatArray:
         """Return the measured components' model values (N): ``sum projection @ (Fx, Fy)``."""
