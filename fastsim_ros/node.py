@@ -22,6 +22,7 @@ from __future__ import annotations
 import gc
 import importlib
 import math
+import signal
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -347,15 +348,35 @@ class _FrontEnd:
                                          f"{outcome.status}: {outcome.detail}")
             return
         pubs = self._pubs
-        for topic, data in self.pipeline.messages(outcome, self._wanted):
-            pubs[topic].publish(data)
+        try:
+            for topic, data in self.pipeline.messages(outcome, self._wanted):
+                pubs[topic].publish(data)
+        except _rclpy.RCLError:
+            self._raise_unless_shut_down()
+
+    def _raise_unless_shut_down(self) -> None:
+        """Re-raise a publish's error, unless a signal shut the context down under it.
+
+        SIGINT or SIGTERM shuts the context down from the signal handler, between
+        two statements of a callback: the callback's next publish then fails
+        ("publisher's context is invalid") and rclpy's executor would log the
+        error with its traceback as FATAL before ``main`` ends the spin.  That
+        publish is the shutdown's, not a fault: the message is dropped, as it
+        would have been a moment later.
+        """
+        node: Node = self  # type: ignore[assignment]
+        if node.context.ok():
+            raise
 
     def _publish_diagnostics(self) -> None:
         if not self._active or self._diagnostics is None:
             return
         node: Node = self  # type: ignore[assignment]
-        self._diagnostics.publish(self.pipeline.diagnostics(
-            node.get_clock().now().nanoseconds, self.connections()))
+        try:
+            self._diagnostics.publish(self.pipeline.diagnostics(
+                node.get_clock().now().nanoseconds, self.connections()))
+        except _rclpy.RCLError:
+            self._raise_unless_shut_down()
 
     def _set_running(self, changes: list[Parameter]) -> SetParametersResult:
         """Check and apply parameter changes to the running pipeline."""
@@ -523,6 +544,26 @@ def main_lifecycle(args: Sequence[str] | None = None) -> int:
 
 def _run(make: Callable[[], Node], program: str, args: Sequence[str] | None) -> int:
     """Build a node, spin it until a signal, always destroy it and shut down."""
+    # SIGINT: rclpy's handler (installed by init) shuts the context down, then calls the
+    # handler it found, Python's, which raises KeyboardInterrupt wherever the main thread
+    # is: inside a callback, rclpy's executor logs it as FATAL with a traceback.  While
+    # spinning the shut-down context alone ends the loop, so Python's handler is quiet
+    # there; before (a cold kernel compile, a table build) it still interrupts.
+    spinning = [False]
+
+    def on_sigint(signum: int, frame: Any) -> None:
+        if not spinning[0]:
+            raise KeyboardInterrupt
+    previous = signal.signal(signal.SIGINT, on_sigint)
+    try:
+        return _run_node(make, program, args, spinning)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _run_node(make: Callable[[], Node], program: str, args: Sequence[str] | None,
+              spinning: list[bool]) -> int:
+    """:func:`_run` with Python's SIGINT handler in place (``spinning``: set while spinning)."""
     try:
         rclpy.init(args=list(args) if args is not None else None)
     except _rclpy.RCLError as e:  # malformed --ros-args: rcl says why
@@ -542,6 +583,7 @@ def _run(make: Callable[[], Node], program: str, args: Sequence[str] | None) -> 
         # spin_once in a loop, not spin(): the events executor's spin() neither
         # runs Python timers nor returns on SIGTERM in this rclpy; spin_once
         # raises ExternalShutdownException once the signal shut the context down
+        spinning[0] = True
         while rclpy.ok():
             executor.spin_once(timeout_sec=0.25)
     except (KeyboardInterrupt, ExternalShutdownException):
