@@ -68,7 +68,7 @@ def cycle_runner(estimation: str, differenced: bool = False):
     pipe = Pipeline(PipelineConfig.from_values(
         {"contacts": ["left", "right"], "friction_estimation": estimation}))
     if differenced:
-        object.__setattr__(pipe._creep_model, "_slope_kernel", None)
+        object.__setattr__(pipe._creep_model, "_marched_slope", False)
     area = samples.flange_root_patch(cells=30)
     twist = cdr(rolling_twist(4e-3))
     measured = wrench(-2.0e4)
@@ -103,14 +103,15 @@ def main() -> None:
         solver.solve_arrays(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0,
                             0.3)
     direct = CreepModel(solver)._kernel  # type: ignore[attr-defined]
-    march = CreepModel(solver)._slope_kernel  # type: ignore[attr-defined]
+    march = CreepModel(solver)._kernel  # type: ignore[attr-defined]
     law = CreepModel._kernel_law(friction_law("constant", 0.3))
 
     def kernel() -> None:
         direct(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, law, 20.0)
 
     def slope() -> None:
-        march(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, law, 20.0)
+        march(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, law, 20.0,
+              True)
     times = per_call({"cycle, estimation off": off, "cycle, estimation on": on,
                       "on, slopes differenced": differenced, "one solve_arrays": solve,
                       "one kernel call": kernel, "one slope kernel call": slope}, args.calls)

@@ -305,6 +305,24 @@ _NO_STATE = np.zeros((0, 0))
 
 
 @njit(cache=True, error_model="numpy")
+def strip_rates(y0, dy, xi, eta, phi, flex, y_s, yp, rate_x, rate_y0, rate_yx, yr, w_x):
+    """Fill each strip's constants of the march (the same for the sweep and its slope).
+
+    ``rate_x``, ``rate_y0``, ``rate_yx`` (Pa/m, Pa/m^2 for the last): the
+    constant parts of the strip's rates, grouped as the reference does;
+    ``yr`` (m): the strip's ``y - yp``; ``w_x`` (1): the rigid slip per unit
+    rolling distance along ``x`` (the rigid-slip return's).
+    """
+    for j in range(len(rate_x)):
+        y = y0 + dy * j
+        rate_x[j] = xi / flex[0, j] - phi * (y - y_s) / flex[3, j]
+        rate_y0[j] = eta / flex[1, j]
+        rate_yx[j] = phi / flex[2, j]
+        yr[j] = y - yp
+        w_x[j] = xi - phi * (y - y_s)
+
+
+@njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
           law, prm, speed, out_x, out_y, slip, store, rigid):
     """March every strip from its leading edge; return ``(Fx, Fy, Mz, slipping, in contact)``.
@@ -391,19 +409,11 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     first = np.zeros(ny, dtype=np.int64)
     # slip-dependent laws: strip j's friction ratio in its last cell if that one slipped, else 1
     level = np.ones(ny)
-    for j in range(ny):
-        y = y0 + dy * j
-        # constant part of the strip's rates (Pa/m), grouped as the reference does
-        rate_x[j] = xi / flex[0, j] - phi * (y - y_s) / flex[3, j]
-        rate_y0[j] = eta / flex[1, j]
-        rate_yx[j] = phi / flex[2, j]
-        yr[j] = y - yp
-        # the rigid slip per unit rolling distance along x (for the rigid-slip return)
-        w_x[j] = xi - phi * (y - y_s)
-        sx[j] = 0.0
-        sy[j] = 0.0
-        sm[j] = 0.0
-        cont[j] = -2
+    strip_rates(y0, dy, xi, eta, phi, flex, y_s, yp, rate_x, rate_y0, rate_yx, yr, w_x)
+    sx[:] = 0.0
+    sy[:] = 0.0
+    sm[:] = 0.0
+    cont[:] = -2
     if store:
         out_x[:, :] = 0.0
         out_y[:, :] = 0.0
@@ -690,21 +700,10 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
     tx, ty, dtx, dty, sx, sy, sm, dsx, dsy = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8]
     rate_x, rate_y0, rate_yx, yr, w_x, dlevel = w[9], w[10], w[11], w[12], w[13], w[14]
     level = np.ones(ny)
-    cont = np.empty(ny, dtype=np.int64)
-    for j in range(ny):
-        y = y0 + dy * j
-        rate_x[j] = xi / flex[0, j] - phi * (y - y_s) / flex[3, j]
-        rate_y0[j] = eta / flex[1, j]
-        rate_yx[j] = phi / flex[2, j]
-        yr[j] = y - yp
-        w_x[j] = xi - phi * (y - y_s)
-        sx[j] = 0.0
-        sy[j] = 0.0
-        sm[j] = 0.0
-        dsx[j] = 0.0
-        dsy[j] = 0.0
-        dlevel[j] = 0.0
-        cont[j] = -2
+    cont = np.full(ny, -2, dtype=np.int64)
+    strip_rates(y0, dy, xi, eta, phi, flex, y_s, yp, rate_x, rate_y0, rate_yx, yr, w_x)
+    w[4:9] = 0.0  # sx, sy, sm, dsx, dsy
+    dlevel[:] = 0.0
     nslip = 0
     ncontact = 0
     v_full = speed / dx
@@ -1385,6 +1384,12 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, law, prm,
 
 
 @njit(cache=True, error_model="numpy")
+def creepages_at_s(geo, xi, eta, phi, xp, yp):
+    """Return ``(xi_s, eta_s)``: the creepages about ``(xp, yp)`` moved to ``S = (x_c, y_s)``."""
+    return xi + phi * (yp - geo[G_YS]), eta - phi * (xp - geo[G_XC])
+
+
+@njit(cache=True, error_model="numpy")
 def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, phi, xp, yp,
               law, prm, speed, out_x, out_y, slip, store, rigid):
     """MAE step 7: FastSim with each zone's ``L``'s, creepages moved to ``S = (x_c, y_s)``.
@@ -1394,13 +1399,43 @@ def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, 
     """
     x_c = geo[G_XC]
     y_s = geo[G_YS]
-    xi_s = xi + phi * (yp - y_s)
-    eta_s = eta - phi * (xp - x_c)
+    xi_s, eta_s = creepages_at_s(geo, xi, eta, phi, xp, yp)
     if parabolic:
         return sweep(bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s,
                      xp, yp, law, prm, speed, out_x, out_y, slip, store, rigid)
     return sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
                  law, prm, speed, out_x, out_y, slip, store, rigid)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic, shear_modulus,
+              knots, polys, calibrated, pair_knots, pair_values):
+    """MAE steps 1-6 of one solve: the inputs checked, the zones, flexibilities and bound.
+
+    Return ``(status, info, geo, env, flex, bound)``: :func:`mae_prepare`'s
+    geometry and column envelopes, :func:`mae_strip_flexibility`'s strip
+    flexibilities and, with ``parabolic``, the parabolic bound (Pa; else an
+    empty array: the given bound ``mu p`` is applied in the sweep).  The
+    arrays are only filled where ``status`` is ``OK``.
+    """
+    ny, nx = p.shape
+    geo = np.empty(GEO_SIZE)
+    env = np.empty((2, nx), dtype=np.int64)
+    flex = np.empty((4, ny))
+    bound = np.empty((ny, nx) if parabolic else (0, 0))
+    status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
+    info = 0.0
+    if status != OK:
+        return status, info, geo, env, flex, bound
+    strips = np.empty((3, ny), dtype=np.int64)
+    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
+                               strips, calibrated, pair_knots, pair_values)
+    if status != OK:
+        return status, info, geo, env, flex, bound
+    if parabolic:
+        parabolic_bound(p, dx, dy, mu, geo[G_LOAD], bound)
+    mae_strip_flexibility(geo, flex)
+    return OK, 0.0, geo, env, flex, bound
 
 
 @njit(cache=True, error_model="numpy")
@@ -1418,23 +1453,11 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     the pair factors ``pair_values`` ``(4, n, n)`` on the nodes
     ``pair_knots`` (``log(a/b)``); else the paper's (those arrays unread).
     """
-    status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
-    if status != OK:
-        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
-    ny, nx = p.shape
-    geo = np.empty(GEO_SIZE)
-    env = np.empty((2, nx), dtype=np.int64)
-    strips = np.empty((3, ny), dtype=np.int64)
-    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
-                               strips, calibrated, pair_knots, pair_values)
+    status, info, geo, env, flex, bound = mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp,
+                                                    rule, parabolic, shear_modulus, knots,
+                                                    polys, calibrated, pair_knots, pair_values)
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
-    # the given bound is mu p, applied in the sweep: no array for it
-    bound = np.empty((ny, nx) if parabolic else (0, 0))
-    if parabolic:
-        parabolic_bound(p, dx, dy, mu, geo[G_LOAD], bound)
-    flex = np.empty((4, ny))
-    mae_strip_flexibility(geo, flex)
     fx, fy, mz, nslip, _ = mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex,
                                      xi, eta, phi, xp, yp, law, prm, speed, out_x, out_y,
                                      slip, store, calibrated)
@@ -1453,27 +1476,16 @@ def mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabo
     as :func:`mae_solve`'s.  The zones, flexibilities and the point ``S``
     do not depend on ``mu_s``.
     """
-    status = check_solve_inputs(xi, eta, phi, mu, xp, yp)
-    if status != OK:
-        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, 0.0
-    ny, nx = p.shape
-    geo = np.empty(GEO_SIZE)
-    env = np.empty((2, nx), dtype=np.int64)
-    strips = np.empty((3, ny), dtype=np.int64)
-    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
-                               strips, calibrated, pair_knots, pair_values)
+    status, info, geo, env, flex, bound = mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp,
+                                                    rule, parabolic, shear_modulus, knots,
+                                                    polys, calibrated, pair_knots, pair_values)
     if status != OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, 0.0
-    flex = np.empty((4, ny))
-    mae_strip_flexibility(geo, flex)
-    # as mae_sweep: the creepages moved to S = (x_c, y_s)
+    xi_s, eta_s = creepages_at_s(geo, xi, eta, phi, xp, yp)
     x_c = geo[G_XC]
     y_s = geo[G_YS]
-    xi_s = xi + phi * (yp - y_s)
-    eta_s = eta - phi * (xp - x_c)
+    # as mae_sweep: the finished bound (outer = inner = 1), or mu p applied in the march
     if parabolic:
-        bound = np.empty((ny, nx))
-        parabolic_bound(p, dx, dy, mu, geo[G_LOAD], bound)
         fx, fy, mz, dfx, dfy, nslip, _ = sweep_mu_slope(
             bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
             law, prm, speed, calibrated, mu)

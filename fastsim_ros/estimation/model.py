@@ -150,18 +150,16 @@ class ContactSample(NamedTuple):
         return float(self.pressure.sum()) * self.dx * self.dy
 
 
-Kernel = Callable[..., tuple[float, float, float]]
+def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float, float]] | None:
+    """Return ``solve(p, x0, y0, dx, dy, xi, eta, phi, law, speed, slope)`` for MAE.
 
-
-def _mae_kernel(solver: Solver, bound: str) -> tuple[Kernel, Kernel] | None:
-    """Return ``solve`` and ``slope`` ``(p, x0, y0, dx, dy, xi, eta, phi, law, speed)`` for MAE.
-
-    ``solve -> (Fx, Fy, k)``: the compiled kernel :meth:`MaeSolver.solve_arrays`
-    calls, with the same arguments (bit for bit its forces), without the
-    wrapping the estimator pays per solve (argument checks, the result
-    object).  ``slope -> (dFx/dmu_s, dFy/dmu_s, k)``: the march's own
-    derivative (:func:`fastsim_ros.contact.kernels.sweep_mu_slope`), the
-    EKF's slope.  None for the other solvers.
+    ``slope`` False: ``(Fx, Fy, k)`` from the compiled kernel
+    :meth:`MaeSolver.solve_arrays` calls, with the same arguments (bit for
+    bit its forces), without the wrapping the estimator pays per solve
+    (argument checks, the result object).  ``slope`` True: ``(dFx/dmu_s,
+    dFy/dmu_s, k)``, the march's own derivative
+    (:func:`fastsim_ros.contact.kernels.mae_solve_mu_slope`), the EKF's
+    slope.  None for the other solvers.
     """
     if not isinstance(solver, MaeSolver):
         return None
@@ -173,32 +171,25 @@ def _mae_kernel(solver: Solver, bound: str) -> tuple[Kernel, Kernel] | None:
 
     def solve(p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
               eta: float, phi: float, law: tuple[int, FloatArray, float, bool],
-              speed: float) -> tuple[float, float, float]:
+              speed: float, slope: bool = False) -> tuple[float, float, float]:
         code, prm, mu, slip_dependent = law
         if not p.flags.c_contiguous:
             p = np.ascontiguousarray(p)
-        status, info, fx, fy, _, _, nslip, ncontact = kernels.mae_solve(
-            p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule, parabolic, shear, knots, polys,
-            code, prm, check_speed(speed) if slip_dependent else 0.0, no_float, no_float,
-            no_bool, False, calibrated, pair_knots, pair_values)
-        if status:
-            _raise(status, info, knots)
-        return fx, fy, nslip / ncontact
-
-    def slope(p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
-              eta: float, phi: float, law: tuple[int, FloatArray, float, bool],
-              speed: float) -> tuple[float, float, float]:
-        code, prm, mu, slip_dependent = law
-        if not p.flags.c_contiguous:
-            p = np.ascontiguousarray(p)
-        status, info, _, _, _, _, nslip, ncontact, dfx, dfy = kernels.mae_solve_mu_slope(
-            p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule, parabolic, shear, knots, polys,
-            code, prm, check_speed(speed) if slip_dependent else 0.0, calibrated, pair_knots,
-            pair_values)
-        if status:
-            _raise(status, info, knots)
-        return dfx, dfy, nslip / ncontact
-    return solve, slope
+        v = check_speed(speed) if slip_dependent else 0.0
+        if slope:
+            r = kernels.mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule,
+                                           parabolic, shear, knots, polys, code, prm, v,
+                                           calibrated, pair_knots, pair_values)
+            a, b = r[8], r[9]
+        else:
+            r = kernels.mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule,
+                                  parabolic, shear, knots, polys, code, prm, v, no_float,
+                                  no_float, no_bool, False, calibrated, pair_knots, pair_values)
+            a, b = r[2], r[3]
+        if r[0]:
+            _raise(r[0], r[1], knots)
+        return a, b, r[6] / r[7]
+    return solve
 
 
 @dataclass(frozen=True)
@@ -226,9 +217,9 @@ class CreepModel:
     def __post_init__(self) -> None:
         """Check the bound; keep the compiled MAE kernel's call (None: the solver's own)."""
         check_bound(self.bound)
-        kernel = _mae_kernel(self.solver, self.bound)
-        object.__setattr__(self, "_kernel", kernel[0] if kernel is not None else None)
-        object.__setattr__(self, "_slope_kernel", kernel[1] if kernel is not None else None)
+        object.__setattr__(self, "_kernel", _mae_kernel(self.solver, self.bound))
+        # the march's own slope (the MAE kernels); False: the EKF's forward difference
+        object.__setattr__(self, "_marched_slope", self._kernel is not None)  # type: ignore
         # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
         object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
 
@@ -252,13 +243,12 @@ class CreepModel:
             x0 = -(x0 + (p.shape[1] - 1) * sample.dx)
             y0 = -(y0 + (p.shape[0] - 1) * sample.dy)
             phi = -phi
-        kernel = (self._slope_kernel if slope  # type: ignore[attr-defined]
-                  else self._kernel)  # type: ignore[attr-defined]
+        kernel = self._kernel  # type: ignore[attr-defined]
         if kernel is not None:  # the kernel solve_arrays calls, without its wrapping
             if kernel_law is None:
                 kernel_law = self._kernel_law(self.friction(mu_s) if law is None else law)
             fx, fy, k = kernel(p, x0, y0, sample.dx, sample.dy, sample.xi, sample.eta, phi,
-                               kernel_law, abs(sample.speed))
+                               kernel_law, abs(sample.speed), slope)
         else:
             law = self.friction(mu_s) if law is None else law
             f = self.solver.solve_arrays(p, x0, y0, sample.dx, sample.dy, sample.xi,
@@ -271,7 +261,7 @@ class CreepModel:
     @property
     def has_slope(self) -> bool:
         """Whether :meth:`slope` is the march's own derivative (MAE solvers), not a difference."""
-        return self._slope_kernel is not None  # type: ignore[attr-defined]
+        return bool(self._marched_slope)  # type: ignore[attr-defined]
 
     def slope(self, samples: Sequence[ContactSample], mu_s: float) -> FloatArray:
         """Return ``d/dmu_s`` of :meth:`predict` (N): the march's derivative (:attr:`has_slope`).
