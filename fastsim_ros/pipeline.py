@@ -42,7 +42,9 @@ from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
 from fastsim_ros.estimation.model import model_error
-from fastsim_ros.contact.transient import RESET_REASONS, ContactMemory, TransientSolver
+from fastsim_ros.contact import kernels as contact_kernels
+from fastsim_ros.contact.transient import (RESET_REASONS, ContactMemory, TractionState,
+                                           TransientSolver)
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
 from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist, stamped_doubles,
@@ -313,6 +315,9 @@ _new_patch = _builder(ContactPatch)
 _new_creepage = _builder(Creepage)
 _new_forces = _builder(ContactForces)
 _new_outcome = _builder(Outcome)
+_new_estimate = _builder(FrictionEstimate)
+#: pipeline_kernels.solve_cloud's memory in steady rolling
+_STEADY_MEMORY = np.zeros(fast.MEMORY_SIZE)
 
 
 def _frame_moved(a: ContactFrame | None, b: ContactFrame) -> bool:
@@ -386,6 +391,7 @@ class Pipeline:
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
         self._apply_estimation(config)
+        self._model_error_share = float(config["friction_model_error"])
         # the estimator's measurement model: the configured solver, law shape and bound
         self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
                                        str(config["friction_law"]),
@@ -412,7 +418,7 @@ class Pipeline:
         if key != self._memory_key:
             self._memories = {}
             self._memory_key = key
-        if isinstance(solver, MaeSolver) and not self._tractions and not self._transient:
+        if isinstance(solver, MaeSolver) and not self._tractions:
             code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
             self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
                               solver._knots, solver._polys, code, prm, mu_s,
@@ -570,21 +576,20 @@ class Pipeline:
             ekf.predict((cycle.stamp_ns - self._last_cycle_ns) * 1e-9)
         self._last_cycle_ns = cycle.stamp_ns
         mu = self._mu
-        samples: list[ContactSample] = []
+        solved: list[tuple[ContactPatch, Creepage, ContactForces]] = []
         normal_x = predicted = load = used = adhesion = slope = 0.0
         marched = True  # every contact's slope came with its solve
         for state in self._contacts.values():
-            if state.solved is None:
+            taken = state.solved
+            if taken is None:
                 continue
-            patch, creep, f = state.solved
+            patch, _, f = taken
             ex, ey, ez = patch.frame.axes
             if state.slope is None:
                 marched = False
             else:
                 slope += ex[0] * state.slope[0] + ey[0] * state.slope[1]
-            samples.append(ContactSample(patch.pressure, patch.x0, patch.y0, patch.dx, patch.dy,
-                                         creep.xi, creep.eta, creep.phi, creep.speed,
-                                         ((ex[0], ey[0]),)))
+            solved.append(taken)
             normal_x += ez[0] * f.n
             predicted += ex[0] * f.fx + ey[0] * f.fy
             load += f.n
@@ -593,16 +598,25 @@ class Pipeline:
         utilisation = used / (mu * load) if load > 0.0 else 0.0
         measured = self._measurement(cycle.stamp_ns)
         status = "no_measurement"
-        if measured is not None and samples and load > 0.0:
-            model = self._creep_model
+        if measured is not None and solved and load > 0.0:
+            model, share = self._creep_model, self._model_error_share
+            # the model's samples only where a solve beyond the published one is asked
+            # for (a step of mu seen, a slope the march did not give): most cycles none
+            built: list[list[ContactSample]] = []
+
+            def samples() -> list[ContactSample]:
+                if not built:
+                    built.append([ContactSample(
+                        p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi, c.eta, c.phi, c.speed,
+                        ((p.frame.axes[0][0], p.frame.axes[1][0]),)) for p, c, _ in solved])
+                return built[0]
             try:
-                share = float(self.config["friction_model_error"])
-                step = ekf.update([measured[0] - normal_x],
-                                  lambda m: model.predict(samples, m), load, [predicted],
+                step = ekf.update((measured[0] - normal_x,),
+                                  lambda m: model.predict(samples(), m), load, (predicted,),
                                   model_error(mu, adhesion, share),
-                                  lambda m: model.predict_with_error(samples, m, share)[1],
-                                  (lambda m: [slope] if marched and m == mu
-                                   else model.slope(samples, m)) if model.has_slope
+                                  lambda m: model.predict_with_error(samples(), m, share)[1],
+                                  (lambda m: (slope,) if marched and m == mu
+                                   else model.slope(samples(), m)) if model.has_slope
                                   else None)
                 status = step.status
                 self.estimation_counts["steps"] += int(step.step_seen)
@@ -618,7 +632,7 @@ class Pipeline:
             c = self._compiled
             if c is not None:  # only mu_s (slot 7) depends on mu
                 self._compiled = c[:7] + (self._mu,) + c[8:]
-        return FrictionEstimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
+        return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
         """Return the wheel and rail twists a patch stamped ``stamp_ns`` is solved with.
@@ -686,8 +700,8 @@ class Pipeline:
                 patch, creep, forces, seconds = given
                 stats.add_solve_time(seconds)
             else:
-                done = (self._solve_compiled(cloud, state) if self._compiled is not None
-                        else None)
+                done = (self._solve_compiled(cloud, state, self._memory(contact))
+                        if self._compiled is not None else None)
                 if done is None:  # the Python path: it gives the reason of a rejection
                     converted = patch_from_cloud(cloud, max_cells=self._max_cells)
                     if converted is None:
@@ -733,7 +747,8 @@ class Pipeline:
         self._twist_arrays[what] = (twist, values)
         return values
 
-    def _solve_compiled(self, cloud: Cloud, state: _ContactState) -> tuple[
+    def _solve_compiled(self, cloud: Cloud, state: _ContactState,
+                        memory: ContactMemory | None = None) -> tuple[
             ContactPatch, Creepage, ContactForces, tuple[float, float, float],
             tuple[float, float, float]] | None:
         """Solve a patch on the compiled path; None where the Python path must decide.
@@ -742,10 +757,26 @@ class Pipeline:
         wheelset frame (force, torque about the origin), each to the bit as
         the Python path gives them.  None for an input the Python path may
         reject (or find without contact): it then runs from the start.
+        ``memory``: transient rolling's state, solved from here where it is
+        carried over (no reset rule, the same grid); a reset, a resample or
+        a jump is the Python path's (ContactMemory.solve), a few cycles in a run.
         """
         ny, nx = cloud.height, cloud.width
         if not 0 < ny * nx <= self._max_cells:
             return None
+        mem: np.ndarray = _STEADY_MEMORY
+        state_arrays: tuple[np.ndarray, ...] = fast.NO_STATE
+        if memory is not None:
+            carried = memory.carried(cloud.stamp_ns)
+            if carried is None:
+                return None
+            previous, dt_ns = carried
+            # in the order of pipeline_kernels.MEM_*
+            mem = np.array((1.0, *previous.grid, dt_ns, memory.direction, *previous.force,
+                            float(memory.solver.far_field), memory.solver.solver.nu))
+            state_arrays = (previous.tau_x, previous.tau_y, np.empty((ny, nx)),
+                            np.empty((ny, nx)), np.empty((ny, nx), dtype=np.bool_),
+                            np.empty(contact_kernels.GEO_SIZE))
         try:
             words, row, step, cols = words_of(cloud)
             wheel, rail = self._kinematics(cloud.stamp_ns)
@@ -761,11 +792,23 @@ class Pipeline:
             words, ny, nx, row, step, cols, pressure, frame_out,
             self._twist_array("wheel", wheel), self._twist_array("rail", rail),
             self._min_speed, rule, parabolic, shear_modulus, knots, polys, law, prm, mu,
-            slip_dependent, calibrated, pair_knots, pair_values, self._ekf is not None, result)
+            slip_dependent, calibrated, pair_knots, pair_values,
+            self._ekf is not None and memory is None, result, mem, *state_arrays)
         elapsed = time.perf_counter() - start
         if status != fast.SOLVED:
             return None
-        if self._ekf is not None:  # friction estimation's slope, from the same march
+        if memory is not None:  # ContactMemory.solve's state, kept unless the patch jumped
+            _, _, tau_x, tau_y, _, geo = state_arrays
+            sign = -1.0 if result[fast.SPEED] < 0.0 else 1.0  # the forces of the turned patch
+            new = TractionState(tau_x, tau_y, previous.grid, float(geo[contact_kernels.G_AREA]),
+                                (float(geo[contact_kernels.G_XC]),
+                                 float(geo[contact_kernels.G_YC])),
+                                float(geo[contact_kernels.G_ELLIPSE + 2]),
+                                force=(sign * float(result[fast.FX]),
+                                       sign * float(result[fast.FY])))
+            if not memory.take(cloud.stamp_ns, float(result[fast.SPEED]), new):
+                return None
+        if self._ekf is not None and memory is None:  # estimation's slope, the same march
             state.slope = (float(result[fast.DFX_DMU]), float(result[fast.DFY_DMU]))
         # the adapter's loop and the solve, timed together on this path
         state.stats.add_solve_time(elapsed)

@@ -23,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from fastsim_ros.contact import kernels as contact
+from fastsim_ros.contact import transient
 from msg_adapters import patch_kernels as adapter
 from msg_adapters.patch import GRID_TOLERANCE, MIN_CELL_SIZE, MIN_CONTACT_CELLS
 
@@ -33,6 +34,13 @@ SOLVED, DEFER = 0, 1
  SLIP_FRACTION, FORCE_WS, TORQUE_WS, DFX_DMU, DFY_DMU) = (
     0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20, 23, 24)
 RESULT_SIZE = 25
+#: the indices of :func:`solve_cloud`'s ``memory`` (transient rolling's carried state):
+#: on (1) or steady (0), the state's grid (turned as the patch is when rolling towards -x),
+#: the time since the last solved patch (ns), the last rolling direction (+-1), the last
+#: force (N, turned), the far field on (1) or off (0), the Poisson ratio
+(MEM_ON, MEM_GRID, MEM_DT_NS, MEM_DIRECTION, MEM_FORCE, MEM_FAR_FIELD, MEM_NU) = (
+    0, 1, 5, 6, 7, 9, 10)
+MEMORY_SIZE = 11
 
 
 @njit(cache=True, inline="always")
@@ -54,7 +62,8 @@ def _grid_axis(first, step, worst, n, result, at):
 @njit(cache=True)
 def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, min_speed, rule,
                 parabolic, shear_modulus, knots, polys, law, prm, mu, slip_dependent,
-                calibrated, pair_knots, pair_values, slope, result):
+                calibrated, pair_knots, pair_values, slope, result, memory, prev_x, prev_y,
+                out_x, out_y, slip, geo):
     """Convert one patch cloud, derive its creepages, solve it (MAE + FastSim); no tractions.
 
     ``words .. cols``: the cloud's points as :func:`msg_adapters.patch._words`
@@ -72,6 +81,16 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
     estimation's slope) from the same march
     (:func:`fastsim_ros.contact.kernels.mae_solve_mu_slope`, the forces
     to the bit); else those slots are NaN.
+
+    Transient rolling (``memory[MEM_ON]`` 1): the contact's state carried
+    over, as :meth:`fastsim_ros.contact.transient.ContactMemory.solve` does
+    when none of its reset rules applies: the tractions ``prev_x``,
+    ``prev_y`` (Pa) on the grid ``memory[MEM_GRID:MEM_GRID + 4]``, rolled
+    ``|V| dt`` (:func:`fastsim_ros.contact.transient.mae_rolling_solve`, the
+    same arguments as :meth:`~fastsim_ros.contact.transient.TransientSolver.step`
+    passes); the new state in ``out_x``, ``out_y``, ``slip``, the MAE
+    geometry in ``geo``.  A reversal or another grid (a resample) is
+    :data:`DEFER`: the Python path applies that rule.
     """
     adapter.adapt(words, ny, nx, row, step, cols, pressure, frame)
     cells = int(frame[adapter.CELLS])
@@ -136,7 +155,22 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
     no_float = np.empty((0, 0))
     no_bool = np.empty((0, 0), dtype=np.bool_)
     dfx = dfy = math.nan
-    if slope:
+    if memory[MEM_ON] != 0.0:
+        if math.copysign(1.0, speed) != memory[MEM_DIRECTION]:
+            return DEFER  # reversed: the steady state, the Python path's rule
+        if prev_x.shape[0] != ny or prev_x.shape[1] != nx or memory[MEM_GRID] != sx0 or (
+                memory[MEM_GRID + 1] != sy0 or memory[MEM_GRID + 2] != dx
+                or memory[MEM_GRID + 3] != dy):
+            return DEFER  # another grid: the state resampled, in Python
+        rolled = abs(speed) * memory[MEM_DT_NS] * 1e-9
+        v = abs(speed) if slip_dependent else 0.0
+        far = memory[MEM_FAR_FIELD] != 0.0
+        r = transient.mae_rolling_solve(
+            p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule, parabolic, shear_modulus,
+            knots, polys, law, prm, v, out_x, out_y, slip, calibrated, pair_knots, pair_values,
+            prev_x, prev_y, rolled, geo, memory[MEM_NU], far, memory[MEM_FORCE],
+            memory[MEM_FORCE + 1])
+    elif slope:
         q = contact.mae_solve_mu_slope(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule,
                                        parabolic, shear_modulus, knots, polys, law, prm,
                                        abs(speed) if slip_dependent else 0.0, calibrated,
@@ -179,6 +213,11 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
     return SOLVED
 
 
+#: ``prev_x .. geo`` of :func:`solve_cloud` in steady rolling (not read)
+NO_STATE = (np.empty((0, 0)), np.empty((0, 0)), np.empty((0, 0)), np.empty((0, 0)),
+            np.empty((0, 0), dtype=np.bool_), np.empty(contact.GEO_SIZE))
+
+
 def warm_up() -> None:
     """Compile (or load from numba's disk cache) :func:`solve_cloud` for every words type.
 
@@ -198,4 +237,4 @@ def warm_up() -> None:
                         solver._rule, False, solver.shear_modulus, solver._knots,
                         solver._polys, contact.LAW_CONSTANT, np.zeros(2), 0.3, False, True,
                         solver._pair_knots, solver._pair_values, writeable,
-                        np.empty(RESULT_SIZE))
+                        np.empty(RESULT_SIZE), np.zeros(MEMORY_SIZE), *NO_STATE)

@@ -208,8 +208,28 @@ class CloudReader:
         return cloud
 
 
+_TWIST_HEAD = struct.Struct("<4xiII")
+
+
 def read_twist(buf: bytes | memoryview) -> StampedTwist:
-    """Decode a serialized ``geometry_msgs/TwistStamped``."""
+    """Decode a serialized ``geometry_msgs/TwistStamped`` (also a ``WrenchStamped``: one layout).
+
+    Little-endian CDR with a NUL-terminated frame id (what every ROS 2
+    writer sends) is read with two unpacks; anything else by the general
+    reader, which names what is wrong.
+    """
+    if isinstance(buf, (bytes, bytearray)) and len(buf) >= 16 and buf[:4] == _CDR_LE:
+        sec, nanosec, size = _TWIST_HEAD.unpack_from(buf)
+        # the six doubles start 8-aligned after the string (offsets from byte 4)
+        start = 16 + size + (-(12 + size) % 8)
+        if size > 0 and start + 48 <= len(buf) and buf[15 + size] == 0:
+            try:
+                frame = buf[16:15 + size].decode("utf-8")
+            except UnicodeDecodeError:
+                raise MalformedMessageError("a string that is not UTF-8") from None
+            v = _SIX_DOUBLES["<"].unpack_from(buf, start)
+            return StampedTwist(sec * 1_000_000_000 + nanosec, frame, (v[0], v[1], v[2]),
+                                (v[3], v[4], v[5]))
     r = _Reader(buf)
     stamp = r.stamp_ns()
     frame = r.string()

@@ -51,7 +51,11 @@ def _dot(a: Vec, b: Vec) -> float:
 
 def twist_is_finite(twist: StampedTwist) -> bool:
     """Return whether every component of the twist is finite."""
-    return all(math.isfinite(c) for c in twist.linear + twist.angular)
+    (a, b, c), (d, e, f) = twist.linear, twist.angular
+    # a sum is not finite where a term is not (or it overflows: finite terms
+    # beyond 1e307, no twist's), and one check is cheaper than six
+    return math.isfinite(a + b + c + d + e + f) or all(
+        math.isfinite(v) for v in (a, b, c, d, e, f))
 
 
 def creepages(frame: ContactFrame, wheel: StampedTwist,

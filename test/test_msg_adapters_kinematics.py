@@ -5,6 +5,7 @@ import math
 import pytest
 
 from msg_adapters.cdr import StampedTwist, read_twist
+from msg_adapters.errors import MalformedMessageError
 from msg_adapters.kinematics import creepages
 from msg_adapters.patch import ContactFrame, frame_from_normal
 from ros_messages import WHEEL_RADIUS as R
@@ -120,3 +121,27 @@ def test_twist_cdr_round_trip():
     assert t.stamp_ns == 1_700_000_001_000_000_007
     assert t.frame_id == "wheelset"
     assert t.linear == (1.0, -2.0, 3.5) and t.angular == (0.1, 43.2, -0.2)
+
+
+@pytest.mark.parametrize("frame_id", ["", "w", "wheelset", "rig1/wheelset", "ab", "abcd",
+                                      "abcdefg", "abcdefgh", "r\u00e4der"])
+def test_twist_fast_path_reads_as_the_general_reader(frame_id):
+    # bytes take read_twist's two-unpack path, a memoryview the general reader:
+    # every alignment of the doubles after the frame id must give the same twist
+    msg = twist_msg((1.0, -2.0, 3.5), (0.1, 43.2, -0.2), stamp_ns=1_700_000_001_000_000_007,
+                    frame_id=frame_id)
+    raw = cdr(msg)
+    fast, general = read_twist(raw), read_twist(memoryview(raw))
+    assert fast == general == read_twist(bytearray(raw))
+    assert fast.frame_id == frame_id and fast.stamp_ns == 1_700_000_001_000_000_007
+    assert fast.linear == (1.0, -2.0, 3.5) and fast.angular == (0.1, 43.2, -0.2)
+
+
+def test_twist_fast_path_refuses_what_the_general_reader_refuses():
+    raw = cdr(twist_msg((1.0, 0.0, 0.0), (0.0, 0.0, 0.0), frame_id="wheelset"))
+    with pytest.raises(MalformedMessageError, match="truncated"):
+        read_twist(raw[:-1])
+    bad = bytearray(raw)
+    bad[16] = 0xFF  # the frame id's first byte: not UTF-8
+    with pytest.raises(MalformedMessageError, match="UTF-8"):
+        read_twist(bytes(bad))

@@ -8,6 +8,7 @@ field, on every layout, orientation and setting the compiled path takes,
 and the same rejections where it defers.
 """
 
+import dataclasses
 import math
 
 import numpy as np
@@ -210,3 +211,64 @@ def test_the_fast_builders_make_the_dataclasses_own_instances():
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(built, dataclasses.fields(cls)[0].name, None)
     assert pipeline._new_frame(*cases[0][2]) == frame  # frozen dataclasses compare by value
+
+
+@pytest.mark.parametrize("settings", [
+    {}, {"method": "mae"}, {"traction_bound": "parabolic"},
+    {"friction_law": "exponential", "friction_limit_ratio": 0.4, "friction_decay": 0.6},
+])
+def test_transient_rolling_equals_the_python_path_cycle_for_cycle(settings):
+    """``rolling: transient``: every outcome and the carried state to the bit, every rule met.
+
+    The compiled path solves the cycles that carry the state over; the
+    start, a creepage step, a stamp gap, reverse running (a reversal, then
+    carried in the turned frame), a lifted wheel and its touch-down, the
+    patch on another grid (a resample) and a jump (half the patch gone,
+    then back) go to the Python path, whose ContactMemory rules decide.
+    """
+    fast, slow = pair(rolling="transient", compiled_only=False, **settings)
+    python_solves = []
+    solve = fast._solve
+
+    def counted(*args, **kwargs):
+        python_solves.append(args[0].stamp_ns)
+        return solve(*args, **kwargs)
+    fast._solve = counted
+    area = egg()
+    half = area.pressure.copy()
+    half[:, : area.nx // 2] = 0.0
+    moved = dataclasses.replace(area, dx=area.dx * 1.05)  # cells 5% longer: another grid
+    # (ms, xi, speed, the patch's keywords, area); 2 m/s at 1 kHz: 2 mm a cycle
+    plan = [(0, 5e-4, 2.0, {}, area), (1, 5e-4, 2.0, {}, area)]
+    plan += [(n, 2e-3, 2.0, {}, area) for n in range(2, 8)]
+    plan += [(100, 2e-3, 2.0, {}, area), (101, 1e-3, 2.0, {}, area)]  # a gap
+    plan += [(n, 1e-3, -2.0, {}, area) for n in range(102, 106)]  # reversed, carried
+    plan += [(106, 1e-3, -2.0, {"pressure": np.zeros_like(area.pressure)}, area)]
+    plan += [(n, 1e-3, -2.0, {}, area) for n in range(107, 110)]  # lifted, down again
+    plan += [(n, 1e-3, -2.0, {}, moved) for n in range(110, 113)]  # resampled, carried
+    plan += [(113, 1e-3, -2.0, {"pressure": half}, moved), (114, 1e-3, -2.0, {}, moved)]
+    carried = 0
+    for ms, xi, speed, keywords, grid in plan:
+        stamp = T0 + ms * MS
+        twist((fast, slow), rolling_twist(xi, speed=speed, stamp_ns=stamp))
+        before = len(python_solves)
+        a, b = feed((fast, slow), "left", cloud_msg(grid, stamp_ns=stamp, dtype="<f8",
+                                                    **keywords))
+        same(a, b)
+        carried += len(python_solves) == before and a.status == "solved"
+        m, n = fast._memories["left"], slow._memories["left"]
+        assert (m.state is None) == (n.state is None) and m.counts == n.counts
+        if m.state is not None:
+            assert np.array_equal(m.state.tau_x, n.state.tau_x)
+            assert np.array_equal(m.state.tau_y, n.state.tau_y)
+            assert (m.state.grid, m.state.area, m.state.centroid, m.state.half_length,
+                    m.state.force) == (n.state.grid, n.state.area, n.state.centroid,
+                                       n.state.half_length, n.state.force)
+            assert (m.stamp_ns, m.direction, m.lost) == (n.stamp_ns, n.direction, n.lost)
+    counts = fast._memories["left"].counts
+    assert counts["start"] == 1 and counts["stamp_gap"] == 1 and counts["reversed"] == 1
+    assert counts["lost_contact"] == 1 and counts["resampled"] == 1
+    assert counts["patch_jump"] == 2  # half the patch gone, then back
+    # the Python path solved the resets (a jump after the compiled solve had found it)
+    assert [(s - T0) // MS for s in python_solves] == [0, 100, 102, 107, 110, 113, 114]
+    assert carried == len(plan) - 1 - 7

@@ -548,6 +548,41 @@ class ContactMemory:
             return "reversed"
         return None
 
+    def carried(self, stamp_ns: int) -> tuple[TractionState, int] | None:
+        """Return the state and the time since it (ns) if a patch stamped ``stamp_ns`` carries it.
+
+        What :meth:`solve` does when no reset applies; ``None`` where a rule
+        other than a reversal (which needs the patch's speed) applies.  A
+        compiled caller solves from it (``|V| dt`` rolled) and hands the new
+        state to :meth:`take`.
+        """
+        state, last = self.state, self.stamp_ns
+        if self.lost or state is None or last is None or stamp_ns < last or (
+                stamp_ns - last) * 1e-9 > self.max_gap:
+            return None
+        return state, stamp_ns - last
+
+    def take(self, stamp_ns: int, speed: float, new: TractionState) -> bool:
+        """Keep ``new``, solved from :meth:`carried`'s state; False (nothing kept) if it jumped.
+
+        A jump (another contact than the last) restarts from zero traction:
+        the caller then solves with :meth:`solve`, which finds the jump itself.
+        """
+        assert self.state is not None
+        if self._jumped(self.state, new):
+            return False
+        self._commit(stamp_ns, speed, new, None)
+        return True
+
+    def _commit(self, stamp_ns: int, speed: float, new: TractionState,
+                reason: str | None) -> None:
+        self.state = new
+        if reason is not None:
+            self.counts[reason] += 1
+        self.stamp_ns = int(stamp_ns)
+        self.direction = math.copysign(1.0, speed)
+        self.lost = False
+
     def _jumped(self, old: TractionState, new: TractionState) -> bool:
         """Whether the patch's area or centroid moved beyond the tolerance in one step."""
         tol = self.jump_tolerance
@@ -587,10 +622,5 @@ class ContactMemory:
             forces, new = self.solver.step(None, *args, **kw)  # type: ignore[arg-type]
         elif reason is None and self.solver.resampled:
             reason = "resampled"
-        self.state = new
-        if reason is not None:
-            self.counts[reason] += 1
-        self.stamp_ns = int(stamp_ns)
-        self.direction = math.copysign(1.0, speed)
-        self.lost = False
+        self._commit(stamp_ns, speed, new, reason)
         return forces, reason

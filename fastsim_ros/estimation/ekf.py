@@ -183,7 +183,8 @@ class FrictionEkf:
 
     def predict(self, dt: float) -> None:
         """Advance by ``dt`` seconds: ``P`` grows by ``q dt`` (the total up to ``sigma_max^2``)."""
-        dt = _positive("dt", dt, zero_ok=True)
+        if not (dt >= 0.0 and math.isfinite(dt)):
+            dt = _positive("dt", dt, zero_ok=True)  # raises
         self.variance = min(self.variance + self.process_noise * dt,
                             max(self.sigma_max ** 2 - self.model_bound ** 2, 0.0))
 

@@ -1,0 +1,80 @@
+"""Transient rolling through the pipeline: a rig cycle on the compiled and the Python path.
+
+``rolling: transient`` keeps each contact's traction between cycles
+(:class:`fastsim_ros.contact.transient.ContactMemory`).  Where the state is
+carried over (no reset rule applies, the same grid) the pipeline solves on
+its compiled path (:func:`fastsim_ros.pipeline_kernels.solve_cloud` with the
+memory); the resets stay on the Python path.  Three pipelines, two contacts
+(``left``, ``right``) of the 30-cell flange-root patch, the default method, a
+1 kHz rig at 2 m/s (2 mm rolled a cycle), ``xi = 2e-3``: steady rolling,
+transient on the compiled path, transient on the Python path alone (the
+pipeline before the compiled transient path).  One timed call is one cycle:
+the wheelset twist and both patches as CDR bytes through the pipeline's
+handlers, interleaved in rounds (``bench_fastsim.per_call``).  Prints medians
+and p99 (us), the ratio to steady rolling and the machine line.  About 5 s.
+
+    PYTHONPATH=. .venv/bin/python benchmarks/bench_transient_pipeline.py [--calls 5000]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Callable
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
+
+from bench_estimation import LEFT, PERIOD_NS, RIGHT, T0, stamped  # noqa: E402
+from bench_fastsim import machine, per_call  # noqa: E402
+from ros_messages import cdr, cloud_msg, rolling_twist  # noqa: E402
+
+from fastsim_ros.contact import samples  # noqa: E402
+from fastsim_ros.contact.compiled import warm_up  # noqa: E402
+from fastsim_ros.pipeline import Pipeline, PipelineConfig  # noqa: E402
+
+
+def cycle_runner(rolling: str, *, compiled: bool = True) -> tuple[Callable[[], None], Pipeline]:
+    """Return a function that runs the next rig cycle through a pipeline, and the pipeline."""
+    pipe = Pipeline(PipelineConfig.from_values({"contacts": ["left", "right"],
+                                                "rolling": rolling}))
+    if not compiled:
+        pipe._compiled = None  # the Python path alone
+    area = samples.flange_root_patch(cells=30)
+    twist = cdr(rolling_twist(2e-3, speed=2.0))
+    left = cdr(cloud_msg(area, origin=LEFT, dtype="<f8"))
+    right = cdr(cloud_msg(area, origin=RIGHT, dtype="<f8"))
+    stamp = [T0]
+
+    def run() -> None:
+        stamp[0] += PERIOD_NS
+        t = stamp[0]
+        pipe.on_wheel_twist(bytes(stamped(twist, t)))
+        pipe.on_patch("left", bytes(stamped(left, t)))
+        pipe.on_patch("right", bytes(stamped(right, t)))
+    return run, pipe
+
+
+def main() -> None:
+    """Time a cycle in steady rolling and in transient rolling on both paths."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--calls", type=int, default=5000)
+    args = parser.parse_args()
+    warm_up()
+    runs = {"steady": cycle_runner("steady"), "transient, compiled": cycle_runner("transient"),
+            "transient, Python path": cycle_runner("transient", compiled=False)}
+    times = per_call({name: run for name, (run, _) in runs.items()}, args.calls)
+    print(f"machine: {machine()}")
+    steady = times["steady"][0]
+    for name, (p50, p99) in times.items():
+        print(f"{name:24s} median {p50:8.1f} us   p99 {p99:8.1f} us   {p50 / steady:5.2f}x steady")
+    for name, (_, pipe) in runs.items():
+        if name != "steady":
+            resets = {k: v for k, v in pipe._memories["left"].counts.items() if v}
+            print(f"{name}: resets of the left contact {resets}")
+
+
+if __name__ == "__main__":
+    main()
