@@ -223,8 +223,10 @@ def warm_up() -> None:
 
     The patch's points as float32 or float64, read-only (a view of the
     message's buffer) or writeable (a copy): one specialisation each, as the
-    adapter's :func:`msg_adapters.patch.warm_up`.
+    adapter's :func:`msg_adapters.patch.warm_up`.  Also transient rolling's
+    Python path (its resets), :func:`fastsim_ros.contact.transient.warm_up`.
     """
+    transient.warm_up()
     from fastsim_ros.contact.compiled import CalibratedMaeSolver
     solver = CalibratedMaeSolver(0.28, 8e10)
     cols = np.arange(7, dtype=np.int64)

@@ -66,6 +66,7 @@ Units: SI (m, Pa, N, s; ``phi`` in 1/m).  No ROS, no SciPy.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -624,3 +625,28 @@ class ContactMemory:
             reason = "resampled"
         self._commit(stamp_ns, speed, new, reason)
         return forces, reason
+
+
+def warm_up() -> float:
+    """Compile (or load from the disk cache) the transient kernels on a tiny patch; return s.
+
+    :func:`fastsim_ros.contact.compiled.warm_up` for transient rolling: the
+    steady start and a carried step of each solver, constant and falling
+    friction, so that a node's first transient patch does not pay for the
+    compilation (seconds, cold).
+    """
+    from fastsim_ros.contact.compiled import CalibratedMaeSolver
+    from fastsim_ros.contact.friction import ExponentialFriction
+    start = time.perf_counter()
+    p = np.array([[0.0, 1.0, 2.0, 1.0, 0.0], [1.0, 2.0, 3.0, 2.0, 1.0],
+                  [1.0, 3.0, 4.0, 3.0, 1.0], [1.0, 2.0, 3.0, 2.0, 1.0],
+                  [0.0, 1.0, 2.0, 1.0, 0.0]])
+    grid = (-1.0, -1.0, 0.4, 0.4)
+    falling = ExponentialFriction(0.3, 0.5, 0.5)
+    for solver in (MaeSolver(0.28, 8e10), CalibratedMaeSolver(0.28, 8e10),
+                   EquivalentEllipseSolver(0.28, 8e10)):
+        stepper = TransientSolver(solver)
+        _, state = stepper.step(None, p, *grid, 1e-3, 0.0, 0.1, math.inf, 0.3)
+        stepper.step(state, p, *grid, 2e-3, 0.0, 0.1, 0.4, 0.3)
+        stepper.step(state, p, *grid, 2e-3, 0.0, 0.1, 0.4, friction=falling, speed=10.0)
+    return time.perf_counter() - start
