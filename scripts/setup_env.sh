@@ -40,9 +40,11 @@ for script in fastsim_node fastsim_lifecycle_node fastsim_replay fastsim_contact
 done
 
 # Fill numba's on-disk cache for the installed kernels (a cold compile takes
-# about 18 s; a cached load a fraction of a second), so that the first start
-# of the node reaches its first wrench quickly.  No-op when cached.
+# about 18 s, the node's compiled patch path and transient rolling some 20 s
+# more; a cached load a fraction of a second), so that the first start of the
+# node reaches its first wrench quickly.  No-op when cached.
 (cd / && "$venv/bin/python" -c \
     'from fastsim_ros.contact import compiled; compiled.warm_up()
 from msg_adapters import patch; patch.warm_up()
-from fastsim_ros.replay import batch; batch.warm_up()')
+from fastsim_ros.replay import batch; batch.warm_up()
+from fastsim_ros import pipeline_kernels; pipeline_kernels.warm_up()')
