@@ -181,8 +181,12 @@ def test_tractions_and_the_equivalent_ellipse_stay_on_the_python_path():
 
 
 def test_warm_up_compiles_every_words_type():
+    from fastsim_ros.contact import transient
     pipeline_kernels.warm_up()
     assert len(pipeline_kernels.solve_cloud.signatures) >= 4
+    # transient rolling's resets run its Python path: compiled at start-up, not at the
+    # first transient patch (seconds, cold)
+    assert transient.mae_rolling_solve.signatures and transient.ellipse_rolling_solve.signatures
 
 
 def test_the_fast_builders_make_the_dataclasses_own_instances():
