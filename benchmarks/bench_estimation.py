@@ -24,6 +24,7 @@ from __future__ import annotations
 import argparse
 import struct
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
@@ -59,8 +60,36 @@ def stamped(raw: bytes, stamp_ns: int) -> bytearray:
     return b
 
 
+def rig_cycle(pipe: Pipeline, *, xi: float = 4e-3, speed: float = 20.0,
+              measured: bool = False) -> Callable[[], None]:
+    """Return a function that runs the next 1 kHz rig cycle through ``pipe``.
+
+    The wheelset twist (creepage ``xi`` at ``speed`` m/s), with ``measured``
+    a measured wrench, and both contacts' 30-cell flange-root patches, as
+    CDR bytes with the cycle's stamp (``bytes``, as the node gets them: the
+    patch topics' header parsed once).
+    """
+    area = samples.flange_root_patch(cells=30)
+    twist = cdr(rolling_twist(xi, speed=speed))
+    force = wrench(-2.0e4)
+    left = cdr(cloud_msg(area, origin=LEFT, dtype="<f8"))
+    right = cdr(cloud_msg(area, origin=RIGHT, dtype="<f8"))
+    stamp = [T0]
+
+    def run() -> None:
+        stamp[0] += PERIOD_NS
+        t = stamp[0]
+        # bytes, as rclpy hands a raw subscription's message to the node
+        pipe.on_wheel_twist(bytes(stamped(twist, t)))
+        if measured:
+            pipe.on_measured_wrench(bytes(stamped(force, t)))
+        pipe.on_patch("left", bytes(stamped(left, t)))
+        pipe.on_patch("right", bytes(stamped(right, t)))
+    return run
+
+
 def cycle_runner(estimation: str, differenced: bool = False):
-    """Return a function that runs the next rig cycle through a pipeline.
+    """Return a function that runs the next rig cycle through a pipeline, and the pipeline.
 
     ``differenced``: the estimator's slope a forward difference (a second
     solve per contact), as before the march's derivative.
@@ -69,22 +98,7 @@ def cycle_runner(estimation: str, differenced: bool = False):
         {"contacts": ["left", "right"], "friction_estimation": estimation}))
     if differenced:
         object.__setattr__(pipe._creep_model, "_marched_slope", False)
-    area = samples.flange_root_patch(cells=30)
-    twist = cdr(rolling_twist(4e-3))
-    measured = wrench(-2.0e4)
-    left = cdr(cloud_msg(area, origin=LEFT, dtype="<f8"))
-    right = cdr(cloud_msg(area, origin=RIGHT, dtype="<f8"))
-    stamp = [T0]
-
-    def run() -> None:
-        stamp[0] += PERIOD_NS
-        t = stamp[0]
-        pipe.on_wheel_twist(stamped(twist, t))
-        if estimation == "on":
-            pipe.on_measured_wrench(stamped(measured, t))
-        pipe.on_patch("left", stamped(left, t))
-        pipe.on_patch("right", stamped(right, t))
-    return run, pipe
+    return rig_cycle(pipe, measured=estimation == "on"), pipe
 
 
 def main() -> None:

@@ -21,17 +21,14 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Callable
+from collections.abc import Callable
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
 
-from bench_estimation import LEFT, PERIOD_NS, RIGHT, T0, stamped  # noqa: E402
+from bench_estimation import rig_cycle  # noqa: E402
 from bench_fastsim import machine, per_call  # noqa: E402
-from ros_messages import cdr, cloud_msg, rolling_twist  # noqa: E402
-
-from fastsim_ros.contact import samples  # noqa: E402
 from fastsim_ros.contact.compiled import warm_up  # noqa: E402
 from fastsim_ros.pipeline import Pipeline, PipelineConfig  # noqa: E402
 
@@ -42,19 +39,7 @@ def cycle_runner(rolling: str, *, compiled: bool = True) -> tuple[Callable[[], N
                                                 "rolling": rolling}))
     if not compiled:
         pipe._compiled = None  # the Python path alone
-    area = samples.flange_root_patch(cells=30)
-    twist = cdr(rolling_twist(2e-3, speed=2.0))
-    left = cdr(cloud_msg(area, origin=LEFT, dtype="<f8"))
-    right = cdr(cloud_msg(area, origin=RIGHT, dtype="<f8"))
-    stamp = [T0]
-
-    def run() -> None:
-        stamp[0] += PERIOD_NS
-        t = stamp[0]
-        pipe.on_wheel_twist(bytes(stamped(twist, t)))
-        pipe.on_patch("left", bytes(stamped(left, t)))
-        pipe.on_patch("right", bytes(stamped(right, t)))
-    return run, pipe
+    return rig_cycle(pipe, xi=2e-3, speed=2.0), pipe
 
 
 def main() -> None:
