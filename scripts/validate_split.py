@@ -1,0 +1,240 @@
+#!/usr/bin/env python3
+"""MAE's split rule on patches with a small zone: the evidence, docs/validation_split.md.
+
+MAE assimilates a patch to two semi-ellipses joined along a lateral line,
+the split (``contact/mae.split_face``).  The default rule ``auto`` takes the
+line through the widest strip (``widest_strip``) unless the smaller zone it
+leaves has less than ``rules.MIN_ZONE_SHARE`` (15%) of the area, then the
+line nearest the centroid (``centroid``).  On a patch whose smaller zone sits
+at that share, a row of cells coming or going flips the split, and the force
+jumps (docs/validation_table.md, "The default method's own jumps near zero
+shift").  This script measures, against the exact theory
+(:func:`fastsim_ros.contact.exact.coulomb`), what each rule gives on three
+families of patches whose smaller zone runs from nothing to a third:
+
+1. **the conformal tread patch** of the Manchester benchmark's placement
+   (S1002 on UIC60 1:40, the right wheel, yaw 0, roll 0, 10 kN per wheel,
+   the per-pose path of ``config/profiles_track_table.yaml``): the four
+   shifts of the table report's jump, solved by the default rule; then the
+   patch at -0.476 mm with its wide end's rows trimmed (2, 4, 6 rows: the
+   smaller zone's share falls to nothing), each rule forced;
+2. **two semi-ellipses sharing their join chord** (a = 5 mm, b1 = 8 mm,
+   b2 = 0.04-0.25 b1, Hertz-like pressure, 50 kN), each rule forced;
+3. **an ellipse cut** below ``y = -c b`` (a = 6 mm, b = 8 mm, 50 kN,
+   c = 0-0.6), each rule forced.
+
+Creepages: the tread patch's own (family 1), and 1.5e-3 of xi, of eta, and
+2 1/m of spin alone; mu = 0.3, G = 80 GPa, nu = 0.28 (the benchmark's
+material for family 1).  Errors: the larger of |Fx - Fx_exact|, |Fy -
+Fy_exact| in % of mu N.  About three minutes.
+
+Usage: ``python scripts/validate_split.py``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
+from fastsim_ros.contact import exact, kernels  # noqa: E402
+from fastsim_ros.contact.area import GridArea  # noqa: E402
+from fastsim_ros.contact import area as areas  # noqa: E402
+from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver  # noqa: E402
+from fastsim_ros.geometry import benchmark  # noqa: E402
+from fastsim_ros.geometry.wheelset import Pose  # noqa: E402
+from fastsim_ros.machine import machine  # noqa: E402
+from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
+from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
+from msg_adapters.cdr import StampedTwist  # noqa: E402
+from msg_adapters.profile_msgs import StampedPose, quaternion  # noqa: E402
+
+REPORT = ROOT / "docs" / "validation_split.md"
+CONFIG = ROOT / "config" / "profiles_track_table.yaml"
+MU = 0.3
+RULES = ("widest_strip", "centroid")
+PURE = (("xi", (1.5e-3, 0.0, 0.0)), ("eta", (0.0, 1.5e-3, 0.0)), ("phi", (0.0, 0.0, 2.0)))
+JUMP_SHIFTS = (-0.480e-3, -0.476e-3, -0.472e-3, -0.468e-3)
+
+
+def smaller_share(p: np.ndarray) -> float:
+    """Return the share of the area in the smaller zone the widest strip's split leaves."""
+    count = (p > 0.0).sum(axis=1).astype(np.int64)
+    f = kernels.split_face(count, kernels.RULE_WIDEST_STRIP)
+    share = float(count[:f].sum()) / float(count.sum())
+    return min(share, 1.0 - share)
+
+
+def tread_patches() -> dict[float, tuple[GridArea, tuple[float, float, float]]]:
+    """Return the right wheel's patch and creepages at each shift of the table report's jump."""
+    values = load_params_file(CONFIG)
+    values.update(profile_table=False, shear_modulus=benchmark.SHEAR_MODULUS,
+                  poisson_ratio=benchmark.POISSON, friction_coefficient=MU,
+                  cell_size=benchmark.CELL)
+    pipe = ProfilePipeline(PipelineConfig.from_values(values))
+    out = {}
+    for k, dy in enumerate(JUMP_SHIFTS):
+        stamp = (k + 1) * 1_000_000
+        pose = Pose(dy=dy, yaw=0.0, roll=0.0)
+        twist = wheel_twist(pose, benchmark.SPEED, benchmark.SPEED / 0.46, 0.0, 0.0)
+        pipe.on_wheel_twist(StampedTwist(stamp, twist.frame_id, twist.linear, twist.angular))
+        pipe.on_load(StampedTwist(stamp, "wheelset", (0.0, 0.0, 2.0 * benchmark.LOAD),
+                                  (0.0, 0.0, 0.0)))
+        cycle = pipe.on_pose(StampedPose(stamp, "track", (0.0, dy, 0.0), quaternion(0.0, 0.0)))
+        for o in cycle.outcomes:
+            if o.contact == "right" and o.patch is not None and o.creepage is not None:
+                p = o.patch
+                out[dy] = (GridArea(p.x0, p.y0, p.dx, p.dy, np.array(p.pressure)),
+                           (o.creepage.xi, o.creepage.eta, o.creepage.phi))
+    return out
+
+
+def two_semi_ellipses(ratio: float) -> GridArea:
+    """Return semi-ellipses (a, b1) below and (a, ratio b1) above y = 0, Hertz-like, 50 kN."""
+    a, b1, cell = 5e-3, 8e-3, 0.25e-3
+    b2 = ratio * b1
+    x = -a + cell * (np.arange(int(round(2 * a / cell))) + 0.5)
+    y = cell * (np.arange(-int(np.ceil(b1 / cell)), max(1, int(np.ceil(b2 / cell)))) + 0.5)
+    xx, yy = np.meshgrid(x, y)
+    b = np.where(yy < 0.0, b1, b2)
+    p = np.sqrt(np.clip(1.0 - (xx / a) ** 2 - (yy / b) ** 2, 0.0, None))
+    return GridArea(float(x[0]), float(y[0]), cell, cell, p * 5e4 / (p.sum() * cell * cell))
+
+
+def cut_ellipse(c: float) -> GridArea:
+    """Return a Hertzian ellipse a = 6 mm, b = 8 mm cut below y = -c b, rescaled to 50 kN."""
+    e = areas.ellipse(6e-3, 8e-3, nx=30, ny=40, load=5e4)
+    p = np.array(e.pressure)
+    y = e.y0 + e.dy * np.arange(e.ny)
+    p[y < -c * 8e-3 - 1e-12, :] = 0.0
+    return GridArea(e.x0, e.y0, e.dx, e.dy, p * 5e4 / (p.sum() * e.dx * e.dy))
+
+
+def errors(area: GridArea, creep: tuple[float, float, float], nu: float, g: float,
+           solvers: dict[str, MaeSolver]) -> tuple[dict[str, float], tuple[float, float]]:
+    """Return each solver's error (% of mu N) against the exact theory, and the exact (Fx, Fy)."""
+    n = float(np.asarray(area.pressure).sum() * area.dx * area.dy)
+    ex = exact.coulomb(area, *creep, mu=MU, nu=nu, shear_modulus=g)
+    out = {}
+    for name, solver in solvers.items():
+        f = solver.solve(area, *creep, mu=MU)
+        out[name] = 100.0 * max(abs(f.fx - ex.fx), abs(f.fy - ex.fy)) / (MU * n)
+    return out, (float(ex.fx), float(ex.fy))
+
+
+def forced(nu: float, g: float) -> dict[str, MaeSolver]:
+    """Return the calibrated and the paper's MAE with each rule forced."""
+    out: dict[str, MaeSolver] = {}
+    for rule in RULES:
+        out[f"calibrated, {rule}"] = CalibratedMaeSolver(nu, g, rule=rule)
+    for rule in RULES:
+        out[f"paper's, {rule}"] = MaeSolver(nu, g, rule=rule)
+    return out
+
+
+def table(rows: list[tuple[str, float, str, dict[str, float]]], names: list[str]) -> list[str]:
+    lines = ["| patch | smaller zone's share | creepage | " + " | ".join(names) + " |",
+             "| --- | --- | --- | " + " | ".join("---" for _ in names) + " |"]
+    for patch, share, creep, err in rows:
+        best = {}
+        for method in ("calibrated", "paper's"):
+            keys = [k for k in names if k.startswith(method)]
+            best[method] = min(keys, key=lambda k: err[k])
+        cells = [f"**{err[k]:.1f}**" if k in best.values() else f"{err[k]:.1f}" for k in names]
+        lines.append(f"| {patch} | {share:.3f} | {creep} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def main() -> int:
+    start = time.perf_counter()
+    nu, g = benchmark.POISSON, benchmark.SHEAR_MODULUS
+    lines = ["# MAE's split rule on patches with a small zone", "",
+             "Generated by `scripts/validate_split.py` (its docstring gives the cases); "
+             f"machine: {machine()}.", ""]
+    # 1a. the jump itself: the default rule
+    treads = tread_patches()
+    defaults = {"calibrated (auto)": CalibratedMaeSolver(nu, g),
+                "paper's (auto)": MaeSolver(nu, g)}
+    lines += ["## The jump: the tread patch near zero shift, the default rule", "",
+              "The right wheel's patch of the per-pose path at fixed roll 0 (the table "
+              "report's 'default method's own jumps'), its own creepages; forces in N "
+              "(contact frame), the split `auto` chose (its y, m: the point S).", "",
+              "| dy (mm) | cells | smaller zone's share | split y_s (mm) | exact Fx | "
+              "calibrated Fx | paper's Fx | calibrated error | paper's error |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+    for dy, (area, creep) in treads.items():
+        ex = exact.coulomb(area, *creep, mu=MU, nu=nu, shear_modulus=g)
+        n = float(np.asarray(area.pressure).sum() * area.dx * area.dy)
+        cal = defaults["calibrated (auto)"].solve(area, *creep, mu=MU)
+        pap = defaults["paper's (auto)"].solve(area, *creep, mu=MU)
+        y_s = defaults["calibrated (auto)"].geometry(area).y_s
+        err = [100.0 * max(abs(f.fx - ex.fx), abs(f.fy - ex.fy)) / (MU * n) for f in (cal, pap)]
+        lines.append(f"| {1e3 * dy:.3f} | {int(np.count_nonzero(area.pressure))} | "
+                     f"{smaller_share(np.asarray(area.pressure)):.3f} | {1e3 * y_s:+.2f} | "
+                     f"{ex.fx:.0f} | {cal.fx:.0f} | {pap.fx:.0f} | {err[0]:.1f} | "
+                     f"{err[1]:.1f} |")
+        print(f"jump {dy}: done", flush=True)
+    solvers = forced(nu, g)
+    names = list(solvers)
+    rows: list[tuple[str, float, str, dict[str, float]]] = []
+    area, creep = treads[-0.476e-3]
+    p0 = np.asarray(area.pressure)
+    occupied = np.flatnonzero((p0 > 0.0).sum(axis=1))
+    for trim in (0, 2, 4, 6):
+        p = p0.copy()
+        if trim:
+            p[occupied[-trim]:, :] = 0.0
+        a = GridArea(area.x0, area.y0, area.dx, area.dy, p)
+        for label, c in (("its own", creep), *PURE):
+            err, _ = errors(a, c, nu, g, solvers)
+            rows.append((f"tread, {trim} rows trimmed", smaller_share(p), label, err))
+        print(f"tread trimmed {trim}: done", flush=True)
+    for ratio in (0.04, 0.1, 0.16, 0.25):
+        a = two_semi_ellipses(ratio)
+        for label, c in PURE:
+            err, _ = errors(a, c, 0.28, 8e10, forced(0.28, 8e10))
+            rows.append((f"semi-ellipses, b2 = {ratio:.2f} b1", smaller_share(
+                np.asarray(a.pressure)), label, err))
+        print(f"semi-ellipses {ratio}: done", flush=True)
+    for c_frac in (0.0, 0.2, 0.3, 0.5):
+        a = cut_ellipse(c_frac)
+        for label, c in PURE:
+            err, _ = errors(a, c, 0.28, 8e10, forced(0.28, 8e10))
+            rows.append((f"ellipse cut at -{c_frac:.1f} b", smaller_share(
+                np.asarray(a.pressure)), label, err))
+        print(f"cut ellipse {c_frac}: done", flush=True)
+    lines += ["", "## Each rule forced: error against the exact theory, % of mu N", "",
+              "Bold: the better rule of each method on that row.", ""]
+    lines += table(rows, names)
+    lines += ["", "## What it shows", "",
+              "The jump: the tread patch's smaller zone has 14.0-15.9% of the area at these "
+              "shifts, across the default rule's 15%, and the split moves 4.8 mm with it "
+              "while the exact force moves smoothly. With each rule forced, the calibrated "
+              "MAE is served better by the widest strip's split on every row whose share "
+              "is above nothing but two (by 0.1 and 0.4 points the other way), by 7-10 "
+              "points on the tread's own creepages; on the tread trimmed to a share of "
+              "nothing still on three creepages of four; the centroid's wins on the cut "
+              "ellipse, whose widest strip is its cut edge, by 4-9 points. The paper's MAE "
+              "differs: on the tread patch the centroid's split is its better one on the "
+              "tread's own creepages and under spin (by 2-8 points), the widest strip's "
+              "under pure xi and eta while the share is above nothing (by 0.4-1.8); on the "
+              "semi-ellipses and the cut ellipses under spin the widest strip's by 5-17 "
+              "points. Any threshold on the share leaves a jump where it is crossed; a "
+              "force continuous in the shape needs the two splits' solves blended over a "
+              "band of shares, each method's band set by evidence like this (not built).",
+              "",
+              f"The run took {time.perf_counter() - start:.0f} s.", ""]
+    REPORT.write_text("\n".join(lines))
+    print(f"wrote {REPORT}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
