@@ -481,7 +481,8 @@ def report(r: dict[str, Any]) -> str:
             "end's split and 7.3-7.5% low with the centroid's, the paper's MAE the other way "
             "round (0.9% low, 4% low). A force continuous across the threshold (the two "
             "splits' solves blended over a band of shares, or a threshold set by evidence "
-            "for each method) is not built yet: the evidence for it is `docs/validation_split.md`.",
+            "for each method) is not built yet: the evidence for it is "
+            "`docs/validation_split.md`.",
             "",
             "| dy (mm) | " + " | ".join(f"{1e3 * x['dy']:.3f}" for x in jumps[::2]) + " |",
             "| --- | " + " | ".join("---" for _ in jumps[::2]) + " |",
