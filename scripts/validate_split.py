@@ -46,7 +46,8 @@ from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
 from fastsim_ros.contact import exact, kernels  # noqa: E402
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact import area as areas  # noqa: E402
-from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver  # noqa: E402
+from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,  # noqa: E402
+                                          MaeSolver)
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.wheelset import Pose  # noqa: E402
 from fastsim_ros.machine import machine  # noqa: E402
@@ -117,16 +118,18 @@ def cut_ellipse(c: float) -> GridArea:
     return GridArea(e.x0, e.y0, e.dx, e.dy, p * 5e4 / (p.sum() * e.dx * e.dy))
 
 
-def errors(area: GridArea, creep: tuple[float, float, float], nu: float, g: float,
-           solvers: dict[str, MaeSolver]) -> tuple[dict[str, float], tuple[float, float]]:
-    """Return each solver's error (% of mu N) against the exact theory, and the exact (Fx, Fy)."""
+def error(f: ContactForces, ex: ContactForces, area: GridArea) -> float:
+    """Return the larger of |Fx - Fx_exact|, |Fy - Fy_exact| in % of mu N."""
     n = float(np.asarray(area.pressure).sum() * area.dx * area.dy)
+    return 100.0 * max(abs(f.fx - ex.fx), abs(f.fy - ex.fy)) / (MU * n)
+
+
+def errors(area: GridArea, creep: tuple[float, float, float], nu: float, g: float,
+           solvers: dict[str, MaeSolver]) -> dict[str, float]:
+    """Return each solver's error (% of mu N) against the exact theory."""
     ex = exact.coulomb(area, *creep, mu=MU, nu=nu, shear_modulus=g)
-    out = {}
-    for name, solver in solvers.items():
-        f = solver.solve(area, *creep, mu=MU)
-        out[name] = 100.0 * max(abs(f.fx - ex.fx), abs(f.fy - ex.fy)) / (MU * n)
-    return out, (float(ex.fx), float(ex.fy))
+    return {name: error(solver.solve(area, *creep, mu=MU), ex, area)
+            for name, solver in solvers.items()}
 
 
 def forced(nu: float, g: float) -> dict[str, MaeSolver]:
@@ -171,11 +174,10 @@ def main() -> int:
               "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for dy, (area, creep) in treads.items():
         ex = exact.coulomb(area, *creep, mu=MU, nu=nu, shear_modulus=g)
-        n = float(np.asarray(area.pressure).sum() * area.dx * area.dy)
         cal = defaults["calibrated (auto)"].solve(area, *creep, mu=MU)
         pap = defaults["paper's (auto)"].solve(area, *creep, mu=MU)
         y_s = defaults["calibrated (auto)"].geometry(area).y_s
-        err = [100.0 * max(abs(f.fx - ex.fx), abs(f.fy - ex.fy)) / (MU * n) for f in (cal, pap)]
+        err = [error(f, ex, area) for f in (cal, pap)]
         lines.append(f"| {1e3 * dy:.3f} | {int(np.count_nonzero(area.pressure))} | "
                      f"{smaller_share(np.asarray(area.pressure)):.3f} | {1e3 * y_s:+.2f} | "
                      f"{ex.fx:.0f} | {cal.fx:.0f} | {pap.fx:.0f} | {err[0]:.1f} | "
@@ -193,23 +195,20 @@ def main() -> int:
             p[occupied[-trim]:, :] = 0.0
         a = GridArea(area.x0, area.y0, area.dx, area.dy, p)
         for label, c in (("its own", creep), *PURE):
-            err, _ = errors(a, c, nu, g, solvers)
-            rows.append((f"tread, {trim} rows trimmed", smaller_share(p), label, err))
+            rows.append((f"tread, {trim} rows trimmed", smaller_share(p), label,
+                         errors(a, c, nu, g, solvers)))
         print(f"tread trimmed {trim}: done", flush=True)
-    for ratio in (0.04, 0.1, 0.16, 0.25):
-        a = two_semi_ellipses(ratio)
+    # families 2 and 3: one material, the same solvers
+    material = (0.28, 8e10)
+    shape_solvers = forced(*material)
+    shapes = [(f"semi-ellipses, b2 = {r:.2f} b1", two_semi_ellipses(r))
+              for r in (0.04, 0.1, 0.16, 0.25)]
+    shapes += [(f"ellipse cut at -{c:.1f} b", cut_ellipse(c)) for c in (0.0, 0.2, 0.3, 0.5)]
+    for name, a in shapes:
+        share = smaller_share(np.asarray(a.pressure))
         for label, c in PURE:
-            err, _ = errors(a, c, 0.28, 8e10, forced(0.28, 8e10))
-            rows.append((f"semi-ellipses, b2 = {ratio:.2f} b1", smaller_share(
-                np.asarray(a.pressure)), label, err))
-        print(f"semi-ellipses {ratio}: done", flush=True)
-    for c_frac in (0.0, 0.2, 0.3, 0.5):
-        a = cut_ellipse(c_frac)
-        for label, c in PURE:
-            err, _ = errors(a, c, 0.28, 8e10, forced(0.28, 8e10))
-            rows.append((f"ellipse cut at -{c_frac:.1f} b", smaller_share(
-                np.asarray(a.pressure)), label, err))
-        print(f"cut ellipse {c_frac}: done", flush=True)
+            rows.append((name, share, label, errors(a, c, *material, shape_solvers)))
+        print(f"{name}: done", flush=True)
     lines += ["", "## Each rule forced: error against the exact theory, % of mu N", "",
               "Bold: the better rule of each method on that row.", ""]
     lines += table(rows, names)

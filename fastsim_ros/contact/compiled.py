@@ -443,6 +443,21 @@ class EquivalentEllipseSolver(_Solver):
         return self._ellipse(_readonly(area.pressure), area.x0, area.y0, area.dx, area.dy)
 
 
+def warm_up_case() -> tuple[GridArea, FrictionLaw,
+                            tuple[MaeSolver, CalibratedMaeSolver, EquivalentEllipseSolver]]:
+    """Return what the warm-ups solve: a tiny patch, a falling law and each solver.
+
+    The kernels compile once per argument type, not per size: a 5 x 5 patch
+    compiles what a rig's 30 x 30 ones run.
+    """
+    area = GridArea(-1.0, -1.0, 0.4, 0.4, np.array(
+        [[0.0, 1.0, 2.0, 1.0, 0.0], [1.0, 2.0, 3.0, 2.0, 1.0], [1.0, 3.0, 4.0, 3.0, 1.0],
+         [1.0, 2.0, 3.0, 2.0, 1.0], [0.0, 1.0, 2.0, 1.0, 0.0]]))
+    return area, ExponentialFriction(0.3, 0.5, 0.5), (
+        MaeSolver(0.28, 8e10), CalibratedMaeSolver(0.28, 8e10),
+        EquivalentEllipseSolver(0.28, 8e10))
+
+
 def warm_up() -> float:
     """Compile (or load from the disk cache) every kernel on a tiny patch; return seconds.
 
@@ -450,13 +465,9 @@ def warm_up() -> float:
     compilation.
     """
     start = time.perf_counter()
-    area = GridArea(-1.0, -1.0, 0.4, 0.4, np.array(
-        [[0.0, 1.0, 2.0, 1.0, 0.0], [1.0, 2.0, 3.0, 2.0, 1.0], [1.0, 3.0, 4.0, 3.0, 1.0],
-         [1.0, 2.0, 3.0, 2.0, 1.0], [0.0, 1.0, 2.0, 1.0, 0.0]]))
+    area, falling, solvers = warm_up_case()
     creep = np.array([[1e-3, 0.0, 0.1], [0.0, -1e-3, 0.0]])
-    falling = ExponentialFriction(0.3, 0.5, 0.5)
-    for solver in (MaeSolver(0.28, 8e10), CalibratedMaeSolver(0.28, 8e10),
-                   EquivalentEllipseSolver(0.28, 8e10)):
+    for solver in solvers:
         solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3)
         solver.solve(area, 1e-3, 0.0, 0.0, mu=0.3, tractions=True)
         solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, creep, mu=0.3)

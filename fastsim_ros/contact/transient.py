@@ -76,7 +76,7 @@ from numpy.typing import ArrayLike, NDArray
 from fastsim_ros.contact import kernels as k
 from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (ContactForces, EquivalentEllipseSolver, MaeSolver,
-                                          _law, _pressure, _raise)
+                                          _law, _pressure, _raise, warm_up_case)
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw
 
@@ -635,16 +635,10 @@ def warm_up() -> float:
     friction, so that a node's first transient patch does not pay for the
     compilation (seconds, cold).
     """
-    from fastsim_ros.contact.compiled import CalibratedMaeSolver
-    from fastsim_ros.contact.friction import ExponentialFriction
     start = time.perf_counter()
-    p = np.array([[0.0, 1.0, 2.0, 1.0, 0.0], [1.0, 2.0, 3.0, 2.0, 1.0],
-                  [1.0, 3.0, 4.0, 3.0, 1.0], [1.0, 2.0, 3.0, 2.0, 1.0],
-                  [0.0, 1.0, 2.0, 1.0, 0.0]])
-    grid = (-1.0, -1.0, 0.4, 0.4)
-    falling = ExponentialFriction(0.3, 0.5, 0.5)
-    for solver in (MaeSolver(0.28, 8e10), CalibratedMaeSolver(0.28, 8e10),
-                   EquivalentEllipseSolver(0.28, 8e10)):
+    area, falling, solvers = warm_up_case()
+    p, grid = area.pressure, (area.x0, area.y0, area.dx, area.dy)
+    for solver in solvers:
         stepper = TransientSolver(solver)
         _, state = stepper.step(None, p, *grid, 1e-3, 0.0, 0.1, math.inf, 0.3)
         stepper.step(state, p, *grid, 2e-3, 0.0, 0.1, 0.4, 0.3)
