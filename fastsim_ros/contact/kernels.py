@@ -322,6 +322,78 @@ def strip_rates(y0, dy, xi, eta, phi, flex, y_s, yp, rate_x, rate_y0, rate_yx, y
         w_x[j] = xi - phi * (y - y_s)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, wxh, wyh, l1, l2):
+    """Project the trial traction ``(t_x, t_y)`` (Pa) of one step on the bound ``g`` (Pa).
+
+    The march's slip test and return, one place for the steady march's cell
+    step and a transient path's sub-steps (:func:`rolling_sweep`), so that
+    both march alike.  ``(p_x, p_y)``: the traction before the step (Pa);
+    ``lev``: the particle's friction ratio on its last step (1 if it stuck;
+    slip-dependent laws: the kinetic level is ``g lev``); ``step``: the
+    distance rolled in the step (m), ``vs``: ``|V| / step`` (1/s);
+    ``rigid``: the rigid-slip return with the rigid slip ``(wxh, wyh)``
+    over the step (m) and the strip's flexibilities ``l1``, ``l2`` (m/Pa),
+    else the radial return.  Return
+    ``(tau_x, tau_y, slipped, ratio)``, the ratio the particle's friction
+    ratio after the step (1 where it stuck or the law is constant).
+    """
+    m2 = t_x * t_x + t_y * t_y
+    if law == LAW_CONSTANT:
+        if not m2 <= _NO_SLIP * g * g:
+            # clearly over the bound: the rigid-slip return needs no |t*|
+            if rigid and m2 > _CLEARLY_OVER * g * g:
+                mag = g + g
+            else:
+                mag = math.sqrt(m2)
+                if abs(mag - g) <= _ON_BOUND * g:
+                    mag = math.hypot(t_x, t_y)
+            if mag > g:
+                done = False
+                if rigid:
+                    r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh, l1, l2, g)
+                    if done:
+                        return r_x, r_y, True, 1.0
+                if rigid:
+                    # the return declined: the radial return, with the true |t*|
+                    mag = math.sqrt(m2)
+                scale = g / mag
+                return t_x * scale, t_y * scale, True, 1.0
+        return t_x, t_y, False, 1.0
+    # the kinetic level: static bound times the particle's last friction ratio
+    gk = g * lev
+    if not m2 <= _NO_SLIP * gk * gk:
+        mag = math.sqrt(m2)
+        if abs(mag - gk) <= _ON_BOUND * gk:
+            mag = math.hypot(t_x, t_y)
+        if mag > gk:
+            # slip velocity at that level: |V| |L t*| (|t*| - gk) / (|t*| step)
+            inv = 1.0 / mag
+            lx = l1 * t_x
+            ly = l2 * t_y
+            done = False
+            r_x = 0.0
+            r_y = 0.0
+            k = 1.0
+            if rigid:
+                r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh, l1, l2, gk)
+                if done:
+                    # the slip at the kinetic level: |w h + L (tau_k - tau_p)| / h
+                    s_x = wxh + l1 * (r_x - p_x)
+                    s_y = wyh + l2 * (r_y - p_y)
+                    k = law_ratio(law, prm, speed * math.sqrt(s_x * s_x + s_y * s_y) / step)
+            if not done:
+                k = law_ratio(law, prm, vs * math.sqrt(lx * lx + ly * ly) * ((mag - gk) * inv))
+            r = g * k
+            if r < mag:
+                if done:
+                    scale = r / gk
+                    return r_x * scale, r_y * scale, True, k
+                scale = r * inv
+                return t_x * scale, t_y * scale, True, k
+    return t_x, t_y, False, 1.0
+
+
 @njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
           law, prm, speed, out_x, out_y, slip, store, rigid):
@@ -350,11 +422,14 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     march's (``rolled = inf`` is the steady state, :func:`sweep`).
     Elsewhere its trial traction is the previous state ``prev_x``,
     ``prev_y`` (Pa, shape of ``shape``) interpolated linearly along the strip
-    at ``x + rolled`` (zero at the segment's front face), minus the rigid
-    slip over ``rolled`` divided by ``L`` (``phi x`` at the middle of the
-    step), and the same projection on the bound follows, with the step
-    ``h = rolled``.  ``shift_x``, ``shift_y`` (m): the elastic shift of the
-    whole patch over the step (:mod:`fastsim_ros.contact.transient`, the
+    at ``x + rolled`` (zero at the segment's front face), marched from
+    there to ``x`` in steps of at most a cell: each step subtracts the rigid
+    slip over it divided by ``L`` (``phi x`` at the step's middle) and is
+    projected on the bound where the particle then is with the steady
+    march's own projection (:func:`project`), so that with ``rolled`` a
+    whole number of cells the steady state is a fixed point of the steps.
+    ``shift_x``, ``shift_y`` (m): the elastic shift of the whole patch over
+    the step (:mod:`fastsim_ros.contact.transient`, the
     half-space's far field ``M dF``), added to the rigid slip of the cells
     that were in the contact before the step (zero: Kalker's local model).
     A cell that entered during the step, ``d`` (m) from the front face,
@@ -438,6 +513,10 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     # slip-dependent laws: |V| per metre of a full step and of a segment's first half step
     v_full = speed / dx
     v_half = speed / half
+    # slip-dependent laws over marched paths: each cell's friction ratio in this sweep (a
+    # path's start reads it)
+    kinetic = law != LAW_CONSTANT and rolled > dx and rolled < math.inf
+    kin = np.ones((ny, nx) if kinetic else (1, 1))
     for i in range(nx - 1, -1, -1):
         x = x0 + dx * i
         x_rel = x - x_c
@@ -462,6 +541,7 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
             cont[j] = i - 1
             g_x = 0.0
             g_y = 0.0
+            lev = level[j]
             if far and dist[j] <= rolled:
                 # entered during the step: the far field's increment over this cell's march
                 n = int((dist[j] - half) / dx + 0.5)
@@ -497,109 +577,55 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                     t_x = w0 * prev_x[j, iu]
                     t_y = w0 * prev_y[j, iu]
                 if rolled > dx:
-                    # a particle that slips on its way from x + h: the slip's direction follows
-                    # the local rigid slip (spin turns it along the path), so the path is
-                    # marched in steps of at most a cell, each projected on the bound where
-                    # the particle is, as the steady march does; the last step is the cell's
-                    o_x = t_x - rate_x[j] * rolled - g_x / flex[0, j]
-                    o_y = (t_y - (rate_y0[j] + rate_yx[j] * (x_rel + 0.5 * rolled)) * rolled
-                           - g_y / flex[1, j])
-                    if o_x * o_x + o_y * o_y > g * g:
-                        nsub = int(math.ceil(rolled / dx - 1e-9))
-                        s = rolled / nsub
-                        g_x = g_x / nsub
-                        g_y = g_y / nsub
-                        for m in range(nsub - 1):
-                            x_m = x_rel + rolled - (m + 0.5) * s
-                            t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
-                            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_m) * s - g_y / flex[1, j]
-                            ic = min(i + int((rolled - (m + 1) * s) / dx + 0.5), nx - 1)
-                            g_m = outer * (shape[j, ic] * inner)
-                            m2 = t_x * t_x + t_y * t_y
-                            if not g_m > 0.0:
-                                t_x = 0.0
-                                t_y = 0.0
-                            elif m2 > g_m * g_m:
-                                scale = g_m / math.sqrt(m2)
-                                t_x = t_x * scale
-                                t_y = t_y * scale
+                    # the particle's path from x + h, marched in steps of at most a cell, each
+                    # projected on the bound where the particle is, as the steady march does
+                    # (the slip's direction follows the local rigid slip, which spin turns
+                    # along the path; one projection over a long step took the path's mean):
+                    # with h a whole number of cells the steady state is then a fixed point
+                    # of the steps exactly; the last step is the cell's own
+                    nsub = int(math.ceil(rolled / dx - 1e-9))
+                    s = rolled / nsub
+                    g_x = g_x / nsub
+                    g_y = g_y / nsub
+                    v_sub = speed / s
+                    lev = 1.0
+                    if kinetic:
+                        # the particle's friction ratio where it starts, this sweep's there
+                        start = i + int(f + 0.5)
+                        if start <= first[j]:
+                            lev = kin[j, start]
+                    for m in range(nsub - 1):
+                        ic = min(i + int((rolled - (m + 1) * s) / dx + 0.5), nx - 1)
+                        g_m = outer * (shape[j, ic] * inner)
+                        if not g_m > 0.0:
+                            # off the contact on its way: no traction carried on
+                            t_x = 0.0
+                            t_y = 0.0
+                            lev = 1.0
+                            continue
+                        x_m = x_rel + rolled - (m + 0.5) * s
+                        p_x = t_x
+                        p_y = t_y
+                        t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
+                        t_y = t_y - (rate_y0[j] + rate_yx[j] * x_m) * s - g_y / flex[1, j]
+                        t_x, t_y, _, lev = project(
+                            t_x, t_y, p_x, p_y, g_m, lev, law, prm, speed, s, v_sub, rigid,
+                            w_x[j] * s + g_x, (eta + phi * (x_m - 0.5 * s)) * s + g_y,
+                            flex[0, j], flex[1, j])
             x_mid = x_rel + 0.5 * s
             p_x = t_x
             p_y = t_y
             t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
             t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s - g_y / flex[1, j]
-            over = False
-            m2 = t_x * t_x + t_y * t_y
-            if law == LAW_CONSTANT:
-                if not m2 <= _NO_SLIP * g * g:
-                    # clearly over the bound: the rigid-slip return needs no |t*|
-                    if rigid and m2 > _CLEARLY_OVER * g * g:
-                        mag = g + g
-                    else:
-                        mag = math.sqrt(m2)
-                        if abs(mag - g) <= _ON_BOUND * g:
-                            mag = math.hypot(t_x, t_y)
-                    if mag > g:
-                        done = False
-                        if rigid:
-                            r_x, r_y, done = rigid_slip_return(
-                                p_x, p_y, w_x[j] * s + g_x, (eta + phi * x_rel) * s + g_y,
-                                flex[0, j], flex[1, j], g)
-                            if done:
-                                t_x = r_x
-                                t_y = r_y
-                        if not done:
-                            if rigid:
-                                # the return declined: the radial return, with the true |t*|
-                                mag = math.sqrt(m2)
-                            scale = g / mag
-                            t_x = t_x * scale
-                            t_y = t_y * scale
-                        over = True
-                        nslip += 1
-            else:
-                # the kinetic level: static bound times the upstream cell's friction ratio
-                gk = g * level[j]
-                if not m2 <= _NO_SLIP * gk * gk:
-                    mag = math.sqrt(m2)
-                    if abs(mag - gk) <= _ON_BOUND * gk:
-                        mag = math.hypot(t_x, t_y)
-                    if mag > gk:
-                        # slip velocity at that level: |V| |L t*| (|t*| - gk) / (|t*| step)
-                        inv = 1.0 / mag
-                        lx = flex[0, j] * t_x
-                        ly = flex[1, j] * t_y
-                        vs = v_full if s == dx else (v_half if s == half else speed / s)
-                        done = False
-                        if rigid:
-                            wxh = w_x[j] * s + g_x
-                            wyh = (eta + phi * x_rel) * s + g_y
-                            r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh,
-                                                               flex[0, j], flex[1, j], gk)
-                            if done:
-                                # the slip at the kinetic level: |w h + L (tau_k - tau_p)| / h
-                                s_x = wxh + flex[0, j] * (r_x - p_x)
-                                s_y = wyh + flex[1, j] * (r_y - p_y)
-                                k = law_ratio(law, prm, speed * math.sqrt(s_x * s_x + s_y * s_y)
-                                              / s)
-                        if not done:
-                            k = law_ratio(law, prm, vs * math.sqrt(lx * lx + ly * ly)
-                                          * ((mag - gk) * inv))
-                        r = g * k
-                        if r < mag:
-                            if done:
-                                scale = r / gk
-                                t_x = r_x * scale
-                                t_y = r_y * scale
-                            else:
-                                scale = r * inv
-                                t_x = t_x * scale
-                                t_y = t_y * scale
-                            over = True
-                            nslip += 1
-                            level[j] = k
-                if not over:
-                    level[j] = 1.0
+            vs = v_full if s == dx else (v_half if s == half else speed / s)
+            t_x, t_y, over, ratio = project(
+                t_x, t_y, p_x, p_y, g, lev, law, prm, speed, s, vs, rigid, w_x[j] * s + g_x,
+                (eta + phi * x_rel) * s + g_y, flex[0, j], flex[1, j])
+            if over:
+                nslip += 1
+            level[j] = ratio
+            if kinetic:
+                kin[j, i] = ratio
             tx[j] = t_x
             ty[j] = t_y
             sx[j] += t_x

@@ -32,17 +32,24 @@ the exact transient solver (``docs/validation_transient.md``):
   field is uniform over the patch (its first moment only: no torsion term),
   and the force changes over a step as a first-order lag of the relaxation
   length (for the material that entered during the step);
-- **slipping paths marched**: a particle that slips on its way from ``x +
-  h`` is marched cell by cell, each step projected on the bound where it is
-  (the slip's direction follows the local rigid slip, which spin turns along
-  the path; one projection over a long step took the path's mean).
+- **paths marched**: a particle's way from ``x + h`` is marched cell by
+  cell, each cell of it projected on the bound where the particle is with
+  the steady march's projection (the slip's direction follows the local
+  rigid slip, which spin turns along the path; one projection over a long
+  step took the path's mean).  Every cell of the path is tested, with the
+  calibrated MAE's rigid-slip return and the falling law's kinetic level,
+  so that steps of whole cells keep the steady state as their fixed point
+  exactly (a path marched only when its end slipped, with the radial
+  return, had the calibrated MAE's fixed point under spin up to 4 points
+  of mu N off its steady answer).
 
 Material that entered during the step (within ``h`` of its segment's front
 face) rolled under the present creepages only: it has the steady march's
 traction.  So the steady FastSim is the limit ``h`` >= the patch length
-(exactly), and with ``h = dx`` it is the exact fixed point of repeated steps
-(the semi-Lagrangian shift is then a shift by one cell); other ``h`` converge
-to it within the interpolation's smoothing.
+(exactly), and with ``h`` a whole number of cells it is the exact fixed
+point of repeated steps (the semi-Lagrangian shift is then a shift by whole
+cells and the path's march is the steady march's); other ``h`` converge to
+it within the interpolation's smoothing.
 
 State rules (:class:`ContactMemory`, stated in :data:`RESET_REASONS`):
 
