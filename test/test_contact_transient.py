@@ -337,3 +337,36 @@ def test_step_response_follows_the_exact_transient_solver(kind: str) -> None:
         f, tstate = _step(t, tstate, ar, creep, 3 * ar.dx, mu=MU)
         gap = abs(getattr(f, key) - exact[3 * step + 2])
         assert gap <= steady_error + 0.02 * MU * load, step
+
+
+@pytest.mark.parametrize("solver_cls", SOLVERS)
+def test_a_long_step_is_the_build_up_of_short_ones(solver_cls) -> None:
+    """A creepage step rolled half the patch's length at once follows the same in small steps.
+
+    The far field's force changes as a lag within a step; over one step of
+    half the patch (``V dt = a``) that overshot the build-up of steps of
+    ``a/10`` by a point of mu N (after ``a``: -0.661 against -0.650 of mu N
+    under ``eta`` on the circle).  Such a step is taken as sub-steps of at
+    most a quarter of the patch (:data:`transient.SUBSTEP`).
+    """
+    a, n, load = 6e-3, 40, 4e4
+    ar = areas.ellipse(a, a, nx=n, ny=n, load=load)
+    solver = solver_cls(NU, G)
+    creep = (0.0, 1.5e-3, 0.0)
+    t = TransientSolver(solver)
+    long_steps, state = [], None
+    for _ in range(3):
+        f, state = _step(t, state, ar, creep, a, mu=MU)
+        long_steps.append(f.fy)
+    short_steps, state = [], None
+    for k in range(30):
+        f, state = _step(t, state, ar, creep, a / 10, mu=MU)
+        if k % 10 == 9:
+            short_steps.append(f.fy)
+    np.testing.assert_allclose(long_steps, short_steps, rtol=0, atol=2e-3 * MU * load)
+    # the sub-steps are steps: one of a equals two of a / 2 from the same state
+    _, start = _step(t, None, ar, creep, 0.3 * a, mu=MU)
+    once, _ = _step(t, start, ar, creep, a, mu=MU)
+    _, mid = _step(t, start, ar, creep, a / 2, mu=MU)
+    twice, _ = _step(t, mid, ar, creep, a / 2, mu=MU)
+    assert (once.fx, once.fy, once.mz) == (twice.fx, twice.fy, twice.mz)

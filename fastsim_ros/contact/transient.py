@@ -280,6 +280,54 @@ def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     return fx, fy, mz, nslip, ncontact
 
 
+#: with the far field, a step longer than this share of the patch's length is taken in equal
+#: sub-steps no longer than it (1): the lag over one long step overshot the exact build-up
+SUBSTEP = 0.25
+
+
+@njit(cache=True, error_model="numpy")
+def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
+                  yp, law, prm, speed, out_x, out_y, slip, rigid, prev_x, prev_y, rolled,
+                  m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total):
+    """Roll ``rolled`` (m) as :func:`elastic_sweep` does, in sub-steps where it is long.
+
+    The far field's force is taken to change as a first-order lag within a
+    step (:func:`elastic_sweep`); over a step of half the patch's length the
+    build-up after a creepage step overshot the one of the same model in
+    small steps by a point of mu N (``docs/validation_transient.md``), the
+    model's own error in time.  So with the far field a step between
+    :data:`SUBSTEP` times the patch's ``length`` and the whole length is
+    taken as equal sub-steps no longer than that, each from the last one's
+    tractions and force (a step of the whole length or more is the steady
+    state in one sweep).  Arguments and return as :func:`elastic_sweep`.
+    """
+    nsub = 1
+    if (m_x != 0.0 or m_y != 0.0) and rolled < length:
+        nsub = max(1, int(math.ceil(rolled / (SUBSTEP * length) - 1e-9)))
+    if nsub == 1:
+        return elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
+                             x_c, y_s, xp, yp, law, prm, speed, out_x, out_y, slip, rigid,
+                             prev_x, prev_y, rolled, m_x, m_y, k_x, k_y, l_x, l_y, length,
+                             f_old_x, f_old_y, bound_total)
+    h = rolled / nsub
+    # the sub-steps' own state: the next one reads what the last one wrote
+    own_x = prev_x.copy()
+    own_y = prev_y.copy()
+    fx = fy = mz = 0.0
+    nslip = ncontact = 0
+    for n in range(nsub):
+        fx, fy, mz, nslip, ncontact = elastic_sweep(
+            shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
+            law, prm, speed, out_x, out_y, slip, rigid, own_x, own_y, h, m_x, m_y, k_x, k_y,
+            l_x, l_y, length, f_old_x, f_old_y, bound_total)
+        f_old_x = fx
+        f_old_y = fy
+        if n < nsub - 1:
+            own_x[:, :] = out_x
+            own_y[:, :] = out_y
+    return fx, fy, mz, nslip, ncontact
+
+
 @njit(cache=True, error_model="numpy")
 def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                       shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
@@ -325,7 +373,7 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
         shape = np.empty((ny, nx))
         k.parabolic_bound(p, dx, dy, mu, geo[k.G_LOAD], shape)
         outer = 1.0
-    fx, fy, mz, nslip, _ = elastic_sweep(
+    fx, fy, mz, nslip, _ = elastic_steps(
         shape, outer, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
         law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
         m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, mu * geo[k.G_LOAD])
@@ -372,7 +420,7 @@ def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic
     if with_far_field:
         m_x, m_y, k_x, k_y, l_x, l_y, length = far_field(shape, env, flex, gdx, gdy, a, b, nu,
                                                          shear_modulus)
-    fx, fy, mz, nslip, ncontact = elastic_sweep(
+    fx, fy, mz, nslip, ncontact = elastic_steps(
         shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi, flex, x_c, y_c, xp, yp,
         law, prm, speed, out_x, out_y, slip, False, prev_x, prev_y, rolled, m_x, m_y, k_x,
         k_y, l_x, l_y, length, f_old_x, f_old_y, mu * ell[k.ELL_LOAD])
