@@ -323,7 +323,8 @@ def strip_rates(y0, dy, xi, eta, phi, flex, y_s, yp, rate_x, rate_y0, rate_yx, y
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, wxh, wyh, l1, l2):
+def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, w_x, g_x, eta, phi,
+            x, g_y, l1, l2):
     """Project the trial traction ``(t_x, t_y)`` (Pa) of one step on the bound ``g`` (Pa).
 
     The march's slip test and return, one place for the steady march's cell
@@ -332,9 +333,12 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, wxh, w
     ``lev``: the particle's friction ratio on its last step (1 if it stuck;
     slip-dependent laws: the kinetic level is ``g lev``); ``step``: the
     distance rolled in the step (m), ``vs``: ``|V| / step`` (1/s);
-    ``rigid``: the rigid-slip return with the rigid slip ``(wxh, wyh)``
-    over the step (m) and the strip's flexibilities ``l1``, ``l2`` (m/Pa),
-    else the radial return.  Return
+    ``rigid``: the rigid-slip return with the rigid slip over the step (m),
+    ``w_x step + g_x`` and ``(eta + phi x) step + g_y`` (``w_x``: the strip's
+    rigid slip along x per metre, ``x`` (m): where the step ends, ``g_x``,
+    ``g_y``: the far field's shift, m; formed only where a cell slips) and
+    the strip's flexibilities ``l1``, ``l2`` (m/Pa), else the radial
+    return.  Return
     ``(tau_x, tau_y, slipped, ratio)``, the ratio the particle's friction
     ratio after the step (1 where it stuck or the law is constant).
     """
@@ -351,7 +355,8 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, wxh, w
             if mag > g:
                 done = False
                 if rigid:
-                    r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh, l1, l2, g)
+                    r_x, r_y, done = rigid_slip_return(p_x, p_y, w_x * step + g_x,
+                                                       (eta + phi * x) * step + g_y, l1, l2, g)
                     if done:
                         return r_x, r_y, True, 1.0
                 if rigid:
@@ -376,6 +381,8 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, wxh, w
             r_y = 0.0
             k = 1.0
             if rigid:
+                wxh = w_x * step + g_x
+                wyh = (eta + phi * x) * step + g_y
                 r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh, l1, l2, gk)
                 if done:
                     # the slip at the kinetic level: |w h + L (tau_k - tau_p)| / h
@@ -392,6 +399,47 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, wxh, w
                 scale = r * inv
                 return t_x * scale, t_y * scale, True, k
     return t_x, t_y, False, 1.0
+
+
+@njit(cache=True, error_model="numpy")
+def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, dx, rolled, nsub, x_rel, rate_x,
+               rate_y0, rate_yx, w_x, g_x, g_y, eta, phi, l1, l2, law, prm, speed, rigid):
+    """March a particle of strip ``j`` from ``x + rolled`` to one step before cell ``i``.
+
+    :func:`rolling_sweep`'s path of a transient step: ``nsub - 1`` steps of
+    ``rolled / nsub`` (m), each projected with :func:`project` on the bound
+    of the cell the particle reaches (zero traction where it is off the
+    contact); ``(t_x, t_y)`` (Pa) and ``lev`` (its friction ratio) where it
+    starts; the strip's rates as :func:`strip_rates`, ``g_x``, ``g_y`` the
+    far field's shift per step (m).  Return the traction and ratio before
+    the last step (the cell's own, :func:`rolling_sweep`'s).  Kept out of
+    the sweep's loop: the steady march does not carry its code.
+    """
+    s = rolled / nsub
+    v_sub = speed / s
+    # the steps' constant parts (Pa) and the cell reached, in cells from cell i
+    d_x = rate_x * s + g_x / l1
+    d_y = rate_y0 * s + g_y / l2
+    d_yx = rate_yx * s
+    ahead = rolled / dx + 0.5
+    per = s / dx
+    for m in range(nsub - 1):
+        ic = min(i + int(ahead - (m + 1) * per), nx - 1)
+        g_m = outer * (shape[j, ic] * inner)
+        if not g_m > 0.0:
+            # off the contact on its way: no traction carried on
+            t_x = 0.0
+            t_y = 0.0
+            lev = 1.0
+            continue
+        x_m = x_rel + rolled - (m + 0.5) * s
+        p_x = t_x
+        p_y = t_y
+        t_x = t_x - d_x
+        t_y = t_y - (d_y + d_yx * x_m)
+        t_x, t_y, _, lev = project(t_x, t_y, p_x, p_y, g_m, lev, law, prm, speed, s, v_sub,
+                                   rigid, w_x, g_x, eta, phi, x_m - 0.5 * s, g_y, l1, l2)
+    return t_x, t_y, lev
 
 
 @njit(cache=True, error_model="numpy")
@@ -587,45 +635,99 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                     s = rolled / nsub
                     g_x = g_x / nsub
                     g_y = g_y / nsub
-                    v_sub = speed / s
                     lev = 1.0
                     if kinetic:
                         # the particle's friction ratio where it starts, this sweep's there
                         start = i + int(f + 0.5)
                         if start <= first[j]:
                             lev = kin[j, start]
-                    for m in range(nsub - 1):
-                        ic = min(i + int((rolled - (m + 1) * s) / dx + 0.5), nx - 1)
-                        g_m = outer * (shape[j, ic] * inner)
-                        if not g_m > 0.0:
-                            # off the contact on its way: no traction carried on
-                            t_x = 0.0
-                            t_y = 0.0
-                            lev = 1.0
-                            continue
-                        x_m = x_rel + rolled - (m + 0.5) * s
-                        p_x = t_x
-                        p_y = t_y
-                        t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
-                        t_y = t_y - (rate_y0[j] + rate_yx[j] * x_m) * s - g_y / flex[1, j]
-                        t_x, t_y, _, lev = project(
-                            t_x, t_y, p_x, p_y, g_m, lev, law, prm, speed, s, v_sub, rigid,
-                            w_x[j] * s + g_x, (eta + phi * (x_m - 0.5 * s)) * s + g_y,
-                            flex[0, j], flex[1, j])
+                    t_x, t_y, lev = march_path(
+                        t_x, t_y, lev, shape, outer, inner, j, i, nx, dx, rolled, nsub, x_rel,
+                        rate_x[j], rate_y0[j], rate_yx[j], w_x[j], g_x, g_y, eta, phi,
+                        flex[0, j], flex[1, j], law, prm, speed, rigid)
+            # the cell's own step: project()'s projection written out (a call costs the
+            # steady march 20-30 %, measured; the fixed-point test of whole-cell transient
+            # steps holds the two to the same answer)
             x_mid = x_rel + 0.5 * s
             p_x = t_x
             p_y = t_y
             t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
             t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s - g_y / flex[1, j]
-            vs = v_full if s == dx else (v_half if s == half else speed / s)
-            t_x, t_y, over, ratio = project(
-                t_x, t_y, p_x, p_y, g, lev, law, prm, speed, s, vs, rigid, w_x[j] * s + g_x,
-                (eta + phi * x_rel) * s + g_y, flex[0, j], flex[1, j])
-            if over:
-                nslip += 1
-            level[j] = ratio
-            if kinetic:
-                kin[j, i] = ratio
+            over = False
+            m2 = t_x * t_x + t_y * t_y
+            if law == LAW_CONSTANT:
+                if not m2 <= _NO_SLIP * g * g:
+                    # clearly over the bound: the rigid-slip return needs no |t*|
+                    if rigid and m2 > _CLEARLY_OVER * g * g:
+                        mag = g + g
+                    else:
+                        mag = math.sqrt(m2)
+                        if abs(mag - g) <= _ON_BOUND * g:
+                            mag = math.hypot(t_x, t_y)
+                    if mag > g:
+                        done = False
+                        if rigid:
+                            r_x, r_y, done = rigid_slip_return(
+                                p_x, p_y, w_x[j] * s + g_x, (eta + phi * x_rel) * s + g_y,
+                                flex[0, j], flex[1, j], g)
+                            if done:
+                                t_x = r_x
+                                t_y = r_y
+                        if not done:
+                            if rigid:
+                                # the return declined: the radial return, with the true |t*|
+                                mag = math.sqrt(m2)
+                            scale = g / mag
+                            t_x = t_x * scale
+                            t_y = t_y * scale
+                        over = True
+                        nslip += 1
+            else:
+                # the kinetic level: static bound times the particle's last friction ratio
+                # (the upstream cell's, or its own on a transient path)
+                gk = g * lev
+                if not m2 <= _NO_SLIP * gk * gk:
+                    mag = math.sqrt(m2)
+                    if abs(mag - gk) <= _ON_BOUND * gk:
+                        mag = math.hypot(t_x, t_y)
+                    if mag > gk:
+                        # slip velocity at that level: |V| |L t*| (|t*| - gk) / (|t*| step)
+                        inv = 1.0 / mag
+                        lx = flex[0, j] * t_x
+                        ly = flex[1, j] * t_y
+                        vs = v_full if s == dx else (v_half if s == half else speed / s)
+                        done = False
+                        if rigid:
+                            wxh = w_x[j] * s + g_x
+                            wyh = (eta + phi * x_rel) * s + g_y
+                            r_x, r_y, done = rigid_slip_return(p_x, p_y, wxh, wyh,
+                                                               flex[0, j], flex[1, j], gk)
+                            if done:
+                                # the slip at the kinetic level: |w h + L (tau_k - tau_p)| / h
+                                s_x = wxh + flex[0, j] * (r_x - p_x)
+                                s_y = wyh + flex[1, j] * (r_y - p_y)
+                                k = law_ratio(law, prm, speed * math.sqrt(s_x * s_x + s_y * s_y)
+                                              / s)
+                        if not done:
+                            k = law_ratio(law, prm, vs * math.sqrt(lx * lx + ly * ly)
+                                          * ((mag - gk) * inv))
+                        r = g * k
+                        if r < mag:
+                            if done:
+                                scale = r / gk
+                                t_x = r_x * scale
+                                t_y = r_y * scale
+                            else:
+                                scale = r * inv
+                                t_x = t_x * scale
+                                t_y = t_y * scale
+                            over = True
+                            nslip += 1
+                            level[j] = k
+                if not over:
+                    level[j] = 1.0
+                if kinetic:
+                    kin[j, i] = level[j]
             tx[j] = t_x
             ty[j] = t_y
             sx[j] += t_x
