@@ -401,7 +401,7 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, w_x, g
     return t_x, t_y, False, 1.0
 
 
-@njit(cache=True, error_model="numpy")
+@njit(cache=True, error_model="numpy", inline="always")
 def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, dx, rolled, nsub, x_rel, rate_x,
                rate_y0, rate_yx, w_x, g_x, g_y, eta, phi, l1, l2, law, prm, speed, rigid):
     """March a particle of strip ``j`` from ``x + rolled`` to one step before cell ``i``.

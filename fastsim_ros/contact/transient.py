@@ -304,27 +304,22 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     nsub = 1
     if (m_x != 0.0 or m_y != 0.0) and rolled < length:
         nsub = max(1, int(math.ceil(rolled / (SUBSTEP * length) - 1e-9)))
-    if nsub == 1:
-        return elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
-                             x_c, y_s, xp, yp, law, prm, speed, out_x, out_y, slip, rigid,
-                             prev_x, prev_y, rolled, m_x, m_y, k_x, k_y, l_x, l_y, length,
-                             f_old_x, f_old_y, bound_total)
     h = rolled / nsub
     # the sub-steps' own state: the next one reads what the last one wrote
-    own_x = prev_x.copy()
-    own_y = prev_y.copy()
+    state_x = prev_x
+    state_y = prev_y
     fx = fy = mz = 0.0
     nslip = ncontact = 0
     for n in range(nsub):
+        if n > 0:
+            state_x = out_x.copy()
+            state_y = out_y.copy()
         fx, fy, mz, nslip, ncontact = elastic_sweep(
             shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
-            law, prm, speed, out_x, out_y, slip, rigid, own_x, own_y, h, m_x, m_y, k_x, k_y,
-            l_x, l_y, length, f_old_x, f_old_y, bound_total)
+            law, prm, speed, out_x, out_y, slip, rigid, state_x, state_y, h, m_x, m_y, k_x,
+            k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total)
         f_old_x = fx
         f_old_y = fy
-        if n < nsub - 1:
-            own_x[:, :] = out_x
-            own_y[:, :] = out_y
     return fx, fy, mz, nslip, ncontact
 
 
