@@ -110,6 +110,38 @@ def test_a_lifted_wheelset_has_no_patches_and_no_force(capsys):
     assert all(w["patches"] == [] and w["force_track"] == [0.0, 0.0, 0.0] for w in r["wheels"])
 
 
+@pytest.mark.parametrize("dz", ["1e-2", "2e-3"])
+def test_a_wheelset_held_above_the_rails_with_its_roll_free_is_lifted(capsys, dz):
+    """The roll to be solved at a height where no wheel touches: lifted, not an error.
+
+    The levelling of both wheels' loads found them equal (zero) at both ends
+    of its bracket and divided by their difference (an internal error, exit
+    1), or, with one end touching, returned that end unsolved (10 mrad, one
+    wheel 5 mm into its rail at 33 MN).
+    """
+    rc, out, err = run(capsys, "wheelset", "--dy", "0", "--yaw", "0", "--dz", dz, "--json")
+    assert rc == 0, err
+    r = json.loads(out)
+    assert r["roll"] == 0.0
+    assert all(w["patches"] == [] and w["force_track"] == [0.0, 0.0, 0.0] for w in r["wheels"])
+
+
+def test_the_roll_at_a_given_height_levels_both_wheels(capsys):
+    """A shifted wheelset at a given height: the roll found gives both wheels one vertical force.
+
+    The bracket grows from a quarter of a milliradian: at once 10 mrad wide it
+    sank a wheel 7.5 mm, past the rail profile (refused as a derailment).
+    """
+    rc, out, err = run(capsys, "wheelset", "--dy", "5e-3", "--yaw", "0", "--dz", "-1e-4",
+                       "--json")
+    assert rc == 0, err
+    r = json.loads(out)
+    left, right = r["wheels"]
+    assert left["patches"] and right["patches"]
+    assert left["force_track"][2] == pytest.approx(right["force_track"][2], rel=1e-4)
+    assert 0.0 < r["roll"] < 1e-3
+
+
 def test_the_exact_method_runs_on_the_same_patches(capsys):
     rc, out, err = run(capsys, "wheelset", "--dy", "0", "--yaw", "0", "--roll", "0", "--load",
                        "1e4", "--method", "exact", "--mu", "0.3", "--json")

@@ -35,7 +35,8 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.checks import check_material
 from fastsim_ros.geometry import normal_fast
-from fastsim_ros.geometry.errors import BalanceError, NoContactError, PoseError
+from fastsim_ros.geometry.errors import (BalanceError, DerailmentError, NoContactError,
+                                         PoseError)
 from fastsim_ros.geometry.placement import (Placement, Pose, RailSide, WheelSide, place_rail,
                                             place_wheel)
 from fastsim_ros.geometry.planar import PlanarGrid, grid_extent, planar_grid
@@ -60,6 +61,9 @@ STEP_LOAD_TOLERANCE = 1e-3
 #: the roll is solved until the wheels' vertical positions agree to this (m)
 ROLL_TOLERANCE = 1e-10
 MAX_ITERATIONS = 60
+#: the half-widths (rad) tried in turn for the bracket of the roll that levels both wheels'
+#: loads at a given vertical position
+ROLL_STEPS = (2.5e-4, 1e-3, 4e-3, 1e-2)
 #: a wheel's first trial interpenetration (m, vertical) at 10 kN, scaled with load^(2/3)
 TRIAL_APPROACH = 20e-6
 #: a patch with fewer cells in contact is dropped (the node's adapter calls it
@@ -399,16 +403,45 @@ class Wheelset:
                 raise BalanceError("the roll that levels both wheels was not found")
             _, left, right, p = best
             return self._one_frame(replace(p, dz=0.5 * (left.dz + right.dz)), left, right)
-        # vertical position given: the roll that makes both wheels' vertical forces equal
-        lo, hi = roll - 0.01, roll + 0.01
-        f_lo = self._load_difference(replace(pose, roll=lo), tangential)
-        f_hi = self._load_difference(replace(pose, roll=hi), tangential)
-        if f_lo * f_hi > 0.0:
-            raise NoContactError("no roll within +-10 mrad gives both wheels equal loads")
+        # vertical position given: the roll that makes both wheels' vertical forces equal.
+        # Their difference falls as the roll lowers one wheel and raises the other, and is
+        # zero, not a root, over the rolls where both wheels are off the rails: a wheelset
+        # held above them is lifted (no patches, not an error) at the roll it was given
+        f_0 = self._load_difference(pose, tangential)
+        if f_0 == 0.0:
+            return self.solve(pose, tangential=tangential)
+        # the bracket grows from a quarter of a milliradian (the levelling roll of a shifted
+        # wheelset is a fraction of one): a roll of 10 mrad at once sank a wheel by 7.5 mm,
+        # past the rail's profile (a derailment) or into a patch of 100,000 cells
+        bracket = None
+        derailed = [False, False]
+        for step in ROLL_STEPS:
+            for side, end in enumerate((roll + step, roll - step)):
+                if derailed[side]:
+                    continue
+                try:
+                    f_end = self._load_difference(replace(pose, roll=end), tangential)
+                except DerailmentError:
+                    derailed[side] = True  # the root lies nearer, if on this side
+                    continue
+                if f_end == 0.0:  # both wheels off the rails there: lifted at that roll
+                    return self.solve(replace(pose, roll=end), tangential=tangential)
+                if f_end * f_0 < 0.0:
+                    bracket = (roll, f_0, end, f_end)
+                    break
+            if bracket is not None:
+                break
+        if bracket is None:
+            raise NoContactError(f"no roll within +-{1e3 * ROLL_STEPS[-1]:g} mrad gives both "
+                                 f"wheels equal loads")
+        lo, f_lo, hi, f_hi = bracket
         for _ in range(MAX_ITERATIONS):
             mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
             f_mid = self._load_difference(replace(pose, roll=mid), tangential)
-            if abs(hi - lo) < 1e-12 or f_mid == 0.0:
+            if f_mid == 0.0:
+                hi = mid
+                break
+            if abs(hi - lo) < 1e-12:
                 break
             if f_mid * f_hi < 0.0:
                 lo, f_lo = hi, f_hi
