@@ -310,6 +310,14 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+def _one_line(error: Exception) -> str:
+    """Return a file error as one line: YAML's where and what, without its quoted snippet."""
+    if isinstance(error, yaml.MarkedYAMLError) and error.problem_mark is not None:
+        mark = error.problem_mark
+        return f"line {mark.line + 1}, column {mark.column + 1}: {error.problem}"
+    return " ".join(str(error).split())
+
+
 def load_params_file(path: Path, node_name: str = "fastsim") -> dict[str, Any]:
     """Read a ROS 2 parameter file (``<node>: ros__parameters: ...``) and check it.
 
@@ -321,7 +329,7 @@ def load_params_file(path: Path, node_name: str = "fastsim") -> dict[str, Any]:
         text = Path(path).read_text(encoding="utf-8")
         data = yaml.safe_load(text)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
-        raise ParameterError(f"{path}: cannot read parameters: {e}") from None
+        raise ParameterError(f"{path}: cannot read parameters: {_one_line(e)}") from None
     if not isinstance(data, dict):
         raise ParameterError(f"{path}: not a ROS 2 parameter file")
     values: dict[str, Any] = {}

@@ -92,6 +92,9 @@ def test_an_integer_is_a_double():
     ("fastsim:\n  ros__parameters:\n    no_such: 1\n", "unknown parameter 'no_such'"),
     ("other_node:\n  ros__parameters:\n    method: mae\n", "no section for node"),
     ("fastsim: [1, 2\n", "cannot read"),
+    ("fastsim:\n  ros__parameters:\n    contacts: [\"left\", \"right\"\n    method: mae\n",
+     r"cannot read parameters: line 4, column 5: expected ',' or '\]'"),
+    ("fastsim:\n\tros__parameters: 1\n", "line 2, column 1: found character"),
     ("- just a list\n", "not a ROS 2 parameter file"),
 ])
 def test_bad_parameter_files(tmp_path, text, match):
@@ -100,6 +103,7 @@ def test_bad_parameter_files(tmp_path, text, match):
     with pytest.raises(ParameterError, match=match) as info:
         load_params_file(path)
     assert str(path) in str(info.value)
+    assert "\n" not in str(info.value)  # one line on stderr
 
 
 def test_wildcard_section_and_node_section(tmp_path):

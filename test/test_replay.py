@@ -465,7 +465,22 @@ def test_namespace_without_patch_topics_warns(tmp_path, capsys):
     assert status == 0
     assert "no patch topic under /rig2 (no --params: the contacts are those with a " \
         "/rig2/contact/<name>/patch topic)" in err
+    # where the bag's patch topics are, for the flag that replays them
+    assert "the bag's patch topics are under / (--namespace /)" in err
     assert "left: 0 patches" in out
+    assert "nan" not in out  # a contact with nothing solved has no solve times
+
+
+def test_a_namespaced_recording_replayed_without_its_namespace_names_it(tmp_path, capsys):
+    bag = tmp_path / "rig1_only"
+    _namespaced_copy(BAGS / "hertz_ramp", bag, {
+        "/contact/left/patch": "/rig1/contact/left/patch",
+        "/contact/right/patch": "/rig1/contact/right/patch",
+        "/wheelset/twist": "/rig1/wheelset/twist"})
+    status, out, err = run([bag, "-o", tmp_path / "out"], capsys)
+    assert status == 0
+    assert "nothing solved (are --params and --namespace right?); the bag's patch topics " \
+        "are under /rig1 (--namespace /rig1)" in err
 
 
 @pytest.mark.parametrize("text, resolved", [("rig1", "/rig1"), ("/rig1", "/rig1"), ("/", "/"),

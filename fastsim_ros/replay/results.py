@@ -94,7 +94,8 @@ class Result:
                 f"{sum(rejected.values())}"
                 + (" (" + ", ".join(f"{r} {n}" for r, n in rejected.items()) + ")"
                    if rejected else "")
-                + f"; solve p50 {p50:.1f} us, p99 {p99:.1f} us")
+                + (f"; solve p50 {p50:.1f} us, p99 {p99:.1f} us" if math.isfinite(p50)
+                   else "; nothing solved"))
         kin = self.kinematics
         dropped = {key: v for key, v in kin.items() if key not in ("wheel", "rail") and v}
         lines.append(f"  twists: {kin.get('wheel', 0)} wheelset, {kin.get('rail', 0)} rail "

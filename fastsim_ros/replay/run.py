@@ -20,6 +20,7 @@ import csv
 import json
 import os
 import pickle
+import re
 import shutil
 import sys
 import tempfile
@@ -47,6 +48,8 @@ PARAMETERS_KEY = "fastsim.parameters"
 #: messages between two progress-bar updates
 _PROGRESS_EVERY = 256
 _KINEMATICS = ("wheel_twist", "rail_twist")
+#: a patch topic, resolved: its namespace (empty: the root) and contact
+_PATCH_TOPIC = re.compile(r"^(.*)/contact/[^/]+/patch$")
 #: how staging directories end
 STAGING = ".replay-tmp"
 #: the committed result, pickled, in the staging directory of a task that may run again
@@ -397,7 +400,8 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
                    f"{resolve('contact/<name>/patch', namespace)} topic)"
                    if task.contacts_from_bag else
                    f"of the configured contacts ({', '.join(contacts)})")
-                + "; nothing solved (are --params and --namespace right?)")
+                + "; nothing solved (are --params and --namespace right?)"
+                + _namespaces_hint(reader.connections, namespace))
         custom = {PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
                   "fastsim.input": str(source), "fastsim.replay": PROG}
         rows = None
@@ -573,3 +577,14 @@ def _solve_input(outcome: Any) -> tuple[Any, ...]:
         phi = -phi
     return (p[None], np.array([[x0, y0, patch.dx, patch.dy]]),
             np.array([[creep.xi, creep.eta, phi]]), np.ones(1, dtype=np.bool_))
+
+
+def _namespaces_hint(connections: Any, namespace: str) -> str:
+    """Name the namespaces under which the bag does have patch topics (for the warning)."""
+    found = sorted({m.group(1) or "/" for conn in connections
+                    if (m := _PATCH_TOPIC.match(resolve(conn.topic))) is not None}
+                   - {resolve(namespace) if namespace else "/"})
+    if not found:
+        return ""
+    return "; the bag's patch topics are under " + ", ".join(
+        f"{ns} (--namespace {ns})" for ns in found)
