@@ -32,8 +32,8 @@ setup(
     entry_points={
         'console_scripts': [
             'fastsim_contact = fastsim_ros.cli:main',
-            'fastsim_node = fastsim_ros.node:main',
-            'fastsim_lifecycle_node = fastsim_ros.node:main_lifecycle',
+            'fastsim_node = fastsim_ros.entry:node',
+            'fastsim_lifecycle_node = fastsim_ros.entry:lifecycle_node',
             'fastsim_replay = fastsim_ros.replay:main',
         ],
     },

@@ -12,7 +12,9 @@ own: about half a second to the refusal), once for the whole module.
 
 from __future__ import annotations
 
+import signal
 import subprocess
+import time
 import warnings
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
@@ -56,6 +58,8 @@ def _cases() -> list[tuple[str, str, list[str]]]:
     cases.append(("wheelset_frame-empty", "wheelset_frame", ["-p", "wheelset_frame:=''"]))
     cases.append(("contacts-duplicate", "contacts", ["-p", 'contacts:=["left", "left"]']))
     cases.append(("contacts-bad-name", "contacts", ["-p", 'contacts:=["left", "9x"]']))
+    # an empty list: rclpy cannot type it and leaves the parameter unset (was a traceback)
+    cases.append(("contacts-empty", "contacts", ["-p", "contacts:=[]"]))
     for name in ("wheel_profile", "rail_profile", "right_wheel_profile", "right_rail_profile"):
         suffix = ".prw" if "wheel" in name else ".prr"
         cases.append((f"{name}-missing", name,
@@ -153,3 +157,22 @@ def test_a_bad_start_is_one_line_naming_the_parameter_exit_2(refusals, case, nam
     assert len(lines) == 1, done.stderr
     assert lines[0].startswith("fastsim_node: ") and name in lines[0], lines[0]
     assert "Traceback" not in done.stderr and done.stdout == ""
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_while_the_node_is_importing_ends_it_with_exit_0(signum):
+    """A stop a third of a second after the start (the node's module still importing).
+
+    The console script imported the node's module (rclpy, numpy, numba: about
+    half a second) before any handler of the node's was in place: a SIGINT
+    printed a KeyboardInterrupt traceback (or rclpy's "C extension isn't
+    present"), a SIGTERM killed the process (-15).  ``fastsim_ros.entry``
+    imports it with quiet handlers in place.
+    """
+    proc = subprocess.Popen([str(NODE_SCRIPT), "--ros-args", "-p", "contacts:=[left]"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    time.sleep(0.3)
+    proc.send_signal(signum)
+    out, _ = proc.communicate(timeout=HANG_SECONDS)
+    assert proc.returncode == 0, out
+    assert not any(w in out for w in ("Traceback", "Error", "error", "Fatal")), out
