@@ -135,6 +135,17 @@ def _qos(reliability: str, depth: int) -> QoSProfile:
                                    else ReliabilityPolicy.RELIABLE))
 
 
+#: the parameters declared as doubles
+_DOUBLES = frozenset(spec.name for spec in parameters.PARAMETERS if spec.kind == "double")
+
+
+def _as_declared(given: Parameter) -> Parameter:
+    """Return ``given`` as a double if it is a whole number for a double parameter."""
+    if given.name in _DOUBLES and given.type_ == Parameter.Type.INTEGER:
+        return Parameter(given.name, Parameter.Type.DOUBLE, float(given.value))
+    return given
+
+
 class _FrontEnd:
     """The wiring the plain and the managed node share (a mixin of an rclpy node).
 
@@ -165,7 +176,14 @@ class _FrontEnd:
         """
         node: Node = self  # type: ignore[assignment]
         # given at launch (a ROS argument or a params file): then checked as given
-        self._contacts_given = "contacts" in getattr(node, "_parameter_overrides", {})
+        overrides = getattr(node, "_parameter_overrides", {})
+        self._contacts_given = "contacts" in overrides
+        # a whole number for a double (`-p friction_coefficient:=1`, `ros2 param set ... 1`)
+        # is that double: rclpy types the value by its spelling and refused it
+        for name, given in list(overrides.items()):
+            overrides[name] = _as_declared(given)
+        node.add_pre_set_parameters_callback(
+            lambda given: [_as_declared(p) for p in given])
         source_spec = parameters.SPECS["patch_source"]
         try:
             source = node.declare_parameter(

@@ -308,6 +308,27 @@ def test_refused_parameter_keeps_the_node_and_its_value(run_node):
     assert math.hypot(fx, fy) == pytest.approx(0.4 * n, rel=0.03)
 
 
+def test_a_whole_number_for_a_double_parameter_is_that_double(run_node):
+    """``-p friction_coefficient:=1`` and ``ros2 param set ... 1``: rclpy types by spelling.
+
+    An integer for a parameter declared double was refused at start ("expecting
+    type 'DOUBLE'", exit 2) and at run time ("Wrong parameter type").
+    """
+    proc, client = run_node("-p", "contacts:=[left]", "-p", "friction_coefficient:=1",
+                            contacts=("left",))
+    value = client.get_parameter("friction_coefficient")
+    assert value == 1.0 and isinstance(value, float)
+    (result,) = client.set_parameters(friction_coefficient=2)
+    assert result.successful, result.reason
+    value = client.get_parameter("friction_coefficient")
+    assert value == 2.0 and isinstance(value, float)
+    (result,) = client.set_parameters(friction_coefficient=9)  # out of range: still refused
+    assert not result.successful and "friction_coefficient" in result.reason
+    (result,) = client.set_parameters(method=3)  # no double: the type is still checked
+    assert not result.successful
+    assert proc.proc.poll() is None
+
+
 def test_diagnostics_report_the_peers_each_topic_matched(run_node):
     """What a client cannot see from its side: the node's own matches, per topic."""
     _, client = run_node(contacts=("left",))  # the node serves left and right
