@@ -269,7 +269,44 @@ class Bag:
             for log_ns, idx, _, msg in sorted(self.items, key=lambda it: it[:3]):
                 writer.write(conns[idx], log_ns,
                              TYPESTORE.serialize_cdr(msg, self.topics[names[idx]]))
+        with_chunk_crcs(path / f"{self.name}.mcap")
         return path
+
+
+def with_chunk_crcs(file: Path) -> None:
+    """Rewrite an MCAP file record for record through ``mcap``, with its chunks' CRCs.
+
+    rosbags writes each chunk's CRC as 0 (none): a corruption inside a chunk's
+    compressed data then decoded as other bytes (patches refused one by one as
+    malformed) instead of failing the read as a bad file.  The schemas,
+    channels (their QoS metadata), messages in file order, metadata records
+    and chunking (1 MiB uncompressed, zstd) are kept; ``metadata.yaml`` names
+    none of what changes.
+    """
+    import io
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer as McapWriter
+
+    reader = make_reader(io.BytesIO(file.read_bytes()))
+    header = reader.get_header()
+    summary = reader.get_summary()
+    assert summary is not None
+    staging = file.with_name(file.name + ".crc")
+    with open(staging, "wb") as f:
+        out = McapWriter(f, compression=CompressionType.ZSTD, chunk_size=1 << 20)
+        out.start(profile=header.profile, library=f"{header.library} + python mcap")
+        schemas = {sid: out.register_schema(sc.name, sc.encoding, sc.data)
+                   for sid, sc in sorted(summary.schemas.items())}
+        channels = {cid: out.register_channel(ch.topic, ch.message_encoding,
+                                              schemas.get(ch.schema_id, 0), ch.metadata)
+                    for cid, ch in sorted(summary.channels.items())}
+        for _, channel, message in reader.iter_messages(log_time_order=False):
+            out.add_message(channels[channel.id], message.log_time, message.data,
+                            message.publish_time, message.sequence)
+        for record in reader.iter_metadata():
+            out.add_metadata(record.name, record.metadata)
+        out.finish()
+    staging.replace(file)
 
 
 def patch_times(duration: float) -> list[float]:

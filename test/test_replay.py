@@ -410,6 +410,43 @@ def _namespaced_copy(source, target, renames):
             writer.write(conns[conn.id], log_ns, raw)
 
 
+def _first_message_body(data: bytes) -> int:
+    """Return the file offset of the first message record's body in an uncompressed chunk."""
+    from mcap.reader import make_reader
+    chunk = make_reader(io.BytesIO(bytes(data))).get_summary().chunk_indexes[0]
+    assert chunk.compression == ""
+    at = chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8 + 4   # opcode, length, times, size, crc
+    at += 4 + int.from_bytes(data[at:at + 4], "little") + 8  # compression string, records size
+    while data[at] != 0x05:                                  # schema and channel records
+        at += 1 + 8 + int.from_bytes(data[at + 1:at + 9], "little")
+    return at + 1 + 8
+
+
+@pytest.mark.parametrize("offset, value, match", [
+    (0, (74).to_bytes(2, "little"), "a message on channel 74, which the file does not define"),
+    (6, (1).to_bytes(8, "little"), "a message logged outside the chunk's time range")])
+def test_a_corrupt_chunk_without_crcs_is_a_bad_input(tmp_path, capsys, offset, value, match):
+    """A chunk that decodes but names another channel or time: one line, exit 2, nothing left.
+
+    rosbags writes no chunk CRCs: such a corruption decodes.  A message on a
+    channel the file does not define ended the replay with an internal error
+    (exit 1); a log time moved out of its chunk was replayed as an old stamp.
+    """
+    bag = tmp_path / "plain"
+    _namespaced_copy(BAGS / "hertz_ramp", bag, {})  # uncompressed chunks, CRC 0
+    f = bag / "plain.mcap"
+    data = bytearray(f.read_bytes())
+    at = _first_message_body(data) + offset         # channel id u16, sequence u32, log time
+    data[at:at + len(value)] = value
+    f.write_bytes(bytes(data))
+    out = tmp_path / "out"
+    status, stdout, err = run([bag, "-o", out], capsys)
+    assert status == 2
+    (line,) = err.splitlines()
+    assert "plain" in line and match in line
+    assert not any(out.iterdir()) if out.exists() else True
+
+
 @pytest.fixture(scope="module")
 def rig1_front(tmp_path_factory):
     """hertz_ramp's left wheel recorded under /rig1 as contact ``front`` (twists relative)."""

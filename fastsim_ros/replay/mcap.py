@@ -330,6 +330,28 @@ def scan_records(records: bytes) -> Arrays:
     return channel, log_time, start, size
 
 
+def _check_chunk(mcap: IndexedMcap, chunk: ChunkIndex, arrays: Arrays) -> None:
+    """Refuse a chunk whose messages name no channel of the file or lie outside its times.
+
+    A file without chunk CRCs (rosbags writes none) decodes a corruption inside
+    a chunk's compressed data as other bytes: a record on channel 74 of a file
+    with six ended the replay with an internal error (exit 1), a log time
+    moved out of the chunk's range was replayed as an old stamp.  Both are
+    the file's fault: a bad input.
+    """
+    channel, log_time = arrays[0], arrays[1]
+    if not channel.size:
+        return
+    known = np.fromiter(mcap.channels, dtype=np.int64, count=len(mcap.channels))
+    if not np.isin(channel, known).all():
+        bad = int(channel[~np.isin(channel, known)][0])
+        raise McapError(f"chunk at byte {chunk.offset}: a message on channel {bad}, which "
+                        f"the file does not define (a corrupt chunk)")
+    if int(log_time[0]) < chunk.start_time or int(log_time[-1]) > chunk.end_time:
+        raise McapError(f"chunk at byte {chunk.offset}: a message logged outside the "
+                        f"chunk's time range (a corrupt chunk)")
+
+
 def windows(mcap: IndexedMcap, on_chunk: Any, max_messages: int = 8192,
             max_bytes: int = 32 << 20) -> Iterator[Window]:
     """Yield every message in log-time order, in windows of at most ``max_messages``.
@@ -359,6 +381,7 @@ def windows(mcap: IndexedMcap, on_chunk: Any, max_messages: int = 8192,
             nxt += 1
             raw, records = mcap.read_chunk(mcap.chunks[k])
             arrays = scan_records(records)
+            _check_chunk(mcap, mcap.chunks[k], arrays)
             on_chunk(k, raw, records, arrays)
             loaded.append(_Loaded(mcap.chunks[k].offset, records, *arrays))
             loaded.sort(key=lambda c: c.order)
