@@ -114,7 +114,7 @@ def test_metadata_version_and_qos(name):
 
 @pytest.mark.parametrize("name", sorted(EXPECTED))
 def test_every_chunk_carries_its_crc(name):
-    """rosbags writes a chunk's CRC as 0 (none); ``make_bags.with_chunk_crcs`` adds them.
+    """Each chunk has its CRC: rosbags writes 0 (none), ``make_bags.with_chunk_crcs`` adds them.
 
     Without, a corruption inside a chunk's compressed data decoded as other
     bytes in 15 of 60 places tried on hertz_ramp (patches refused one by one,

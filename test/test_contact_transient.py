@@ -347,7 +347,8 @@ def test_a_long_step_is_the_build_up_of_short_ones(solver_cls) -> None:
     half the patch (``V dt = a``) that overshot the build-up of steps of
     ``a/10`` by a point of mu N (after ``a``: -0.661 against -0.650 of mu N
     under ``eta`` on the circle).  Such a step is taken as sub-steps of at
-    most a quarter of the patch (:data:`transient.SUBSTEP`).
+    most an eighth of the patch (:data:`transient.SUBSTEP`) where its force
+    changes (:data:`transient.SUBSTEP_CHANGE`).
     """
     a, n, load = 6e-3, 40, 4e4
     ar = areas.ellipse(a, a, nx=n, ny=n, load=load)

@@ -10,6 +10,7 @@ and the same rejections where it defers.
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -314,3 +315,37 @@ def test_transient_rolling_on_the_bundled_bags_equals_the_python_path(bag):
     for contact in fast.config.contacts:
         if contact in fast._memories:
             assert fast._memories[contact].counts == slow._memories[contact].counts
+
+
+def test_the_kernel_cache_is_keyed_on_every_compiled_source():
+    """The cache is keyed on every compiled source: numba checks only a kernel's own file.
+
+    ``transient.py``'s kernels are compiled into ``pipeline_kernels.solve_cloud``;
+    with ``transient.py`` left out of the key, a changed transient step loaded
+    the pipeline's old machine code from the cache (the compiled path then
+    disagreed with the library by 0.7 N in a development tree).  Every module
+    with compiled functions must be in the key, and so must every package
+    module they import whole or take constants (upper-case names) from.
+    """
+    import re
+
+    import fastsim_ros
+    root = Path(fastsim_ros.__file__).resolve().parent
+    keyed = {(root / name).resolve() for name in fastsim_ros._KERNEL_SOURCES}
+    files = [*root.rglob("*.py"), *(root.parent / "msg_adapters").glob("*.py")]
+    compiled = [f for f in files if re.search(r"@njit|= njit\(", f.read_text())]
+    assert compiled
+    for f in compiled:
+        assert f.resolve() in keyed, f
+        for pkg, names in re.findall(
+                r"^\s*from ((?:fastsim_ros|msg_adapters)[\w.]*) import \(?([^)\n]*)",
+                f.read_text(), flags=re.M):
+            base = root.parent.joinpath(*pkg.split("."))
+            for name in (n.split(" as ")[0].strip() for n in names.split(",")):
+                if not name:
+                    continue
+                module = base / f"{name}.py"
+                if module.exists():  # a module imported whole
+                    assert module.resolve() in keyed, (f, module)
+                elif name.isupper():  # a constant, frozen into the kernels
+                    assert base.with_suffix(".py").resolve() in keyed, (f, pkg, name)
