@@ -327,9 +327,11 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, w_x, g
             x, g_y, l1, l2):
     """Project the trial traction ``(t_x, t_y)`` (Pa) of one step on the bound ``g`` (Pa).
 
-    The march's slip test and return, one place for the steady march's cell
-    step and a transient path's sub-steps (:func:`rolling_sweep`), so that
-    both march alike.  ``(p_x, p_y)``: the traction before the step (Pa);
+    The march's slip test and return for a transient path's sub-steps
+    (:func:`march_path`), the same operations as the cell step of
+    :func:`rolling_sweep` writes out (a call there cost the steady march 20-30
+    %), so that both march alike (``test_contact_transient`` holds them to the
+    same fixed point).  ``(p_x, p_y)``: the traction before the step (Pa);
     ``lev``: the particle's friction ratio on its last step (1 if it stuck;
     slip-dependent laws: the kinetic level is ``g lev``); ``step``: the
     distance rolled in the step (m), ``vs``: ``|V| / step`` (1/s);
