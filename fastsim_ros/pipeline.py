@@ -611,13 +611,21 @@ class Pipeline:
                         ((p.frame.axes[0][0], p.frame.axes[1][0]),)) for p, c, _ in solved])
                 return built[0]
             try:
-                step = ekf.update((measured[0] - normal_x,),
-                                  lambda m: model.predict(samples(), m), load, (predicted,),
-                                  model_error(mu, adhesion, share),
-                                  lambda m: model.predict_with_error(samples(), m, share)[1],
-                                  (lambda m: (slope,) if marched and m == mu
-                                   else model.slope(samples(), m)) if model.has_slope
-                                  else None)
+                if marched and model.has_slope and ekf.mu == mu:
+                    # the node's cycle: the model and its slope at the prior are the
+                    # published solve's (update, to the bit, without its sequences)
+                    step = ekf.update_scalar(
+                        measured[0] - normal_x, predicted, slope, load,
+                        model_error(mu, adhesion, share),
+                        lambda m: model.predict_with_error(samples(), m, share)[1])
+                else:
+                    step = ekf.update((measured[0] - normal_x,),
+                                      lambda m: model.predict(samples(), m), load, (predicted,),
+                                      model_error(mu, adhesion, share),
+                                      lambda m: model.predict_with_error(samples(), m, share)[1],
+                                      (lambda m: (slope,) if marched and m == mu
+                                       else model.slope(samples(), m)) if model.has_slope
+                                      else None)
                 status = step.status
                 self.estimation_counts["steps"] += int(step.step_seen)
             except ContactError:  # the solver refused the perturbed mu: hold

@@ -443,6 +443,41 @@ def test_a_step_takes_the_model_error_at_the_new_level():
     assert step.model_bound == pytest.approx(step.gain * error_at(0.4) / abs(slope), rel=1e-9)
 
 
+def test_the_scalar_update_is_the_general_one_to_the_bit():
+    """update_scalar (the node's cycle: model and slope at the prior known) is update's.
+
+    A sequence of cycles through a step of mu (the step gate and the model
+    error at the new level), noisy samples, a sample below the observability
+    threshold: both filters in the same state after each, bit for bit.
+    """
+    rng = np.random.default_rng(11)
+
+    def error_at(m):
+        return 0.5 * m * 0.05 * LOAD
+
+    general = FrictionEkf(0.2, 0.01, process_noise=2e-5, measurement_noise=NOISE)
+    scalar = FrictionEkf(0.2, 0.01, process_noise=2e-5, measurement_noise=NOISE)
+    seen = set()
+    for k, (truth, r) in enumerate([(0.2, 0.9)] * 20 + [(0.4, 0.9)] * 20 + [(0.4, 0.01)] * 3
+                                   + [(0.4, 0.7)] * 20):
+        slope = -r * LOAD
+        z = slope * truth + rng.normal(0.0, NOISE)
+        s = 0.001 * (k % 5) * LOAD
+        for ekf in (general, scalar):
+            ekf.predict(1e-3)
+        mu = general.mu
+        a = general.update([z], lambda m: np.array([slope * m]), LOAD, (slope * mu,), s,
+                           error_at, lambda m: (slope,))
+        b = scalar.update_scalar(z, slope * mu, slope, LOAD, s, error_at)
+        assert a == b
+        assert (general.mu, general.variance, general.model_bound) == (
+            scalar.mu, scalar.variance, scalar.model_bound)
+        seen.add((a.status, a.step_seen))
+    assert seen >= {(UPDATED, False), (UPDATED, True), (UNOBSERVABLE, False)}
+    with pytest.raises(InvalidInputError, match="finite"):
+        scalar.update_scalar(math.nan, 0.0, -LOAD, LOAD)
+
+
 @pytest.fixture(scope="module")
 def exact_curve(hertz):
     """Return the exact theory's Fx at mu = 0.4 beyond the linear range (knee to full slip)."""

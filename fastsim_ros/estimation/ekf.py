@@ -215,8 +215,7 @@ class FrictionEkf:
         for v in z:
             if not math.isfinite(v):
                 raise InvalidInputError("measured forces must be finite")
-        mu0, var0, c0 = self.mu, self.variance, self.model_bound
-        sigma0 = math.sqrt(var0 + c0 * c0)
+        mu0 = self.mu
         h0 = _floats(model(mu0) if predicted is None else predicted)
         if len(h0) != len(z):
             raise InvalidInputError(f"model gives {len(h0)} components, measured {len(z)}")
@@ -241,6 +240,37 @@ class FrictionEkf:
             innovation = tuple(a - b for a, b in zip(z, h0))
             h2 = math.fsum(v * v for v in slope)
             hv = math.fsum(a * b for a, b in zip(slope, innovation))
+        return self._correct(h2, hv, load, s, model_error_at, slope, innovation)
+
+    def update_scalar(self, measured: float, predicted: float, slope: float, load: float,
+                      model_error: float = 0.0,
+                      model_error_at: Callable[[float], float] | None = None) -> EkfStep:
+        """Take one measured component whose model value and slope at the prior are known.
+
+        The node's cycle (one component, ``force.x``; the published solve is
+        the model at the prior and its march gave the slope): :meth:`update`
+        with ``predicted`` and ``slope_at`` given, to the bit, without its
+        sequences.  ``measured``, ``predicted`` (N), ``slope`` (N per unit
+        mu), ``load`` (N), ``model_error`` (N) and ``model_error_at`` as
+        :meth:`update`'s.
+        """
+        z, h0, h = float(measured), float(predicted), float(slope)
+        if not (load > 0.0 and math.isfinite(load)):
+            load = _positive("load", load)
+        if not (model_error >= 0.0 and math.isfinite(model_error)):
+            model_error = _positive("model_error", model_error, zero_ok=True)
+        if not math.isfinite(z):
+            raise InvalidInputError("measured forces must be finite")
+        y = z - h0
+        return self._correct(h * h, h * y, load, float(model_error), model_error_at, (h,),
+                             (y,))
+
+    def _correct(self, h2: float, hv: float, load: float, s: float,
+                 model_error_at: Callable[[float], float] | None, slope: tuple[float, ...],
+                 innovation: tuple[float, ...]) -> EkfStep:
+        """Apply the update of ``|H|^2 = h2``, ``H.y = hv`` (the module's docstring)."""
+        mu0, var0, c0 = self.mu, self.variance, self.model_bound
+        sigma0 = math.sqrt(var0 + c0 * c0)
         sensitivity = math.sqrt(h2) / load
         if not sensitivity >= self.min_sensitivity:
             self.skipped += 1
