@@ -54,6 +54,7 @@ import argparse
 import contextlib
 import importlib.util
 import io
+import math
 import os
 import subprocess
 import sys
@@ -80,6 +81,9 @@ from msg_adapters import patch as patch_adapter  # noqa: E402
 
 BAGS = ROOT / "bags"
 NAMES = ("hertz_ramp", "semi_ellipses_spin", "flange_shift", "roller_rig", "bad_inputs")
+#: bags the replay takes message by message (transient rolling's memory, friction estimation,
+#: profiles mode): in section 1 beside the others, outside "all, in turn" (no batch to compare)
+PER_MESSAGE = ("transient_step", "adhesion_rig", "mbench_a22")
 #: bags whose params use the default contacts (left, right): one --params for all
 SAME_CONTACTS = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
 PHASES = ("read", "copy", "decode", "kinematics", "solve", "state", "encode", "write",
@@ -262,7 +266,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--repeats", type=int, default=5, help="replays per bag (best is kept)")
     ap.add_argument("--copies", type=int, default=4,
                     help="copies of each default-contact bag in the many-bags run")
-    ap.add_argument("--bags", nargs="+", default=list(NAMES), choices=NAMES)
+    ap.add_argument("--bags", nargs="+", default=list(NAMES + PER_MESSAGE),
+                    choices=NAMES + PER_MESSAGE)
     ap.add_argument("--scheduler", action="store_true",
                     help="small bags on a local Dask cluster (two workers) against --jobs 2")
     ap.add_argument("--small", type=int, default=200, help="small bags for --scheduler")
@@ -305,7 +310,12 @@ def main(argv: list[str] | None = None) -> int:
         for name, (r, values) in results.items():
             n_patch = patches_of(name)
             solves = r.profile.solves
-            rate = batch_rate(solves, values) if solves else float("nan")
+            if not solves:  # message by message: no batch of its solves to compare with
+                print(f"{name:20s} {n_patch:7d} {r.wall_s * 1e3:8.1f} "
+                      f"{n_patch / r.wall_s:8.0f} {r.speed:7.1f} "
+                      f"{reference[name].speed:14.1f} {'-':>13s} {'-':>6s}")
+                continue
+            rate = batch_rate(solves, values)
             totals["wall"] += r.wall_s
             totals["log"] += r.duration_s
             totals["patches"] += n_patch
@@ -313,6 +323,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{name:20s} {n_patch:7d} {r.wall_s * 1e3:8.1f} {n_patch / r.wall_s:8.0f} "
                   f"{r.speed:7.1f} {reference[name].speed:14.1f} {rate:13.0f} "
                   f"{100 * n_patch / r.wall_s / rate:5.1f}%")
+        if not totals["patches"]:
+            totals["wall"] = totals["solve_s"] = math.nan
         all_rate = totals["patches"] / totals["wall"]
         solver_rate = totals["patches"] / totals["solve_s"]
         print(f"{'all, in turn':20s} {totals['patches']:7d} {totals['wall'] * 1e3:8.1f} "

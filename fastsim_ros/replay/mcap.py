@@ -55,6 +55,9 @@ from fastsim_ros.replay import kernels
 MAGIC = MCAP0_MAGIC
 #: uncompressed bytes of new messages after which a chunk is written (rosbags: 1 MiB)
 CHUNK_BYTES = 1 << 20
+#: a message record's fixed part: opcode, record length, channel id, sequence, log and publish
+#: times (MCAP's Message record, the layout of :func:`message_records`)
+_MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 #: bytes of the footer record and the closing magic at the end of every MCAP file
 _TAIL = 9 + 20 + 8
 #: what a file's bytes or the library's parsers raise on a malformed file
@@ -447,9 +450,10 @@ class _Pending:
     size: int = 0
     start: int = (1 << 63) - 1
     end: int = 0
-    # per channel: (log time, offset in the chunk) arrays
-    index: dict[int, list[tuple[NDArray[np.int64], NDArray[np.int64]]]] = field(
-        default_factory=dict)
+    # per channel: (log time, offset in the chunk) arrays, or lists of single messages' (the
+    # per-message path: a run of them appended to the channel's last lists, in file order)
+    index: dict[int, list[tuple[NDArray[np.int64] | list[int],
+                                NDArray[np.int64] | list[int]]]] = field(default_factory=dict)
 
 
 class McapWriter:
@@ -515,12 +519,33 @@ class McapWriter:
             self.end = max(self.end, chunk.end_time)
 
     def write(self, channel: int, log_time: int, data: bytes | bytearray | memoryview) -> None:
-        """Add one message (log time ns) to the pending chunk."""
-        rec.Message(channel_id=channel, sequence=0, log_time=log_time, publish_time=log_time,
-                    data=bytes(data)).write(self._builder)
-        self.write_records(self._builder.end(), np.array([channel], dtype=np.int64),
-                           np.array([log_time], dtype=np.int64),
-                           np.array([0], dtype=np.int64))
+        """Add one message (log time ns) to the pending chunk.
+
+        The record :func:`message_records` builds for one (the bytes
+        :class:`mcap.records.Message` writes), without the arrays of the bulk
+        path: the per-message replay writes every output this way, and the
+        arrays cost it some 10 us a message.
+        """
+        p = self._pending
+        offset = p.size
+        p.parts.append(_MESSAGE_HEAD.pack(Opcode.MESSAGE, 22 + len(data), channel, 0, log_time,
+                                          log_time))
+        p.parts.append(bytes(data))
+        p.size += 31 + len(data)
+        if log_time < p.start:
+            p.start = log_time
+        if log_time > p.end:
+            p.end = log_time
+        pieces = p.index.setdefault(channel, [])
+        if pieces and isinstance(pieces[-1][0], list):
+            pieces[-1][0].append(log_time)  # type: ignore[union-attr]
+            pieces[-1][1].append(offset)  # type: ignore[union-attr]
+        else:
+            pieces.append(([log_time], [offset]))
+        self.counts[channel] += 1
+        self.start = min(self.start, p.start)
+        self.end = max(self.end, p.end)
+        self._flush_if(CHUNK_BYTES)
 
     def write_records(self, records: bytes, channel: NDArray[np.int64],
                       log_time: NDArray[np.int64], offset: NDArray[np.int64]) -> None:
@@ -558,9 +583,9 @@ class McapWriter:
             uncompressed_size=len(records)))
         index_offsets = {}
         for c, pieces in sorted(p.index.items()):
-            entries = np.empty((sum(t.size for t, _ in pieces), 2), dtype="<u8")
-            entries[:, 0] = np.concatenate([t for t, _ in pieces])
-            entries[:, 1] = np.concatenate([o for _, o in pieces])
+            entries = np.empty((sum(len(t) for t, _ in pieces), 2), dtype="<u8")
+            entries[:, 0] = np.concatenate([np.asarray(t, dtype=np.int64) for t, _ in pieces])
+            entries[:, 1] = np.concatenate([np.asarray(o, dtype=np.int64) for _, o in pieces])
             index_offsets[c] = self.file.tell()
             self._put(_MessageIndex(c, entries))
         self.chunks.append(ChunkIndex(p.start, p.end, offset, length, index_offsets,
