@@ -6,6 +6,7 @@ corrupt chunks refused.
 
 from __future__ import annotations
 
+import io
 import shutil
 import sys
 from pathlib import Path
@@ -13,6 +14,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+import zstandard
+from mcap.data_stream import ReadDataStream
 from rosbags.rosbag2 import Reader
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -134,3 +137,68 @@ def test_a_corrupt_chunk_is_a_bad_input_and_leaves_nothing(tmp_path, capsys):
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"fastsim_replay: {bag}: unreadable")
     assert sorted(p.name for p in out.iterdir()) == ["roller_rig", "roller_rig.csv"]
+
+
+def test_message_indexes_of_single_and_bulk_writes_point_at_their_records(tmp_path,
+                                                                          monkeypatch):
+    """Every message index entry names a message record of its channel and log time.
+
+    One message at a time (``write``, the per-message replay) and in bulk
+    (``write_records``, the batched one) into the same chunks and channels,
+    in runs that alternate: each record indexed once, in file order.
+    """
+    from mcap.records import Chunk, Message, MessageIndex
+    from mcap.stream_reader import StreamReader
+    monkeypatch.setattr(mcap, "CHUNK_BYTES", 700)
+    path = tmp_path / "mixed.mcap"
+    text, _ = bagio.TYPESTORE.generate_msgdef("std_msgs/msg/String", ros_version=2)
+    w = mcap.McapWriter(path)
+    w.add_schema(mcap.Schema(1, "std_msgs/msg/String", "ros2msg", text.encode()))
+    for cid in (1, 2):
+        w.add_channel(mcap.Channel(cid, 1, f"/chatter{cid}", "cdr", mcap.metadata_map(
+            {"offered_qos_profiles": ""})))
+    written = []
+    t = 0
+    for run in range(12):
+        if run % 3 == 2:  # a bulk run: fixed-size payloads, both channels
+            payloads = np.frombuffer(b"".join(_string(f"bulk{run}{k:02d}") for k in range(6)),
+                                     dtype=np.uint8).reshape(6, -1)
+            ch = np.array([1, 2, 1, 1, 2, 2], dtype=np.int64)
+            times = np.arange(t, t + 6, dtype=np.int64)
+            records = mcap.message_records(ch, times, payloads)
+            offsets = np.arange(6, dtype=np.int64) * records.shape[1]
+            w.write_records(records.tobytes(), ch, times, offsets)
+            written += [(int(c), int(s), payloads[k].tobytes()) for k, (c, s) in
+                        enumerate(zip(ch, times))]
+            t += 6
+        else:
+            for k in range(5):
+                cid = 1 + (run + k) % 2
+                data = _string(f"one{run}-{k}")
+                w.write(cid, t, data)
+                written.append((cid, t, data))
+                t += 1
+    w.close("")
+    indexed = []
+    chunks = 0
+    last_chunk = None
+    for record in StreamReader(str(path), emit_chunks=True, validate_crcs=True).records:
+        if isinstance(record, Chunk):
+            chunks += 1
+            last_chunk = record
+        elif isinstance(record, MessageIndex):
+            assert last_chunk is not None
+            data = zstandard.ZstdDecompressor().decompress(
+                last_chunk.data, max_output_size=last_chunk.uncompressed_size)
+            for log_time, offset in record.records:
+                # opcode, length, then the Message record's fields
+                assert data[offset] == 0x05
+                length = int.from_bytes(data[offset + 1:offset + 9], "little")
+                msg = Message.read(ReadDataStream(io.BytesIO(
+                    data[offset + 9:offset + 9 + length])), length)
+                assert (msg.channel_id, msg.log_time) == (record.channel_id, log_time)
+                indexed.append((msg.channel_id, msg.log_time, bytes(msg.data)))
+    assert chunks > 3
+    assert sorted(indexed, key=lambda m: m[1]) == written
+    got, _ = window_order(path)
+    assert [(int(topic[-1]), t, d) for topic, t, d in got] == written

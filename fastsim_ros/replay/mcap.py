@@ -526,12 +526,13 @@ class McapWriter:
         path: the per-message replay writes every output this way, and the
         arrays cost it some 10 us a message.
         """
+        raw = bytes(data)
         p = self._pending
         offset = p.size
-        p.parts.append(_MESSAGE_HEAD.pack(Opcode.MESSAGE, 22 + len(data), channel, 0, log_time,
+        p.parts.append(_MESSAGE_HEAD.pack(Opcode.MESSAGE, 22 + len(raw), channel, 0, log_time,
                                           log_time))
-        p.parts.append(bytes(data))
-        p.size += 31 + len(data)
+        p.parts.append(raw)
+        p.size += 31 + len(raw)
         if log_time < p.start:
             p.start = log_time
         if log_time > p.end:
