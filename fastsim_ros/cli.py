@@ -632,4 +632,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # ``python -m fastsim_ros.cli``: run the package's module, not this copy of it named
+    # __main__, whose UsageError the subcommands' modules (which import fastsim_ros.cli)
+    # would not raise: their usage errors were internal errors, exit 1
+    from fastsim_ros.cli import main as _main
+    sys.exit(_main())

@@ -72,6 +72,9 @@ def patch_topic(contact: str) -> str:
 WHEEL_TWIST_TOPIC, RAIL_TWIST_TOPIC = "wheelset/twist", "rail/twist"
 WHEELSET_WRENCH_TOPIC, MARKERS_TOPIC = "wheelset/wrench", "contact/markers"
 DIAGNOSTICS_TOPIC = "/diagnostics"
+#: a measured creep force (N) beyond this times the highest mu_s the estimator admits times the
+#: cycle's load is a fault of the measurement, not a rail: the update is skipped (implausible)
+IMPLAUSIBLE_FORCE = 1.0
 #: online friction estimation (parameter friction_estimation): the measured wrench in, the
 #: estimate out (Vector3Stamped: x = mu_s, y = its standard deviation, z = adhesion utilisation)
 MEASURED_WRENCH_TOPIC, FRICTION_ESTIMATE_TOPIC = "wheelset/measured_wrench", "friction/estimate"
@@ -138,7 +141,9 @@ class FrictionEstimate:
     wrenches use); ``sigma``: its standard deviation; ``utilisation``: the
     cycle's creep forces over the friction available, ``sum |(Fx, Fy)| /
     (mu sum N)`` at the mu they were solved with; ``status``: ``updated``,
-    ``unobservable`` (the linear range: held, sigma grown) or
+    ``unobservable`` (the linear range, or no contact: held, sigma grown),
+    ``implausible`` (the measured creep force beyond the friction any rail
+    gives the cycle's load: held, :data:`IMPLAUSIBLE_FORCE`) or
     ``no_measurement`` (no fresh ``wheelset/measured_wrench``: held).
     """
 
@@ -374,7 +379,8 @@ class Pipeline:
         self._measured_used_ns: int | None = None
         self._last_cycle_ns: int | None = None
         self.estimation_counts = {"measured": 0, "dropped": 0, "updated": 0,
-                                  "unobservable": 0, "no_measurement": 0, "steps": 0}
+                                  "unobservable": 0, "implausible": 0, "no_measurement": 0,
+                                  "steps": 0}
         self._apply(config)
 
     def _apply(self, config: PipelineConfig) -> None:
@@ -598,7 +604,15 @@ class Pipeline:
         utilisation = used / (mu * load) if load > 0.0 else 0.0
         measured = self._measurement(cycle.stamp_ns)
         status = "no_measurement"
-        if measured is not None and solved and load > 0.0:
+        if measured is not None and not (solved and load > 0.0):
+            status = "unobservable"  # no contact (a lifted wheelset): no force depends on mu
+        elif measured is not None and abs(measured[0] - normal_x) > (
+                IMPLAUSIBLE_FORCE * ekf.mu_bounds[1] * load + 10.0 * ekf.measurement_noise):
+            # more creep force than the highest friction the filter admits gives the load
+            # (plus ten of the load cell's sigmas): a fault of the measurement, which as a
+            # step of mu would drive the estimate to its bound and every wrench with it
+            status = "implausible"
+        elif measured is not None:
             model, share = self._creep_model, self._model_error_share
             # the model's samples only where a solve beyond the published one is asked
             # for (a step of mu seen, a slope the march did not give): most cycles none
@@ -814,7 +828,10 @@ class Pipeline:
                                 float(geo[contact_kernels.G_ELLIPSE + 2]),
                                 force=(sign * float(result[fast.FX]),
                                        sign * float(result[fast.FY])))
-            if not memory.take(cloud.stamp_ns, float(result[fast.SPEED]), new):
+            (o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2) = frame_out[
+                patch_kernels.ORIGIN:patch_kernels.E_Y + 3].tolist()
+            if not memory.take(cloud.stamp_ns, float(result[fast.SPEED]), new,
+                               ((o0, o1, o2), (ex0, ex1, ex2), (ey0, ey1, ey2))):
                 return None
         if self._ekf is not None and memory is None:  # estimation's slope, the same march
             state.slope = (float(result[fast.DFX_DMU]), float(result[fast.DFY_DMU]))
@@ -912,7 +929,8 @@ class Pipeline:
                 # transient: the distance rolled from the stamps, the rules of ContactMemory
                 f, _ = memory.solve(patch.stamp_ns, creep.speed, p, x0, y0, dx, dy, xi, eta,
                                     phi, None if self._law else self._mu, bound=self._bound,
-                                    friction=self._law)
+                                    friction=self._law, frame=(patch.frame.origin,
+                                                               *patch.frame.axes[:2]))
                 if not self._tractions:
                     f = ContactForces(f.fx, f.fy, f.mz, f.n, f.slip_fraction)
         except OutOfTableError as e:

@@ -379,6 +379,66 @@ def test_pipeline_holds_without_a_fresh_measurement(hertz):
     assert pipe.estimation_counts["dropped"] == 2
 
 
+@pytest.mark.parametrize("xi", [0.0, 1e-4])
+def test_a_threshold_of_zero_never_divides_by_a_zero_slope(hertz, xi):
+    """friction_min_sensitivity 0 (a legal value): no slope is still no information.
+
+    At zero creepage and in full adhesion (the slope zero or vanishing) the
+    update is skipped and the estimate holds, instead of dividing by the
+    slope (ZeroDivisionError, the node and the replay ended).
+    """
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from ros_messages import cdr, cloud_msg, rolling_twist
+
+    pipe = Pipeline(PipelineConfig.from_values(dict(
+        contacts=["left"], friction_estimation="on", friction_coefficient=0.3,
+        friction_min_sensitivity=0.0)))
+    t0 = 1_700_000_000 * 1_000_000_000
+    for k in range(3):
+        stamp = t0 + k * 5_000_000
+        pipe.on_wheel_twist(cdr(rolling_twist(xi, stamp_ns=stamp)))
+        pipe.on_measured_wrench(cdr(wrench_msg((-10.0, 0.0, 0.0), stamp)))
+        out = pipe.on_patch("left", cdr(cloud_msg(hertz, stamp_ns=stamp, dtype="<f8")))
+        assert out.status == "solved" and math.isfinite(out.friction.mu)
+        assert out.friction.sigma >= 0.1
+    if xi == 0.0:
+        assert out.friction.status == "unobservable" and out.friction.mu == 0.3
+    ekf = FrictionEkf(0.3, 0.1, process_noise=0.0, measurement_noise=NOISE,
+                      min_sensitivity=0.0)
+    step = ekf.update_scalar(-10.0, 0.0, 0.0, LOAD)
+    assert step.status == UNOBSERVABLE and ekf.mu == 0.3
+
+
+def test_a_measured_force_no_rail_can_give_is_held_not_taken(hertz):
+    """A load cell's fault (1e12 N on a 50 kN wheel): counted implausible, mu held.
+
+    Taken as a step of mu it drove the estimate to its lower bound and every
+    later wrench with it.  A lifted wheelset (no contact) with a measurement
+    is unobservable (no force depends on mu), not a missing measurement.
+    """
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from ros_messages import cdr, cloud_msg, rolling_twist
+
+    pipe = Pipeline(PipelineConfig.from_values(dict(
+        contacts=["left"], friction_estimation="on", friction_coefficient=0.3,
+        friction_measurement_noise=NOISE)))
+    t0 = 1_700_000_000 * 1_000_000_000
+    statuses = []
+    for k, (force, pressure) in enumerate([(1e12, None), (-2.1 * LOAD, None),
+                                           (-1e4, np.zeros_like(hertz.pressure))]):
+        stamp = t0 + k * 5_000_000
+        pipe.on_wheel_twist(cdr(rolling_twist(6e-3, stamp_ns=stamp)))
+        pipe.on_measured_wrench(cdr(wrench_msg((force, 0.0, 0.0), stamp)))
+        out = pipe.on_patch("left", cdr(cloud_msg(hertz, stamp_ns=stamp, dtype="<f8",
+                                                  pressure=pressure)))
+        statuses.append(out.friction.status)
+        assert out.friction.mu == 0.3
+    assert statuses == ["implausible", "implausible", "unobservable"]
+    assert pipe.estimation_counts["implausible"] == 2
+    values = {v.key: v.value for v in pipe.diagnostics(t0).status[0].values}
+    assert values["friction_estimation/implausible"] == "2"
+
+
 def test_estimation_is_taken_in_both_patch_sources():
     # profiles mode too (test_profile_estimation.py runs it)
     from fastsim_ros.params import checked

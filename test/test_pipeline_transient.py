@@ -99,3 +99,39 @@ def test_rolling_parameter_is_checked() -> None:
     """Only steady and transient are allowed."""
     with pytest.raises(ParameterError, match="rolling"):
         make(rolling="unsteady")
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+@pytest.mark.parametrize("speed", [SPEED, -SPEED])
+def test_a_patch_that_moves_is_a_jump_and_one_that_creeps_is_not(compiled, speed) -> None:
+    """The jump rule measures the centroid's move in the wheelset frame.
+
+    The same patch, its contact frame's origin (its pressure centroid) moved
+    5 mm across the wheel in one cycle (more than 0.3 of its 6 mm half
+    length): another contact, zero traction, the build-up again; moved 0.5
+    mm: the same contact, the state carried.  In the patch's own frame the
+    centroid never moves (the frame's origin is the centroid), so the rule
+    must not be measured there; both paths alike, either rolling direction.
+    """
+    pipe = make(rolling="transient")
+    if not compiled:
+        pipe._compiled = None  # the Python path alone
+    x, y, z = (0.0, 0.75, -0.46)
+
+    def at(n, dy):
+        stamp = T0 + n * MS
+        twist = rolling_twist(XI1, speed=speed, stamp_ns=stamp)
+        assert pipe.on_wheel_twist(cdr(twist)) == "ok"
+        return pipe.on_patch("left", cdr(cloud_msg(patch(), origin=(x, y + dy, z),
+                                                   stamp_ns=stamp, dtype="<f8")))
+
+    out = [at(n, 0.0) for n in range(12)]  # the steady state of XI1
+    settled = out[-1].forces.fx
+    creep = at(12, 5e-4)
+    assert creep.forces.fx == pytest.approx(settled, rel=1e-3)
+    jumped = at(13, 5.5e-3)
+    assert 0.0 < jumped.forces.fx / settled < 0.6  # rebuilt from zero traction over 2 mm
+    values = dict(pipe.report("left").values)
+    assert values["transient/patch_jump"] == "1"
+    again = [at(n, 5.5e-3).forces.fx for n in range(14, 26)]
+    assert again[-1] == pytest.approx(settled, rel=1e-3)

@@ -89,6 +89,8 @@ from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw
 
 FloatArray = NDArray[np.float64]
+#: a contact frame: origin (m), unit vectors e_x, e_y, in a frame the patches share
+Frame = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
 #: why a contact's state was reset (or resampled), the keys of the diagnostics' counts
 RESET_REASONS = ("start", "stamp_gap", "lost_contact", "patch_jump", "resampled", "reversed")
@@ -596,6 +598,8 @@ class ContactMemory:
         self.max_gap = float(max_gap)
         self.jump_tolerance = float(jump_tolerance)
         self.state: TractionState | None = None
+        # the state's pressure centroid in the frame the patches' frames are given in (m)
+        self.position: tuple[float, float, float] | None = None
         self.stamp_ns: int | None = None
         self.direction = 0.0
         self.lost = False
@@ -635,43 +639,77 @@ class ContactMemory:
             return None
         return state, stamp_ns - last
 
-    def take(self, stamp_ns: int, speed: float, new: TractionState) -> bool:
+    def take(self, stamp_ns: int, speed: float, new: TractionState,
+             frame: Frame | None = None) -> bool:
         """Keep ``new``, solved from :meth:`carried`'s state; False (nothing kept) if it jumped.
 
         A jump (another contact than the last) restarts from zero traction:
         the caller then solves with :meth:`solve`, which finds the jump itself.
+        ``frame``: the patch's contact frame, as :meth:`solve` takes it.
         """
         assert self.state is not None
-        if self._jumped(self.state, new):
+        position = self._position(new, speed, frame)
+        if self._jumped(self.state, new, position):
             return False
-        self._commit(stamp_ns, speed, new, None)
+        self._commit(stamp_ns, speed, new, None, position)
         return True
 
     def _commit(self, stamp_ns: int, speed: float, new: TractionState,
-                reason: str | None) -> None:
+                reason: str | None, position: tuple[float, float, float] | None) -> None:
         self.state = new
+        self.position = position
         if reason is not None:
             self.counts[reason] += 1
         self.stamp_ns = int(stamp_ns)
         self.direction = math.copysign(1.0, speed)
         self.lost = False
 
-    def _jumped(self, old: TractionState, new: TractionState) -> bool:
-        """Whether the patch's area or centroid moved beyond the tolerance in one step."""
+    @staticmethod
+    def _position(state: TractionState, speed: float,
+                  frame: Frame | None) -> tuple[float, float, float] | None:
+        """Return the state's pressure centroid in the frame ``frame`` is given in (m).
+
+        The solver's grid is the contact frame's, turned by 180 degrees about
+        ``z`` in reverse running (``speed`` < 0): ``(x, y) -> (-x, -y)``.
+        """
+        if frame is None:
+            return None
+        origin, e_x, e_y = frame
+        turn = -1.0 if speed < 0.0 else 1.0
+        c_x, c_y = turn * state.centroid[0], turn * state.centroid[1]
+        return (origin[0] + c_x * e_x[0] + c_y * e_y[0], origin[1] + c_x * e_x[1] + c_y * e_y[1],
+                origin[2] + c_x * e_x[2] + c_y * e_y[2])
+
+    def _jumped(self, old: TractionState, new: TractionState,
+                position: tuple[float, float, float] | None = None) -> bool:
+        """Whether the patch's area or centroid moved beyond the tolerance in one step.
+
+        The centroid's move is measured where the patches' frames are given
+        (the wheelset frame: a contact frame's origin moves with its patch,
+        so in it a patch that moved keeps its centroid), else in the grid.
+        """
         tol = self.jump_tolerance
-        moved = math.hypot(new.centroid[0] - old.centroid[0], new.centroid[1] - old.centroid[1])
+        if position is not None and self.position is not None:
+            moved = math.dist(position, self.position)
+        else:
+            moved = math.hypot(new.centroid[0] - old.centroid[0],
+                               new.centroid[1] - old.centroid[1])
         return abs(new.area - old.area) > tol * old.area or moved > tol * old.half_length
 
     def solve(self, stamp_ns: int, speed: float, pressure: ArrayLike, x0: float, y0: float,
               dx: float, dy: float, xi: float, eta: float, phi: float, mu: float | None = None,
               *, reference: tuple[float, float] = (0.0, 0.0), bound: str = "given",
-              friction: FrictionLaw | None = None) -> tuple[ContactForces, str | None]:
+              friction: FrictionLaw | None = None,
+              frame: Frame | None = None) -> tuple[ContactForces, str | None]:
         """Solve the patch stamped ``stamp_ns`` (ns) at rolling speed ``speed`` (m/s, signed).
 
         The distance rolled since the last solved patch is ``|V| dt``
         (``dt`` from the stamps: the state's rules depend on the messages
         only, so a replay gives the node's answers).  Return the forces and
         the reset reason that applied (``None``: the state carried over).
+        ``frame``: the patch's contact frame ``(origin, e_x, e_y)`` in a frame
+        the patches share (the wheelset's; m, unit vectors), for the jump
+        rule; ``None``: the grids share one frame.
         """
         p = _pressure(pressure, 2)
         reason = self._rule(stamp_ns, speed)
@@ -689,13 +727,15 @@ class ContactMemory:
         args = (p, x0, y0, dx, dy, xi, eta, phi, rolled, mu)
         kw = {"reference": reference, "bound": bound, "friction": friction, "speed": abs(speed)}
         forces, new = self.solver.step(state, *args, **kw)  # type: ignore[arg-type]
-        if reason is None and state is not None and self._jumped(state, new):
+        position = self._position(new, speed, frame)
+        if reason is None and state is not None and self._jumped(state, new, position):
             # another contact than the last one: its material has no history
             reason = "patch_jump"
             forces, new = self.solver.step(None, *args, **kw)  # type: ignore[arg-type]
+            position = self._position(new, speed, frame)
         elif reason is None and self.solver.resampled:
             reason = "resampled"
-        self._commit(stamp_ns, speed, new, reason)
+        self._commit(stamp_ns, speed, new, reason, position)
         return forces, reason
 
 

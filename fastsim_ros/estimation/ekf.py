@@ -96,6 +96,9 @@ FloatArray = NDArray[np.float64]
 UPDATED, UNOBSERVABLE = "updated", "unobservable"
 #: the model's error is at most this many of its scales s (the bound taken as two sigma)
 MODEL_BOUND_SIGMAS = 2.0
+#: a sensitivity r at or below this is none, even with min_sensitivity 0: dividing by a
+#: slope of zero (full adhesion, no contact) gave an infinite correction (1)
+NO_SENSITIVITY = 1e-12
 
 
 class EkfStep(NamedTuple):
@@ -272,7 +275,8 @@ class FrictionEkf:
         mu0, var0, c0 = self.mu, self.variance, self.model_bound
         sigma0 = math.sqrt(var0 + c0 * c0)
         sensitivity = math.sqrt(h2) / load
-        if not sensitivity >= self.min_sensitivity:
+        # a zero slope is never information, whatever the threshold (0 is a legal one)
+        if not (sensitivity >= self.min_sensitivity and sensitivity > NO_SENSITIVITY):
             self.skipped += 1
             return EkfStep(UNOBSERVABLE, mu0, sigma0, mu0, sigma0, slope, sensitivity,
                            innovation, model_bound=c0)
