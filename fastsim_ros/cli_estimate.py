@@ -108,7 +108,7 @@ def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
 
 def run(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``estimate``: a dict of the results."""
-    from fastsim_ros.estimation.fit import fit_friction
+    from fastsim_ros.estimation.fit import MU_RANGE, fit_friction
     from fastsim_ros.estimation.model import solver_for
 
     cli._check_material(args.nu, args.shear_modulus)
@@ -147,6 +147,23 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     def finite_or_none(v: float) -> float | None:
         return v if math.isfinite(v) else None
 
+    if not math.isfinite(fit.sigmas["mu_s"]):
+        # the fit's mu_s would be its starting value (--mu): not an answer
+        raise InvalidInputError(
+            f"{args.measured}: the samples do not determine mu_s (their forces do not depend "
+            "on it: the linear range, full adhesion, or no force); give samples nearer "
+            "saturation")
+    if any(abs(fit.mu_s - b) <= 1e-6 * b for b in MU_RANGE):
+        raise InvalidInputError(
+            f"{args.measured}: no friction coefficient in [{MU_RANGE[0]:g}, {MU_RANGE[1]:g}] "
+            f"fits the samples (best {fit.mu_s:.4g}, worst error "
+            f"{fit.worst_error_percent:.3g}% of mu N): are the forces' sign (METHOD.md: "
+            "opposing the creepage), units (N) and --load those of the patch?")
+
+    def determined(name: str, value: float) -> float | None:
+        # an undetermined parameter stays at its starting value: not an answer either
+        return value if math.isfinite(fit.sigmas[name]) else None
+
     result: dict[str, Any] = {
         "mu_static": fit.mu_s, "friction_law": fit.law, "method": args.method,
         "N": fit.load, "samples": int(creepages.shape[0]),
@@ -155,7 +172,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "worst_error_percent_mu_N": fit.worst_error_percent,
         "rms_error_percent_mu_N": fit.rms_error_percent, "evaluations": fit.evaluations}
     if exponential:
-        result.update(friction_limit_ratio=fit.limit_ratio, friction_decay=fit.decay,
+        result.update(friction_limit_ratio=determined("limit_ratio", fit.limit_ratio),
+                      friction_decay=determined("decay", fit.decay),
                       sigma_friction_limit_ratio=finite_or_none(fit.sigmas["limit_ratio"]),
                       sigma_friction_decay=finite_or_none(fit.sigmas["decay"]),
                       speed=abs(args.speed))
@@ -166,7 +184,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
 def print_table(result: dict[str, Any]) -> None:
     """Print the fit readably."""
-    def pm(v: float, s: float | None) -> str:
+    def pm(v: float | None, s: float | None) -> str:
+        if v is None:
+            return "undetermined by the samples"
         return f"{v:.5g} +- {s:.2g}" if s is not None else f"{v:.5g} (undetermined)"
 
     print(f"method {result['method']}, friction {result['friction_law']}, N = "
@@ -175,6 +195,7 @@ def print_table(result: dict[str, Any]) -> None:
     print(f"  mu_s = {pm(result['mu_static'], result['sigma_mu_static'])}")
     if result["friction_law"] == "exponential":
         print(f"  A = {pm(result['friction_limit_ratio'], result['sigma_friction_limit_ratio'])}")
-        print(f"  B = {pm(result['friction_decay'], result['sigma_friction_decay'])} s/m")
+        unit = " s/m" if result["friction_decay"] is not None else ""
+        print(f"  B = {pm(result['friction_decay'], result['sigma_friction_decay'])}{unit}")
     print(f"  fitted curve: worst error {result['worst_error_percent_mu_N']:.3g}% of mu N, "
           f"rms {result['rms_error_percent_mu_N']:.3g}%")

@@ -277,6 +277,43 @@ def test_cli_bad_files_exit_2_with_one_line(capsys, tmp_path, text, words):
     assert err.count("\n") == 1 and words in err and "Traceback" not in err
 
 
+def test_cli_never_prints_a_value_the_samples_do_not_give(capsys, tmp_path, solver, hertz):
+    """What the fit cannot determine is an error or null, never its starting value.
+
+    Samples in the linear range (the force does not depend on mu) and forces
+    of the wrong sign or units (no mu in the fit's range reproduces them):
+    one line, exit 2 (before: ``--mu``'s 0.3, or the range's bound 0.001 or
+    5, printed as the answer).  The exponential law at zero rolling speed
+    (no slip velocity: A and B unseen): A and B null, mu_s and its sigma
+    determined (before: A and B at their starting values and mu_s's sigma
+    null, the whole covariance singular).
+    """
+    import json
+    law = friction_law("constant", 0.3)
+    linear = np.column_stack([np.linspace(1e-7, 2e-6, 12), np.zeros(12), np.zeros(12)])
+    f = solver.solve_batch(hertz.pressure, hertz.x0, hertz.y0, hertz.dx, hertz.dy, linear,
+                           friction=law)[:, :1]
+    for path, words in ((write_curve(tmp_path / "linear.csv", linear, f), "do not determine"),
+                        (write_curve(tmp_path / "zero.csv", linear, 0.0 * f),
+                         "do not determine")):
+        code, out, err = estimate(capsys, path)
+        assert code == 2 and out == "" and words in err and err.count("\n") == 1, err
+    full = curve(16, 2e-2)
+    f = solver.solve_batch(hertz.pressure, hertz.x0, hertz.y0, hertz.dx, hertz.dy, full,
+                           friction=law)[:, :1]
+    for path in (write_curve(tmp_path / "sign.csv", full, -f),
+                 write_curve(tmp_path / "units.csv", full, 1e3 * f)):
+        code, out, err = estimate(capsys, path)
+        assert code == 2 and out == "" and "no friction coefficient" in err, err
+    code, out, err = estimate(capsys, write_curve(tmp_path / "good.csv", full, f),
+                              "--friction-law", "exponential", "--speed", "0")
+    assert code == 0, err
+    result = json.loads(out)
+    assert abs(result["mu_static"] - 0.3) < 1e-3 and result["sigma_mu_static"] is not None
+    assert result["friction_limit_ratio"] is None and result["friction_decay"] is None
+    assert result["sigma_friction_limit_ratio"] is None
+
+
 def test_cli_bad_bytes_and_missing_file_exit_2(capsys, tmp_path):
     path = tmp_path / "bin.csv"
     path.write_bytes(b"xi,eta,phi,Fx\n\xff\xfe,0,0,1\n")

@@ -10,8 +10,9 @@ the limit ratio ``A`` and the decay ``B`` (s/m) for the exponential law
 Gauss-Newton (bounds: ``mu_s > 0``, ``0 < A <= 1``, ``B >= 0``), forward
 differences for the Jacobian.  Standard deviations: the diagonal of
 ``s^2 (J^T J)^-1``, ``s^2`` the residuals' variance (n - p degrees of
-freedom); a parameter the data do not determine (singular ``J^T J``) has
-none (``nan``).  The fitted curve's worst error is reported in % of
+freedom); a parameter the data do not determine (its column of ``J`` zero,
+or ``J^T J`` singular) has none (``nan``), and the others' are those of the
+rest.  The fitted curve's worst error is reported in % of
 ``mu_s N``.
 """
 
@@ -124,10 +125,17 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
     s2 = float(np.sum(sol.fun ** 2)) / dof
     names = ("mu_s", "limit_ratio", "decay")[:p]
     sigmas = {name: math.nan for name in names}
-    jtj = sol.jac.T @ sol.jac
-    if np.all(np.isfinite(jtj)) and np.linalg.cond(jtj) < 1e14:
-        cov = np.linalg.inv(jtj) * s2
-        sigmas = {name: math.sqrt(max(float(cov[i, i]), 0.0)) for i, name in enumerate(names)}
+    # a parameter the forces do not depend on at all (A and B at zero rolling speed, mu_s in
+    # full adhesion) has a zero column: the others' covariance is that of the rest
+    jac = np.asarray(sol.jac, dtype=np.float64)
+    norms = np.linalg.norm(jac, axis=0) if np.all(np.isfinite(jac)) else np.zeros(p)
+    seen = np.flatnonzero(norms > 1e-12 * max(float(norms.max()), 1e-300))
+    if seen.size:
+        jtj = jac[:, seen].T @ jac[:, seen]
+        if np.linalg.cond(jtj) < 1e14:
+            cov = np.linalg.inv(jtj) * s2
+            for k, i in enumerate(seen.tolist()):
+                sigmas[names[i]] = math.sqrt(max(float(cov[k, k]), 0.0))
     mu_n = float(theta[0]) * load
     err = np.abs(predicted - z)
     return FrictionFit(law, float(theta[0]), float(theta[1]) if exponential else 1.0,
