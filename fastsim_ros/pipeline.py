@@ -384,6 +384,7 @@ class Pipeline:
         self._apply(config)
 
     def _apply(self, config: PipelineConfig) -> None:
+        previous: PipelineConfig | None = getattr(self, "config", None)
         self.config = config
         self._solver = self._override or self._solvers[config["method"]]
         self._bound = config["traction_bound"]
@@ -396,7 +397,7 @@ class Pipeline:
         rate = float(config["marker_rate"])
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
-        self._apply_estimation(config)
+        self._apply_estimation(config, previous)
         self._model_error_share = float(config["friction_model_error"])
         # the estimator's measurement model: the configured solver, law shape and bound
         self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
@@ -419,11 +420,14 @@ class Pipeline:
         self._compiled: tuple[Any, ...] | None = None
         solver = self._solver
         self._transient = config["rolling"] == "transient" and self._override is None
-        # a new method, material or gap rule: the contacts' memories start afresh
-        key = (self._transient, config["method"], float(config["transient_max_gap"]))
+        # a new method or rolling: the contacts' memories start afresh; a new gap rule
+        # applies to them from the next patch (their state and counts carry on)
+        key = (self._transient, config["method"])
         if key != self._memory_key:
             self._memories = {}
             self._memory_key = key
+        for memory in self._memories.values():
+            memory.max_gap = float(config["transient_max_gap"])
         if isinstance(solver, MaeSolver) and not self._tractions:
             code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
             self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
@@ -431,20 +435,32 @@ class Pipeline:
                               self._law is not None, solver._calibrated, solver._pair_knots,
                               solver._pair_values)
 
-    def _apply_estimation(self, config: PipelineConfig) -> None:
-        """Start the friction estimator (estimation on), or retune the running one."""
+    def _apply_estimation(self, config: PipelineConfig,
+                          previous: PipelineConfig | None = None) -> None:
+        """Start the friction estimator (estimation on), or retune the running one.
+
+        At run time a new ``friction_coefficient`` restarts the estimate from
+        it, and a new ``friction_estimate_sigma`` sets the estimate's
+        uncertainty to it (an operator's new prior: the rail was cleaned, the
+        estimate is not to be trusted); the other settings change how the
+        estimate moves from then on.
+        """
         if config["friction_estimation"] != "on":
             self._ekf = None
             return
         q, r = float(config["friction_process_noise"]), float(config["friction_measurement_noise"])
         gate = float(config["friction_min_sensitivity"])
+        mu, sigma = float(config["friction_coefficient"]), float(config["friction_estimate_sigma"])
         if self._ekf is None:
-            self._ekf = FrictionEkf(float(config["friction_coefficient"]),
-                                    float(config["friction_estimate_sigma"]), process_noise=q,
-                                    measurement_noise=r, min_sensitivity=gate)
-        else:  # the state carries on; only how it moves changes
-            self._ekf.process_noise, self._ekf.measurement_noise = q, r
-            self._ekf.min_sensitivity = gate
+            self._ekf = FrictionEkf(mu, sigma, process_noise=q, measurement_noise=r,
+                                    min_sensitivity=gate)
+            return
+        self._ekf.process_noise, self._ekf.measurement_noise = q, r
+        self._ekf.min_sensitivity = gate
+        if previous is not None:
+            new_mu = mu != float(previous["friction_coefficient"])
+            if new_mu or sigma != float(previous["friction_estimate_sigma"]):
+                self._ekf.restart(sigma, mu if new_mu else None)
 
     def update(self, changes: Mapping[str, Any]) -> None:
         """Apply new values of parameters (checked; the material and contacts stay)."""
@@ -1103,9 +1119,10 @@ class Pipeline:
         ]
         values += [(f"rejected/{r}", str(stats.counts[r])) for r in REJECTION_REASONS]
         values.append(("rolling", str(self.config["rolling"])))
-        memory = self._memories.get(contact)
-        if memory is not None:  # why the contact's traction state was reset (transient.py)
-            values += [(f"transient/{r}", str(memory.counts[r])) for r in RESET_REASONS]
+        if self._transient:  # why the contact's traction state was reset (transient.py)
+            memory = self._memories.get(contact)
+            values += [(f"transient/{r}", str(memory.counts[r] if memory is not None else 0))
+                       for r in RESET_REASONS]
         level, message = 0, "ok"
         if stats.window_inputs == 0:
             level, message = 1, "no patch in the last period"

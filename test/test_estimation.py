@@ -476,6 +476,43 @@ def test_a_measured_force_no_rail_can_give_is_held_not_taken(hertz):
     assert values["friction_estimation/implausible"] == "2"
 
 
+def test_a_run_time_prior_restarts_the_estimate(hertz):
+    """friction_coefficient at run time restarts the estimate from it; the sigma reopens it.
+
+    A rig engineer who sets the friction by hand while estimating (a rail
+    just cleaned or sanded) means it: the estimate starts again from that
+    value with friction_estimate_sigma, and the wrenches use it at once;
+    a new friction_estimate_sigma alone sets the estimate's uncertainty.
+    (Before, both were taken and did nothing.)
+    """
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from ros_messages import cdr, cloud_msg, rolling_twist
+
+    pipe = Pipeline(PipelineConfig.from_values(dict(
+        contacts=["left"], friction_estimation="on", friction_coefficient=0.3,
+        friction_measurement_noise=NOISE)))
+    t0 = 1_700_000_000 * 1_000_000_000
+
+    def cycle(k, force):
+        stamp = t0 + k * 5_000_000
+        pipe.on_wheel_twist(cdr(rolling_twist(8e-3, stamp_ns=stamp)))
+        pipe.on_measured_wrench(cdr(wrench_msg((force, 0.0, 0.0), stamp)))
+        return pipe.on_patch("left", cdr(cloud_msg(hertz, stamp_ns=stamp, dtype="<f8")))
+
+    for k in range(20):  # the truth: about mu 0.2 in full slip on the 50 kN wheel
+        out = cycle(k, -0.2 * LOAD)
+    assert abs(out.friction.mu - 0.2) < 0.02 and out.friction.sigma < 0.02
+    pipe.update({"friction_estimate_sigma": 0.2})
+    assert pipe._ekf.sigma == pytest.approx(0.2) and pipe._ekf.mu == out.friction.mu
+    pipe.update({"friction_coefficient": 0.45})
+    assert pipe._ekf.mu == 0.45 and pipe._ekf.sigma == pytest.approx(0.2) and pipe._mu == 0.45
+    first = cycle(20, -0.2 * LOAD)
+    # the cycle's wrench solved with the operator's mu: near full slip, |Fx| ~ 0.45 N
+    assert abs(first.forces.fx) > 0.4 * LOAD
+    pipe.update({"friction_process_noise": 1e-4})  # how it moves, not where it is
+    assert pipe._ekf.mu == first.friction.mu
+
+
 def test_estimation_is_taken_in_both_patch_sources():
     # profiles mode too (test_profile_estimation.py runs it)
     from fastsim_ros.params import checked

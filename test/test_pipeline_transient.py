@@ -135,3 +135,34 @@ def test_a_patch_that_moves_is_a_jump_and_one_that_creeps_is_not(compiled, speed
     assert values["transient/patch_jump"] == "1"
     again = [at(n, 5.5e-3).forces.fx for n in range(14, 26)]
     assert again[-1] == pytest.approx(settled, rel=1e-3)
+
+
+def test_the_reset_keys_are_there_from_the_start_and_survive_a_new_gap_rule() -> None:
+    """/diagnostics lists every transient/<reason> from the start (0 before any patch).
+
+    A run-time transient_max_gap applies to the running memory from the next
+    patch: its state and counts carry on (before, the memories were dropped:
+    the keys vanished and the counts restarted).  An empty patch followed by
+    nothing for longer than the gap is a stamp gap (the history is unknown),
+    not a start.
+    """
+    pipe = make(rolling="transient", transient_max_gap=0.01)
+    values = dict(pipe.report("left").values)
+    assert all(values[f"transient/{r}"] == "0" for r in
+               ("start", "stamp_gap", "lost_contact", "patch_jump", "resampled", "reversed"))
+    cycle(pipe, T0, XI1)
+    carried = cycle(pipe, T0 + MS, XI1)
+    pipe.update({"transient_max_gap": 0.05})
+    assert dict(pipe.report("left").values)["transient/start"] == "1"
+    # 20 ms later: within the new gap, the state carried over
+    later = cycle(pipe, T0 + 21 * MS, XI1)
+    assert dict(pipe.report("left").values)["transient/stamp_gap"] == "0"
+    assert later.forces.fx == pytest.approx(carried.forces.fx, rel=0.05)
+    empty = np.zeros_like(patch().pressure)
+    assert cycle(pipe, T0 + 22 * MS, XI1, pressure=empty).status == "no_contact"
+    steady = make()
+    back = cycle(pipe, T0 + 122 * MS, XI1)  # 100 ms after the empty patch
+    values = dict(pipe.report("left").values)
+    assert values["transient/stamp_gap"] == "1" and values["transient/lost_contact"] == "0"
+    assert values["transient/start"] == "1"
+    assert back.forces.fx == cycle(steady, T0 + 122 * MS, XI1).forces.fx

@@ -56,13 +56,16 @@ State rules (:class:`ContactMemory`, stated in :data:`RESET_REASONS`):
 
 - ``start``: the first patch; the rig was rolling before the node listened:
   the steady state is the best estimate;
-- ``stamp_gap``: more than ``max_gap`` (s) since the last solved patch (a
-  dropped stream, a standstill): the history is unknown, steady state;
-- ``lost_contact``: the previous patch was empty (a lifted wheel): the new
-  contact starts from zero traction (its material has no history);
+- ``stamp_gap``: more than ``max_gap`` (s) since the last solved patch, or
+  since the last empty one (a dropped stream, a standstill): the history is
+  unknown, steady state;
+- ``lost_contact``: the previous patch was empty (a lifted wheel), at most
+  ``max_gap`` before: the new contact starts from zero traction (its
+  material has no history);
 - ``patch_jump``: the load-bearing area changed by more than ``jump_tolerance``
-  (relative) or its centroid moved by more than ``jump_tolerance`` times the
-  patch's half length in one step (a new contact, e.g. a flange): zero traction;
+  (relative) or its pressure centroid moved by more than ``jump_tolerance``
+  times the patch's half length in one step, in the frame the patches' contact
+  frames are given in (a new contact, e.g. a flange): zero traction;
 - ``resampled`` (not a reset): another grid (cell size, origin, shape): the
   previous traction is interpolated bilinearly onto the new cell centres in
   the contact plane, zero outside the previous contact;
@@ -614,9 +617,10 @@ class ContactMemory:
 
     def _rule(self, stamp_ns: int, speed: float) -> str | None:
         """Return the reset that applies before the solve (the jump is found after it)."""
-        if self.lost and self.lost_ns is not None and stamp_ns >= self.lost_ns and (
-                stamp_ns - self.lost_ns) * 1e-9 <= self.max_gap:
-            return "lost_contact"
+        if self.lost and self.lost_ns is not None:
+            if stamp_ns >= self.lost_ns and (stamp_ns - self.lost_ns) * 1e-9 <= self.max_gap:
+                return "lost_contact"
+            return "stamp_gap"  # an empty patch, then nothing for longer than the gap
         if self.stamp_ns is None or self.state is None:
             return "start"
         if (stamp_ns - self.stamp_ns) * 1e-9 > self.max_gap or stamp_ns < self.stamp_ns:

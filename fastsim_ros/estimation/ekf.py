@@ -179,6 +179,19 @@ class FrictionEkf:
         self.skipped = 0
         self.steps = 0
 
+    def restart(self, sigma: float, mu: float | None = None) -> None:
+        """Start again from ``mu`` (None: the estimate as it is) with standard deviation ``sigma``.
+
+        An operator's new prior (a run-time ``friction_coefficient`` or
+        ``friction_estimate_sigma``): the noise part is ``sigma^2`` (at most
+        ``sigma_max^2``), the model's bound is dropped, the counts stay.
+        """
+        lo, hi = self.mu_bounds
+        if mu is not None:
+            self.mu = min(max(_positive("mu", mu), lo), hi)
+        self.variance = min(_positive("sigma", sigma), self.sigma_max) ** 2
+        self.model_bound = 0.0
+
     @property
     def sigma(self) -> float:
         """Return the standard deviation of the estimate, ``sqrt(P + c^2)``."""
