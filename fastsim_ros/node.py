@@ -355,6 +355,18 @@ class _FrontEnd:
                 if verdict != "ok" and log.due():
                     log.warning(f"{what} twist dropped: {verdict}")
             return kinematics
+        if spec.check is not None:  # the measured wrench: no outcome, a verdict to log
+            check = spec.check
+            log = ThrottledLog(node.get_logger())
+
+            def screened(raw: bytes) -> None:
+                if not self._active:
+                    self._dropped_inactive += 1
+                    return
+                verdict = check(raw)
+                if verdict != "ok" and log.due():
+                    log.warning(f"{spec.topic} dropped: {verdict}")
+            return screened
         take, publish = spec.take, self._publish
 
         def callback(raw: bytes) -> None:

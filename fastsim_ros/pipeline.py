@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 import time
 from collections import deque
-from collections.abc import Callable, Container, Mapping, Sequence
+from collections.abc import Callable, Collection, Container, Mapping, Sequence
 from dataclasses import MISSING, dataclass, field, fields
 from typing import Any
 
@@ -226,7 +226,9 @@ class InputTopic:
     ``topic``: relative name; ``msgtype``: its ROS type; ``kind``:
     ``"patch"`` (of ``contact``), ``"wheel_twist"`` or ``"rail_twist"``;
     ``take``: the pipeline's handler of one message (CDR bytes), returning
-    the outcomes it gave (none for kinematics).
+    the outcomes it gave (none for kinematics); ``check``: for an input
+    without outcomes (the measured wrench), the same handler returning
+    ``"ok"`` or why the message was dropped (a front end logs it).
     """
 
     topic: str
@@ -234,6 +236,7 @@ class InputTopic:
     kind: str
     contact: str | None
     take: InputHandler
+    check: Callable[[bytes | memoryview], str] | None = None
 
 
 @dataclass(frozen=True)
@@ -368,6 +371,8 @@ class Pipeline:
         # transient rolling: each contact's traction between cycles (contact/transient.py)
         self._memories: dict[str, ContactMemory] = {}
         self._memory_key: tuple[Any, ...] | None = None
+        # transient rolling's reset counts of memories a method or rolling change dropped
+        self._reset_counts: dict[str, dict[str, int]] = {}
         self._fresh = 0  # contacts with a wrench not yet in a wheelset wrench
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
@@ -378,13 +383,15 @@ class Pipeline:
             maxlen=TWIST_HISTORY)
         self._measured_used_ns: int | None = None
         self._last_cycle_ns: int | None = None
+        # measured wrenches dropped, by reason (the twists' reasons)
+        self.wrench_counts = {"nonfinite": 0, "wrong_frame": 0, "old_stamp": 0, "malformed": 0}
         self.estimation_counts = {"measured": 0, "dropped": 0, "updated": 0,
                                   "unobservable": 0, "implausible": 0, "no_measurement": 0,
                                   "steps": 0}
         self._apply(config)
 
-    def _apply(self, config: PipelineConfig) -> None:
-        previous: PipelineConfig | None = getattr(self, "config", None)
+    def _apply(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
+        """Take ``config``; ``changed``: the parameters set at run time (:meth:`update`)."""
         self.config = config
         self._solver = self._override or self._solvers[config["method"]]
         self._bound = config["traction_bound"]
@@ -397,7 +404,7 @@ class Pipeline:
         rate = float(config["marker_rate"])
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
-        self._apply_estimation(config, previous)
+        self._apply_estimation(config, changed)
         self._model_error_share = float(config["friction_model_error"])
         # the estimator's measurement model: the configured solver, law shape and bound
         self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
@@ -424,6 +431,9 @@ class Pipeline:
         # applies to them from the next patch (their state and counts carry on)
         key = (self._transient, config["method"])
         if key != self._memory_key:
+            # the counts are the contact's, cumulative as every other count
+            for contact, memory in self._memories.items():
+                self._reset_counts[contact] = dict(memory.counts)
             self._memories = {}
             self._memory_key = key
         for memory in self._memories.values():
@@ -435,15 +445,14 @@ class Pipeline:
                               self._law is not None, solver._calibrated, solver._pair_knots,
                               solver._pair_values)
 
-    def _apply_estimation(self, config: PipelineConfig,
-                          previous: PipelineConfig | None = None) -> None:
+    def _apply_estimation(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
         """Start the friction estimator (estimation on), or retune the running one.
 
-        At run time a new ``friction_coefficient`` restarts the estimate from
-        it, and a new ``friction_estimate_sigma`` sets the estimate's
-        uncertainty to it (an operator's new prior: the rail was cleaned, the
-        estimate is not to be trusted); the other settings change how the
-        estimate moves from then on.
+        At run time ``friction_coefficient``, set (to any value, the one it
+        had too), restarts the estimate from it, and ``friction_estimate_sigma``
+        sets the estimate's uncertainty to it (an operator's new prior: the
+        rail was cleaned, the estimate is not to be trusted); the other
+        settings change how the estimate moves from then on.
         """
         if config["friction_estimation"] != "on":
             self._ekf = None
@@ -452,15 +461,17 @@ class Pipeline:
         gate = float(config["friction_min_sensitivity"])
         mu, sigma = float(config["friction_coefficient"]), float(config["friction_estimate_sigma"])
         if self._ekf is None:
+            # the estimate ranges over the parameter's own range: a friction_coefficient
+            # the node takes is never clamped unseen (the filter's default was 0.01 to 2)
+            spec = parameters.SPECS["friction_coefficient"]
+            assert spec.low is not None and spec.high is not None
             self._ekf = FrictionEkf(mu, sigma, process_noise=q, measurement_noise=r,
-                                    min_sensitivity=gate)
+                                    min_sensitivity=gate, mu_bounds=(spec.low, spec.high))
             return
         self._ekf.process_noise, self._ekf.measurement_noise = q, r
         self._ekf.min_sensitivity = gate
-        if previous is not None:
-            new_mu = mu != float(previous["friction_coefficient"])
-            if new_mu or sigma != float(previous["friction_estimate_sigma"]):
-                self._ekf.restart(sigma, mu if new_mu else None)
+        if "friction_coefficient" in changed or "friction_estimate_sigma" in changed:
+            self._ekf.restart(sigma, mu if "friction_coefficient" in changed else None)
 
     def update(self, changes: Mapping[str, Any]) -> None:
         """Apply new values of parameters (checked; the material and contacts stay)."""
@@ -471,7 +482,7 @@ class Pipeline:
                      "friction_estimation"):
             if config[name] != self.config[name]:
                 raise parameters.ParameterError(f"parameter {name!r} is set at start only")
-        self._apply(config)
+        self._apply(config, tuple(changes))
 
     def outputs(self) -> dict[str, str]:
         """Return every topic the pipeline publishes (relative, but /diagnostics) with its type."""
@@ -499,7 +510,8 @@ class Pipeline:
 
         twist = "geometry_msgs/msg/TwistStamped"
         measured = ((InputTopic(MEASURED_WRENCH_TOPIC, "geometry_msgs/msg/WrenchStamped",
-                                "measured_wrench", None, kinematics(self.on_measured_wrench)),)
+                                "measured_wrench", None, kinematics(self.on_measured_wrench),
+                                self.on_measured_wrench),)
                     if self._ekf is not None else ())
         return ((InputTopic(WHEEL_TWIST_TOPIC, twist, "wheel_twist", None,
                             kinematics(self.on_wheel_twist)),
@@ -560,6 +572,7 @@ class Pipeline:
         taken = self._screened(wrench, self._measured[-1][0] if self._measured else None)
         if isinstance(taken, str):
             self.estimation_counts["dropped"] += 1
+            self.wrench_counts[taken] += 1
             return taken
         f = taken.linear
         self._measured.append((taken.stamp_ns, (f[0], f[1], f[2])))
@@ -909,6 +922,7 @@ class Pipeline:
         if memory is None:
             memory = ContactMemory(TransientSolver(self._solver),
                                    max_gap=float(self.config["transient_max_gap"]))
+            memory.counts.update(self._reset_counts.get(contact, {}))
             self._memories[contact] = memory
         return memory
 
@@ -1070,7 +1084,8 @@ class Pipeline:
             twists += (("friction_estimation/mu", f"{self._ekf.mu:.6g}"),
                        ("friction_estimation/sigma", f"{self._ekf.sigma:.3g}")) + tuple(
                 (f"friction_estimation/{key}", str(v))
-                for key, v in self.estimation_counts.items())
+                for key, v in self.estimation_counts.items()) + tuple(
+                (f"measured_wrench/{key}", str(v)) for key, v in self.wrench_counts.items())
         statuses: list[tuple[str, int, str, Sequence[tuple[str, str]]]] = []
         for c in self.config.contacts:
             r = self.report(c)
@@ -1121,8 +1136,8 @@ class Pipeline:
         values.append(("rolling", str(self.config["rolling"])))
         if self._transient:  # why the contact's traction state was reset (transient.py)
             memory = self._memories.get(contact)
-            values += [(f"transient/{r}", str(memory.counts[r] if memory is not None else 0))
-                       for r in RESET_REASONS]
+            counts = memory.counts if memory is not None else self._reset_counts.get(contact, {})
+            values += [(f"transient/{r}", str(counts.get(r, 0))) for r in RESET_REASONS]
         level, message = 0, "ok"
         if stats.window_inputs == 0:
             level, message = 1, "no patch in the last period"

@@ -413,7 +413,18 @@ def test_pipeline_holds_without_a_fresh_measurement(hertz):
     assert pipe.on_measured_wrench(cdr(wrench_msg((1.0, 0.0, 0.0), t0 + 1, "base"))) \
         == "wrong_frame"
     assert pipe.on_measured_wrench(cdr(wrench_msg((math.nan, 0.0, 0.0), t0 + 2))) == "nonfinite"
-    assert pipe.estimation_counts["dropped"] == 2
+    assert pipe.on_measured_wrench(b"\x00\x01") == "malformed"
+    assert pipe.on_measured_wrench(cdr(wrench_msg((1.0, 0.0, 0.0), t0 - 1))) == "old_stamp"
+    assert pipe.estimation_counts["dropped"] == 4
+    # each counted by its reason in /diagnostics, as a dropped twist is
+    values = {v.key: v.value for v in pipe.diagnostics(t0).status[0].values}
+    assert {k: values[f"measured_wrench/{k}"] for k in
+            ("wrong_frame", "nonfinite", "malformed", "old_stamp")} == dict.fromkeys(
+        ("wrong_frame", "nonfinite", "malformed", "old_stamp"), "1")
+    # the front ends' verdict of the input (the node logs it)
+    (measured,) = [i for i in pipe.inputs() if i.kind == "measured_wrench"]
+    assert measured.check is not None
+    assert measured.check(cdr(wrench_msg((1.0, 0.0, 0.0), t0 + 3, "base"))) == "wrong_frame"
 
 
 @pytest.mark.parametrize("xi", [0.0, 1e-4])
@@ -461,7 +472,7 @@ def test_a_measured_force_no_rail_can_give_is_held_not_taken(hertz):
         friction_measurement_noise=NOISE)))
     t0 = 1_700_000_000 * 1_000_000_000
     statuses = []
-    for k, (force, pressure) in enumerate([(1e12, None), (-2.1 * LOAD, None),
+    for k, (force, pressure) in enumerate([(1e12, None), (-5.5 * LOAD, None),
                                            (-1e4, np.zeros_like(hertz.pressure))]):
         stamp = t0 + k * 5_000_000
         pipe.on_wheel_twist(cdr(rolling_twist(6e-3, stamp_ns=stamp)))
@@ -511,6 +522,29 @@ def test_a_run_time_prior_restarts_the_estimate(hertz):
     assert abs(first.forces.fx) > 0.4 * LOAD
     pipe.update({"friction_process_noise": 1e-4})  # how it moves, not where it is
     assert pipe._ekf.mu == first.friction.mu
+    # the value it had is a value too: putting the dry value back after a wet spell
+    for k in range(21, 40):
+        cycle(k, -0.2 * LOAD)
+    assert abs(pipe._ekf.mu - 0.2) < 0.02
+    pipe.update({"friction_coefficient": 0.45})
+    assert pipe._ekf.mu == 0.45 == pipe._mu
+    pipe.update({"friction_estimate_sigma": 0.2})
+    assert pipe._ekf.sigma == pytest.approx(0.2)
+
+
+@pytest.mark.parametrize("mu", [0.001, 0.005, 3.0, 5.0])
+def test_the_estimate_keeps_to_the_parameters_range_not_a_narrower_one(hertz, mu):
+    """friction_coefficient takes [0.001, 5]; the estimate starts where it is set, unclamped.
+
+    The filter's own range was 0.01 to 2: 3.0 was taken and solved at 2.
+    """
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    pipe = Pipeline(PipelineConfig.from_values(dict(
+        contacts=["left"], friction_estimation="on", friction_coefficient=mu)))
+    assert pipe._ekf.mu == mu == pipe._mu
+    pipe.update({"friction_coefficient": 0.3})
+    pipe.update({"friction_coefficient": mu})
+    assert pipe._ekf.mu == mu == pipe._mu
 
 
 def test_estimation_is_taken_in_both_patch_sources():

@@ -135,9 +135,17 @@ def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
         got = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in estimates}
         got_fx = {(c, stamp_ns(w)): w.wrench.force.x for c, ws in client.wrenches.items()
                   for w in ws}
+        # a measured wrench in another frame: dropped, counted by its reason, logged
+        bad = WrenchStamped()
+        bad.header.frame_id = "base_link"
+        bad.header.stamp.sec = 2_000_000_000
+        pubs["/wheelset/measured_wrench"].publish(bad)
+        assert client.wait_for(lambda: client.diagnostic_values("left").get(
+            "measured_wrench/wrong_frame") == "1", 20.0)
     finally:
         client.close()
         assert proc.stop() == 0
+    assert "wheelset/measured_wrench dropped: wrong_frame" in proc.output()
     assert len(want) == 400 and got.keys() == want.keys()
     for stamp, value in want.items():
         assert got[stamp] == pytest.approx(value, rel=1e-12), stamp

@@ -166,3 +166,16 @@ def test_the_reset_keys_are_there_from_the_start_and_survive_a_new_gap_rule() ->
     assert values["transient/stamp_gap"] == "1" and values["transient/lost_contact"] == "0"
     assert values["transient/start"] == "1"
     assert back.forces.fx == cycle(steady, T0 + 122 * MS, XI1).forces.fx
+
+
+def test_the_reset_counts_are_cumulative_across_a_method_change() -> None:
+    """A run-time method (or rolling) change starts the memories afresh, the counts carry on."""
+    pipe = make(rolling="transient", transient_max_gap=0.01)
+    cycle(pipe, T0, XI1)
+    cycle(pipe, T0 + 30 * MS, XI1)  # a gap
+    pipe.update({"method": "mae"})
+    values = dict(pipe.report("left").values)
+    assert (values["transient/start"], values["transient/stamp_gap"]) == ("1", "1")
+    cycle(pipe, T0 + 31 * MS, XI1)  # the new method's memory: a start
+    values = dict(pipe.report("left").values)
+    assert (values["transient/start"], values["transient/stamp_gap"]) == ("2", "1")
