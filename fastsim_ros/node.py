@@ -341,31 +341,23 @@ class _FrontEnd:
     def _input_callback(self, spec: InputTopic) -> Callable[[bytes], None]:
         """Return the subscription callback of an input: its handler, then the outputs."""
         node: Node = self  # type: ignore[assignment]
+        # inputs without outcomes (twists, the measured wrench): the verdict, logged if a drop
+        check, what = spec.check, spec.topic
         if spec.kind in ("wheel_twist", "rail_twist"):
-            on = (self.pipeline.on_wheel_twist if spec.kind == "wheel_twist"
-                  else self.pipeline.on_rail_twist)
-            what = "wheelset" if spec.kind == "wheel_twist" else "rail"
-            log = ThrottledLog(node.get_logger())
-
-            def kinematics(raw: bytes) -> None:
-                if not self._active:
-                    self._dropped_inactive += 1
-                    return
-                verdict = on(raw)
-                if verdict != "ok" and log.due():
-                    log.warning(f"{what} twist dropped: {verdict}")
-            return kinematics
-        if spec.check is not None:  # the measured wrench: no outcome, a verdict to log
-            check = spec.check
+            check = (self.pipeline.on_wheel_twist if spec.kind == "wheel_twist"
+                     else self.pipeline.on_rail_twist)
+            what = "wheelset twist" if spec.kind == "wheel_twist" else "rail twist"
+        if check is not None:
+            on = check
             log = ThrottledLog(node.get_logger())
 
             def screened(raw: bytes) -> None:
                 if not self._active:
                     self._dropped_inactive += 1
                     return
-                verdict = check(raw)
+                verdict = on(raw)
                 if verdict != "ok" and log.due():
-                    log.warning(f"{spec.topic} dropped: {verdict}")
+                    log.warning(f"{what} dropped: {verdict}")
             return screened
         take, publish = spec.take, self._publish
 

@@ -66,15 +66,21 @@ def _string(text):
     return b"\x00\x01\x00\x00" + len(data).to_bytes(4, "little") + data
 
 
-def _write(path, records, monkeypatch, chunk_bytes):
-    """Write ``(channel, log_ns, text)`` records in this order, chunks of ``chunk_bytes``."""
-    monkeypatch.setattr(mcap, "CHUNK_BYTES", chunk_bytes)
+def _writer(path):
+    """Return a writer of ``path`` with two String channels, ids 1 and 2 (/chatter1, 2)."""
     text, _ = bagio.TYPESTORE.generate_msgdef("std_msgs/msg/String", ros_version=2)
     w = mcap.McapWriter(path)
     w.add_schema(mcap.Schema(1, "std_msgs/msg/String", "ros2msg", text.encode()))
     for cid in (1, 2):
         w.add_channel(mcap.Channel(cid, 1, f"/chatter{cid}", "cdr", mcap.metadata_map(
             {"offered_qos_profiles": ""})))
+    return w
+
+
+def _write(path, records, monkeypatch, chunk_bytes):
+    """Write ``(channel, log_ns, text)`` records in this order, chunks of ``chunk_bytes``."""
+    monkeypatch.setattr(mcap, "CHUNK_BYTES", chunk_bytes)
+    w = _writer(path)
     for cid, t, s in records:
         w.write(cid, t, _string(s))
     w.close("")
@@ -151,12 +157,7 @@ def test_message_indexes_of_single_and_bulk_writes_point_at_their_records(tmp_pa
     from mcap.stream_reader import StreamReader
     monkeypatch.setattr(mcap, "CHUNK_BYTES", 700)
     path = tmp_path / "mixed.mcap"
-    text, _ = bagio.TYPESTORE.generate_msgdef("std_msgs/msg/String", ros_version=2)
-    w = mcap.McapWriter(path)
-    w.add_schema(mcap.Schema(1, "std_msgs/msg/String", "ros2msg", text.encode()))
-    for cid in (1, 2):
-        w.add_channel(mcap.Channel(cid, 1, f"/chatter{cid}", "cdr", mcap.metadata_map(
-            {"offered_qos_profiles": ""})))
+    w = _writer(path)
     written = []
     t = 0
     for run in range(12):
