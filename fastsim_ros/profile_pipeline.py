@@ -70,6 +70,8 @@ from msg_adapters.profile_msgs import (StampedPose, cloud_cdr, patch_cloud, read
 POSE_TOPIC, LOAD_TOPIC = "wheelset/pose", "wheelset/load"
 #: loads kept for matching pose stamps
 LOAD_HISTORY = 1024
+#: the largest wheel load taken (N): wheel_load's own range, and the wheelset solve's
+MAX_WHEEL_LOAD = 1.0e7
 #: the table's vertical balance with the creep forces: to this share of the load (1 N at
 #: 10 kN: the creep forces then err by 1e-4 of themselves, twenty times below the table's
 #: median interpolation error, docs/validation_table.md), in at most BALANCE_ITERATIONS
@@ -237,7 +239,7 @@ class ProfilePipeline:
         self._last_pose_ns: int | None = None
         self._clouds: dict[str, Cloud] = {}
         self.pose_counts = {"pose": 0, "load": 0, "malformed": 0, "wrong_frame": 0,
-                            "nonfinite": 0, "old_stamp": 0}
+                            "nonfinite": 0, "out_of_range": 0, "old_stamp": 0}
 
     @property
     def config(self) -> PipelineConfig:
@@ -297,7 +299,7 @@ class ProfilePipeline:
                 InputTopic(RAIL_TWIST_TOPIC, twist, "rail_twist", None,
                            kinematics(self.on_rail_twist)),
                 InputTopic(LOAD_TOPIC, "geometry_msgs/msg/WrenchStamped", "load", None,
-                           kinematics(self.on_load))) + measured + (
+                           kinematics(self.on_load), self.on_load)) + measured + (
                 InputTopic(POSE_TOPIC, "geometry_msgs/msg/PoseStamped", "pose", None, pose),)
 
     def messages(self, outcome: Outcome,
@@ -322,6 +324,10 @@ class ProfilePipeline:
             spec = SPECS.get(name)
             if spec is not None and not spec.dynamic and value != self.config[name]:
                 raise ParameterError(f"parameter {name!r} is set at start only")
+        if self.table is not None and "wheel_load" in changes and \
+                not float(changes["wheel_load"]) > 0.0:
+            raise ParameterError("parameter 'wheel_load': profile_table needs the wheel load "
+                                 "(N) > 0 (a pose's height is not the table's)")
         self.pipeline.update(changes)
 
     # ------------------------------------------------------------------ inputs
@@ -344,9 +350,13 @@ class ProfilePipeline:
                 return "malformed"
         if load.frame_id != self.config["wheelset_frame"]:
             reason = "wrong_frame"
-        elif not all(math.isfinite(v) for v in load.linear + load.angular) \
-                or min(self.split_load(load.linear[2], load.angular[0])) < 0.0:
-            reason = "nonfinite"  # a negative share cannot press a wheel onto its rail
+        elif not all(math.isfinite(v) for v in load.linear + load.angular):
+            reason = "nonfinite"
+        elif not all(0.0 <= share <= MAX_WHEEL_LOAD
+                     for share in self.split_load(load.linear[2], load.angular[0])):
+            # a negative share cannot press a wheel onto its rail; beyond wheel_load's own
+            # range a table patch scaled by Hertz grew past any memory before its size check
+            reason = "out_of_range"
         elif self._loads and load.stamp_ns < self._loads[-1].stamp_ns:
             reason = "old_stamp"
         else:
@@ -359,14 +369,24 @@ class ProfilePipeline:
     def wheel_loads(self, stamp_ns: int) -> tuple[float, float] | None:
         """Return the per-wheel loads (N) for a pose stamped ``stamp_ns``, or ``None``.
 
-        A share of zero lifts that wheel (no patches, a zero wrench).
+        A share of zero lifts that wheel (no patches, a zero wrench).  The
+        load follows the kinematics' rules: the newest ``wheelset/load`` not
+        after the pose and at most ``max_kinematics_age`` before it;
+        ``wheel_load`` (0: the pose's height) only until a load has arrived.
+        Once one has, a pose without a fresh one is rejected
+        (``stale_kinematics``: the rig's load is not known, and another would
+        give other forces).
         """
         max_age = round(float(self.config["max_kinematics_age"]) * 1e9)
         for load in reversed(self._loads):
             if load.stamp_ns <= stamp_ns:
                 if stamp_ns - load.stamp_ns <= max_age:
                     return self.split_load(load.linear[2], load.angular[0])
-                break
+                raise RejectedInput("stale_kinematics", f"the last wheelset/load is "
+                                    f"{(stamp_ns - load.stamp_ns) * 1e-6:.3g} ms older than "
+                                    "the pose")
+        if self._loads:
+            raise RejectedInput("stale_kinematics", "no wheelset/load at or before the pose")
         per_wheel = float(self.config["wheel_load"])
         return (per_wheel, per_wheel) if per_wheel > 0.0 else None
 
@@ -408,7 +428,13 @@ class ProfilePipeline:
             wheel, rail = self.pipeline.kinematics(stamp)
         except RejectedInput as e:
             return self._dropped(stamp, e.reason, e.detail)
-        loads = self.wheel_loads(stamp)
+        try:
+            loads = self.wheel_loads(stamp)
+        except RejectedInput as e:
+            return self._dropped(stamp, e.reason, e.detail)
+        if self.table is not None and loads is None:  # (wheel_load 0 is refused with a table)
+            return self._dropped(stamp, "no_kinematics", "the contact table needs a wheel "
+                                 "load: no wheelset/load and wheel_load is 0")
         contact: WheelsetContact | TableContact
         solved: dict[str, Solved | None] = {}
         try:

@@ -48,9 +48,13 @@ class StampedPose:
         :class:`MalformedMessageError`.
         """
         x, y, z, w = self.orientation
-        norm = math.sqrt(x * x + y * y + z * z + w * w)
-        if not norm > 0.0:
+        # scaled by its largest component first: a finite quaternion of 1e300 squared to inf
+        # (its norm then made it zero: a 90 degree yaw served as none)
+        big = max(abs(x), abs(y), abs(z), abs(w))
+        if not big > 0.0:
             raise MalformedMessageError("a zero quaternion")
+        x, y, z, w = x / big, y / big, z / big, w / big
+        norm = math.sqrt(x * x + y * y + z * z + w * w)
         x, y, z, w = x / norm, y / norm, z / norm, w / norm
         r00 = 1.0 - 2.0 * (y * y + z * z)
         r01 = 2.0 * (x * y - z * w)

@@ -227,3 +227,19 @@ def test_a_bare_name_of_a_shipped_profile_reads_the_shipped_file(tmp_path, monke
     (tmp_path / name).write_text("0 0\n")
     assert resolve_path(name) == Path(name)
     assert resolve_path("sub/" + name) == Path("sub/" + name)
+
+
+@pytest.mark.parametrize("smooth, points", [(0.0, 10_001), (2e-3, 4_001)])
+def test_more_points_than_a_profile_has_are_one_line(tmp_path, smooth, points):
+    """A file under the size limit with 10,000+ points: refused at once, not hours of loops.
+
+    The loop check grows with the square of the count and the smoothing spline
+    is dense: 400,000 points (8.5 MB) took 6 GB and never finished, 20,000
+    smoothed ones ended in a MemoryError.
+    """
+    y = np.linspace(-0.07, 0.07, points)
+    z = 1e-3 * np.cos(y / 0.07 * math.pi)
+    path = tmp_path / "dense.txt"
+    path.write_text("".join(f"{a * 1e3:.9f} {b * 1e3:.9f}\n" for a, b in zip(y, z)))
+    with pytest.raises(ProfileError, match="at most"):
+        read_profile(path, kind="rail", smooth=smooth)

@@ -257,6 +257,39 @@ def test_save_and_read_round_trip(table, wheelset, grid, tmp_path):
                                                     ["junk.npz", "t.npz"])
 
 
+def test_a_damaged_table_file_is_a_table_error(table, wheelset, grid, tmp_path):
+    """Empty, truncated, bit-flipped, a plain array, NaN pressures: TableError, never another.
+
+    The cache then rebuilds (cached_table catches TableError); before, an
+    EOFError, BadZipFile, TypeError or ValueError ended the node's start with
+    a traceback, and the lifecycle node's configure failed without a word.
+    """
+    key = table_key(wheelset, grid, LOAD)
+    good = tmp_path / "t.npz"
+    table.save(good, key)
+    data = good.read_bytes()
+    flipped = bytearray(data)
+    flipped[len(data) // 2] ^= 0xFF
+    damaged = {"empty.npz": b"", "truncated.npz": data[:len(data) // 3],
+               "flipped.npz": bytes(flipped), "tail.npz": data[:-40]}
+    for name, content in damaged.items():
+        (tmp_path / name).write_bytes(content)
+    np.save(tmp_path / "array.npy", np.zeros(3))
+    (tmp_path / "array.npy").rename(tmp_path / "array.npz")
+    with np.load(good) as f:
+        arrays = {k: f[k] for k in f.files}
+    arrays["pressure"] = arrays["pressure"].copy()
+    arrays["pressure"][0] = np.nan
+    np.savez(tmp_path / "nan.npz", **arrays)
+    for name in (*damaged, "array.npz", "nan.npz"):
+        try:
+            ContactTable.read(tmp_path / name, key)
+        except TableError as e:
+            assert "not a contact table" in str(e) or "other profiles" in str(e), name
+        else:
+            assert name == "flipped.npz"  # a flip inside a pressure may still read
+
+
 def test_the_key_follows_every_input(wheelset, grid):
     key = table_key(wheelset, grid, LOAD)
     assert table_key(wheelset, grid, 2 * LOAD) != key

@@ -13,7 +13,8 @@ from geometry_msgs.msg import PoseStamped, WrenchStamped
 from msg_adapters.cdr import read_cloud
 from msg_adapters.errors import MalformedMessageError
 from msg_adapters.patch import patch_from_cloud
-from msg_adapters.profile_msgs import (cloud_cdr, patch_cloud, quaternion, read_load, read_pose)
+from msg_adapters.profile_msgs import (StampedPose, cloud_cdr, patch_cloud, quaternion, read_load,
+                                       read_pose)
 from sensor_msgs.msg import PointCloud2
 
 
@@ -57,6 +58,13 @@ def test_an_unnormalised_quaternion_gives_the_same_angles():
     pose = read_pose(serialize_message(_pose_msg(0, "track", (0, 0, 0), (3 * x, 3 * y, 3 * z,
                                                                          3 * w))))
     assert pose.roll_yaw() == pytest.approx((0.01, 0.02), abs=1e-15)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e300, 1.7e308])
+def test_a_huge_or_tiny_quaternion_gives_its_angles(scale):
+    """Normalised without overflow: 1e300 (0, 0, 1, 1) is a 90 degree yaw, not none."""
+    pose = StampedPose(0, "track", (0.0, 0.0, 0.0), (0.0, 0.0, scale, scale))
+    assert pose.roll_yaw() == pytest.approx((0.0, math.pi / 2), abs=1e-12)
 
 
 def test_a_zero_quaternion_and_truncated_bytes_are_malformed():

@@ -13,6 +13,7 @@ from fastsim_ros.params import PROFILE_CONTACTS, ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from fastsim_ros.profile_pipeline import BALANCE_TOLERANCE, ProfilePipeline
 from msg_adapters.cdr import StampedTwist
+from msg_adapters.errors import RejectedInput
 from msg_adapters.profile_msgs import StampedPose, quaternion
 
 MS = 1_000_000
@@ -125,14 +126,36 @@ def test_a_load_all_on_one_wheel_lifts_the_other():
 
 @pytest.mark.parametrize("load, why", [
     (StampedTwist(0, "other", (0.0, 0.0, 2e4), (0.0, 0.0, 0.0)), "wrong_frame"),
-    (StampedTwist(0, "wheelset", (0.0, 0.0, -2e4), (0.0, 0.0, 0.0)), "nonfinite"),
-    (StampedTwist(0, "wheelset", (0.0, 0.0, 2e4), (2e5, 0.0, 0.0)), "nonfinite"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, -2e4), (0.0, 0.0, 0.0)), "out_of_range"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, 2e4), (2e5, 0.0, 0.0)), "out_of_range"),
+    (StampedTwist(0, "wheelset", (0.0, 0.0, 1e13), (0.0, 0.0, 0.0)), "out_of_range"),
     (StampedTwist(0, "wheelset", (0.0, 0.0, math.nan), (0.0, 0.0, 0.0)), "nonfinite"),
 ])
 def test_bad_loads_are_not_taken(load, why):
     p = ProfilePipeline(_config(wheel_load=0.0))
     assert p.on_load(load) == why
     assert p.wheel_loads(1 * MS) is None
+    assert p.pose_counts[why] == 1
+    (taken,) = [i for i in p.inputs() if i.kind == "load"]
+    assert taken.check is not None  # the node logs the verdict
+
+
+def test_a_stale_load_is_rejected_not_replaced():
+    """Once a load has arrived, a pose without a fresh one is stale_kinematics.
+
+    Before, wheel_load (or, at 0, the pose's height: zero wrenches as if the
+    wheelset were lifted) silently took the measured load's place.
+    """
+    p = ProfilePipeline(_config(wheel_load=1e4))
+    p.on_wheel_twist(_twist(0))
+    assert p.on_load(StampedTwist(0, "wheelset", (0.0, 0.0, 1.6e4), (0.0, 0.0, 0.0))) == "ok"
+    assert p.wheel_loads(1 * MS) == (8e3, 8e3)
+    late = 1 * MS + round(p.config["max_kinematics_age"] * 1e9) + MS
+    with pytest.raises(RejectedInput, match="older than the pose"):
+        p.wheel_loads(late)
+    p.on_wheel_twist(_twist(late))
+    cycle = p.on_pose(_pose(late, 0.0))
+    assert {o.status for o in cycle.outcomes} == {"stale_kinematics"}
 
 
 def test_without_a_load_the_pose_height_is_used_and_a_lifted_pair_has_no_contact():
@@ -200,6 +223,17 @@ def table_cache(tmp_path_factory):
 @pytest.fixture(scope="module")
 def tabled(table_cache):
     return ProfilePipeline(_config(**TABLE, table_cache=str(table_cache)))
+
+
+def test_the_table_refuses_a_wheel_load_of_zero_at_run_time(tabled):
+    """The table needs a load: wheel_load 0 is refused at run time as at start.
+
+    Before, it was taken and poses went to the per-pose solve at their own
+    height (328 kN on a pose outside the table).
+    """
+    with pytest.raises(ParameterError, match="wheel_load"):
+        tabled.update({"wheel_load": 0.0})
+    assert tabled.config["wheel_load"] > 0.0
 
 
 def _serve(p, stamp, dy, yaw, **twist):

@@ -60,6 +60,12 @@ Kind = Literal["wheel", "rail"]
 
 #: fewer points than this cannot describe a wheel or rail surface
 MIN_POINTS = 10
+#: at most this many distinct points (measured profiles have hundreds to a few thousand):
+#: the loop check and the smoothing's matrices grow with the square of the count, and a
+#: 400,000-point file (8.5 MB, under MAX_FILE_BYTES) took 6 GB and never finished
+MAX_POINTS = 10_000
+#: ... and with smoothing (its spline is solved densely: 4,000 points take some 0.4 GB)
+MAX_SMOOTHED_POINTS = 4_000
 #: a zig-zag: two successive direction changes sharper than this (rad; CONTACT's ZIGTHRS)
 ZIGZAG_ANGLE = 5.0 * math.pi / 6.0
 #: summed chord length of a profile, in its own unit: millimetres or metres (CONTACT: 5..500 mm)
@@ -362,6 +368,11 @@ def _canonical(kind: Kind, label: str, y: FloatArray, z: FloatArray, index: NDAr
     y, z, index = y[keep], z[keep], index[keep]
     if y.size < MIN_POINTS:
         raise ProfileError(f"{label}: {y.size} distinct points, at least {MIN_POINTS} needed")
+    most = MAX_SMOOTHED_POINTS if smooth > 0.0 else MAX_POINTS
+    if y.size > most:
+        raise ProfileError(f"{label}: {y.size} distinct points, at most {most} taken"
+                           f"{' with smoothing' if smooth > 0.0 else ''} (resample it: a "
+                           "profile has hundreds to a few thousand)")
     length = _chord_length(y, z)
     if not MIN_LENGTH_MM * 1e-3 <= length <= MAX_LENGTH_MM * 1e-3:
         raise ProfileError(f"{label}: the profile is {length * 1e3:.4g} mm long, outside "

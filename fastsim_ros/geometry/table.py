@@ -66,6 +66,7 @@ import math
 import os
 import tempfile
 import time
+import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -1143,7 +1144,22 @@ class ContactTable:
 
     @classmethod
     def read(cls, path: Path, key: str | None = None) -> ContactTable:
-        """Read a table written by :meth:`save`; a wrong version or ``key`` raises TableError."""
+        """Read a table written by :meth:`save`; a wrong version or ``key`` raises TableError.
+
+        So does any file that is not such a table: empty, truncated, damaged
+        (the zip's or the arrays' own errors), or with values no build gives
+        (non-finite, a negative pressure, records that do not fit together).
+        """
+        try:
+            return cls._read(path, key)
+        except TableError:
+            raise
+        except (OSError, EOFError, zipfile.BadZipFile, KeyError, ValueError, TypeError,
+                IndexError, AttributeError) as e:
+            raise TableError(f"{path}: not a contact table ({type(e).__name__}: {e})") from None
+
+    @classmethod
+    def _read(cls, path: Path, key: str | None) -> ContactTable:
         try:
             with np.load(path, allow_pickle=False) as f:
                 if int(f["version"]) != TABLE_VERSION:
@@ -1159,6 +1175,11 @@ class ContactTable:
                 windows, axes, refs = f["windows"], f["window_axes"], f["window_refs"]
         except (OSError, KeyError, ValueError) as e:
             raise TableError(f"{path}: not a contact table ({e})") from None
+        if not (np.all(np.isfinite(floats)) and np.all(np.isfinite(pressure))
+                and np.all(np.isfinite(node_rows)) and (pressure.size == 0
+                                                        or float(pressure.min()) >= 0.0)):
+            raise TableError(f"{path}: not a contact table (non-finite values or a negative "
+                             "pressure)")
         patches: list[tuple[list[TablePatch], list[TablePatch]]] = [
             ([], []) for _ in range(len(node_rows))]
         for (k, side, nb, na, off), fl in zip(meta, floats):
