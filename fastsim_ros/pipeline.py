@@ -371,7 +371,8 @@ class Pipeline:
         # transient rolling: each contact's traction between cycles (contact/transient.py)
         self._memories: dict[str, ContactMemory] = {}
         self._memory_key: tuple[Any, ...] | None = None
-        # transient rolling's reset counts of memories a method or rolling change dropped
+        # transient rolling's reset counts per contact, shared by its successive memories (a
+        # method or rolling change starts a new memory; the counts carry on)
         self._reset_counts: dict[str, dict[str, int]] = {}
         self._fresh = 0  # contacts with a wrench not yet in a wheelset wrench
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
@@ -431,9 +432,6 @@ class Pipeline:
         # applies to them from the next patch (their state and counts carry on)
         key = (self._transient, config["method"])
         if key != self._memory_key:
-            # the counts are the contact's, cumulative as every other count
-            for contact, memory in self._memories.items():
-                self._reset_counts[contact] = dict(memory.counts)
             self._memories = {}
             self._memory_key = key
         for memory in self._memories.values():
@@ -633,15 +631,17 @@ class Pipeline:
         utilisation = used / (mu * load) if load > 0.0 else 0.0
         measured = self._measurement(cycle.stamp_ns)
         status = "no_measurement"
-        if measured is not None and not (solved and load > 0.0):
+        if measured is None:
+            pass
+        elif not (solved and load > 0.0):
             status = "unobservable"  # no contact (a lifted wheelset): no force depends on mu
-        elif measured is not None and abs(measured[0] - normal_x) > (
+        elif abs(measured[0] - normal_x) > (
                 IMPLAUSIBLE_FORCE * ekf.mu_bounds[1] * load + 10.0 * ekf.measurement_noise):
             # more creep force than the highest friction the filter admits gives the load
             # (plus ten of the load cell's sigmas): a fault of the measurement, which as a
             # step of mu would drive the estimate to its bound and every wrench with it
             status = "implausible"
-        elif measured is not None:
+        else:
             model, share = self._creep_model, self._model_error_share
             # the model's samples only where a solve beyond the published one is asked
             # for (a step of mu seen, a slope the march did not give): most cycles none
@@ -661,13 +661,12 @@ class Pipeline:
                         measured[0] - normal_x, predicted, slope, load,
                         model_error(mu, adhesion, share),
                         lambda m: model.predict_with_error(samples(), m, share)[1])
-                else:
+                else:  # a slope the march did not give, or an estimate off the published mu
                     step = ekf.update((measured[0] - normal_x,),
                                       lambda m: model.predict(samples(), m), load, (predicted,),
                                       model_error(mu, adhesion, share),
                                       lambda m: model.predict_with_error(samples(), m, share)[1],
-                                      (lambda m: (slope,) if marched and m == mu
-                                       else model.slope(samples(), m)) if model.has_slope
+                                      (lambda m: model.slope(samples(), m)) if model.has_slope
                                       else None)
                 status = step.status
                 self.estimation_counts["steps"] += int(step.step_seen)
@@ -922,7 +921,8 @@ class Pipeline:
         if memory is None:
             memory = ContactMemory(TransientSolver(self._solver),
                                    max_gap=float(self.config["transient_max_gap"]))
-            memory.counts.update(self._reset_counts.get(contact, {}))
+            # the contact's counts, cumulative as every other count
+            memory.counts = self._reset_counts.setdefault(contact, memory.counts)
             self._memories[contact] = memory
         return memory
 
@@ -1135,8 +1135,7 @@ class Pipeline:
         values += [(f"rejected/{r}", str(stats.counts[r])) for r in REJECTION_REASONS]
         values.append(("rolling", str(self.config["rolling"])))
         if self._transient:  # why the contact's traction state was reset (transient.py)
-            memory = self._memories.get(contact)
-            counts = memory.counts if memory is not None else self._reset_counts.get(contact, {})
+            counts = self._reset_counts.get(contact, {})
             values += [(f"transient/{r}", str(counts.get(r, 0))) for r in RESET_REASONS]
         level, message = 0, "ok"
         if stats.window_inputs == 0:

@@ -351,7 +351,7 @@ def _check_chunk(mcap: IndexedMcap, chunk: ChunkIndex, arrays: Arrays) -> None:
         bad = int(channel[unknown][0])
         raise McapError(f"chunk at byte {chunk.offset}: a message on channel {bad}, which "
                         f"the file does not define (a corrupt chunk)")
-    if int(log_time[0]) < chunk.start_time or int(log_time[-1]) > chunk.end_time:
+    if int(log_time.min()) < chunk.start_time or int(log_time.max()) > chunk.end_time:
         raise McapError(f"chunk at byte {chunk.offset}: a message logged outside the "
                         f"chunk's time range (a corrupt chunk)")
 
