@@ -23,6 +23,7 @@ from __future__ import annotations
 import argparse
 import csv
 import math
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -149,8 +150,26 @@ def _config(args: argparse.Namespace) -> PipelineConfig:
     try:
         return PipelineConfig.from_values(values)
     except ParameterError as e:
-        raise InvalidInputError(str(e).replace("parameter 'friction_coefficient'", "--mu")
-                                .replace("parameter 'cell_size'", "--cell")) from None
+        raise _flag_error(e) from None
+
+
+#: the node's parameter behind each flag of this command: its errors name the flag
+FLAG_OF_PARAMETER = {
+    "wheel_profile": "--wheel", "rail_profile": "--rail", "right_wheel_profile": "--right-wheel",
+    "right_rail_profile": "--right-rail", "profile_smoothing": "--smooth",
+    "gauge_width": "--gauge-width", "gauge_height": "--gauge-height", "cant": "--cant",
+    "flange_back_distance": "--flange-back-distance",
+    "flange_back_position": "--flange-back-position", "nominal_radius": "--nominal-radius",
+    "cell_size": "--cell", "shear_modulus": "--shear-modulus", "poisson_ratio": "--nu",
+    "friction_coefficient": "--mu", "method": "--method", "traction_bound": "--bound",
+}
+
+
+def _flag_error(error: ParameterError) -> InvalidInputError:
+    """Return a parameter's error as this command's, naming the flag the user gave."""
+    text = re.sub(r"parameter '(\w+)'",
+                  lambda m: FLAG_OF_PARAMETER.get(m.group(1), m.group(0)), str(error))
+    return InvalidInputError(text)
 
 
 def wheel_twist(pose: Pose, speed: float, axle_spin: float, lateral_speed: float,
@@ -186,7 +205,7 @@ def solve_pose(args: argparse.Namespace, dy: float,
         pipeline = ProfilePipeline(config, solver=solver)
         cycle = _cycle(pipeline, Pose(dy, dz, yaw, roll), args, axle_spin)
     except ParameterError as e:
-        raise InvalidInputError(str(e)) from None
+        raise _flag_error(e) from None
     if cycle.contact is None:
         _refused(cycle)
     return cycle, pipeline

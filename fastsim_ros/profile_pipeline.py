@@ -43,7 +43,6 @@ import math
 from collections import deque
 from collections.abc import Callable, Container, Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any, Literal, Protocol
 
 import numpy as np
@@ -51,7 +50,7 @@ import numpy as np
 from fastsim_ros.contact.errors import ContactError
 from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
 from fastsim_ros.geometry.placement import Placement, Pose, rotation
-from fastsim_ros.geometry.profiles import Profile, read_profile
+from fastsim_ros.geometry.profiles import Profile, expand_path, read_profile
 from fastsim_ros.geometry.table import (ContactTable, TableError, TableGrid, TablePatch,
                                         TableRangeError, cached_table)
 from fastsim_ros.geometry.table import warm_up as table_warm_up
@@ -129,7 +128,10 @@ def table_of(config: PipelineConfig, wheelset: Wheelset,
         raise ParameterError("parameter 'wheel_load': profile_table needs the reference wheel "
                              "load (N) > 0")
     cache = str(config["table_cache"])
-    directory = Path(cache).expanduser() if cache else None
+    try:
+        directory = expand_path(cache) if cache else None
+    except ValueError as e:
+        raise ParameterError(f"parameter 'table_cache': {e}") from None
     return cached_table(wheelset, table_grid_of(config), load, directory,
                         refine=int(config["table_refine"]), log=log)
 

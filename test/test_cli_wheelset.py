@@ -187,11 +187,13 @@ def test_the_table_output_names_both_wheels(capsys):
     (["--dy", "-0.045", "--yaw", "0", "--roll", "0", "--load", "1e4"], "derailment"),
     (["--dy", "0", "--yaw", "0", "--load", "1e4", "--cell", "0"], "cell"),
     (["--dy", "0", "--yaw", "0", "--load", "1e4", "--wheel", "/nonexistent/w.prw"],
-     "w.prw: cannot read"),
-    (["--dy", "0", "--yaw", "0", "--load", "1e4", "--gauge-width", "9"], "gauge_width"),
+     "^fastsim_contact: error: --wheel: /nonexistent/w.prw: cannot read"),
+    (["--dy", "0", "--yaw", "0", "--load", "1e4", "--rail", ""], "--rail: '' is not allowed"),
+    (["--dy", "0", "--yaw", "0", "--load", "1e4", "--gauge-width", "9"],
+     r"--gauge-width: 9.0 is not allowed; it must be in \[0.3, 3\]"),
     (["--dy", "0", "--yaw", "0", "--load", "1e4", "-o", "x.csv"], "-o and --plot belong"),
 ], ids=["load-and-dz", "no-dy", "no-load", "negative-load", "nan", "derailment", "cell",
-        "missing-file", "gauge", "stray-output"])
+        "missing-file", "empty-rail", "gauge", "stray-output"])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, match):
     rc, out, err = run(capsys, "wheelset", *argv)
     assert rc == 2 and out == ""

@@ -10,7 +10,8 @@ import pytest
 
 from fastsim_ros.geometry.errors import PlacementError, ProfileError
 from fastsim_ros.geometry.placement import Placement, place_rail, place_wheel
-from fastsim_ros.geometry.profiles import S1002, UIC60, profile_from_points, read_profile
+from fastsim_ros.geometry.profiles import (PACKAGE_ROOT, S1002, UIC60, expand_path,
+                                           profile_from_points, read_profile)
 
 
 @pytest.fixture(scope="module")
@@ -163,8 +164,38 @@ def test_bad_simpack_files_are_refused(tmp_path, name, content, kind, match):
 def test_bytes_that_are_not_text_are_refused(tmp_path):
     path = tmp_path / "bin.prr"
     path.write_bytes(b"\xff\xfe\x00\x81" * 100)
-    with pytest.raises(ProfileError, match="not UTF-8"):
+    with pytest.raises(ProfileError, match="bin.prr: not a text file"):
         read_profile(path)
+
+
+def test_a_latin_1_comment_reads_as_the_same_profile(tmp_path):
+    # a SIMPACK file edited on a Windows machine: a degree sign in Windows-1252 / Latin-1
+    shipped = PACKAGE_ROOT / "data/profiles/MBench_S1002_v3.prw"
+    raw = shipped.read_bytes()
+    path = tmp_path / "s1002_latin1.prw"
+    path.write_bytes(b"! inclination 1:40, 1.43\xb0, M\xfcller\n" + raw)
+    with pytest.raises(UnicodeDecodeError):
+        path.read_bytes().decode("utf-8")
+    edited, original = read_profile(path), read_profile(shipped)
+    assert np.array_equal(edited.dense_y, original.dense_y)
+    assert np.array_equal(edited.dense_z, original.dense_z)
+
+
+@pytest.mark.parametrize("text, expected", [
+    ("$FASTSIM_TEST_RIG/w.prw", "/rigs/one/w.prw"),
+    ("${FASTSIM_TEST_RIG}/w.prw", "/rigs/one/w.prw"),
+    ("~/w.prw", None),
+])
+def test_paths_expand_the_home_and_environment_variables(monkeypatch, text, expected):
+    monkeypatch.setenv("FASTSIM_TEST_RIG", "/rigs/one")
+    path = expand_path(text)
+    assert str(path) == (expected or str(Path.home() / "w.prw"))
+
+
+def test_an_unset_variable_in_a_path_is_refused_naming_it(monkeypatch):
+    monkeypatch.delenv("FASTSIM_TEST_UNSET", raising=False)
+    with pytest.raises(ProfileError, match="FASTSIM_TEST_UNSET is not set"):
+        read_profile("$FASTSIM_TEST_UNSET/w.prw")
 
 
 def test_smoothing_damps_short_wavelengths_and_keeps_the_shape():

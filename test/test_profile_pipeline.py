@@ -335,6 +335,22 @@ def test_a_second_pipeline_reads_the_cached_table(tabled, table_cache, monkeypat
     assert {o.contact: o.status for o in served.outcomes}["left"] == "solved"
 
 
+def test_the_table_cache_expands_environment_variables(tabled, table_cache, monkeypatch):
+    """``table_cache: $RIG_TABLES`` names the directory the variable holds (no literal '$')."""
+    from fastsim_ros.geometry.table import ContactTable
+
+    def no_build(*args, **kwargs):
+        raise AssertionError("the table was built again")
+    monkeypatch.setattr(ContactTable, "build", no_build)
+    monkeypatch.setenv("FASTSIM_TEST_TABLES", str(table_cache))
+    again = ProfilePipeline(_config(**TABLE, table_cache="$FASTSIM_TEST_TABLES"))
+    assert again.table.nodes[0].roll == tabled.table.nodes[0].roll
+    monkeypatch.delenv("FASTSIM_TEST_TABLES")
+    with pytest.raises(ParameterError,
+                       match="'table_cache'.*FASTSIM_TEST_TABLES is not set"):
+        ProfilePipeline(_config(**TABLE, table_cache="${FASTSIM_TEST_TABLES}/x"))
+
+
 def test_the_table_needs_a_reference_load(table_cache):
     with pytest.raises(ParameterError, match="wheel_load"):
         ProfilePipeline(_config(**TABLE, wheel_load=0.0, table_cache=str(table_cache)))

@@ -45,6 +45,7 @@ than ``L_filt`` are damped, longer ones kept (Vollebregt 2022).
 from __future__ import annotations
 
 import math
+import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -118,6 +119,24 @@ class Profile:
                                     right=math.nan), dtype=np.float64)
 
 
+_VARIABLE = re.compile(r"\$(\w+|\{[^}]*\})")
+
+
+def expand_path(text: str) -> Path:
+    """Return a path with ``~`` and environment variables (``$HOME``, ``${RIG}``) expanded.
+
+    ROS parameters are not expanded by ROS itself, and a rig's parameter file
+    names its files as a shell would.  A variable that is not set raises
+    :class:`ValueError` naming it (a directory literally named ``$RIG`` is
+    never what was meant).
+    """
+    for match in _VARIABLE.finditer(text):
+        name = match.group(1).strip("{}")
+        if name not in os.environ:
+            raise ValueError(f"{text}: the environment variable {name} is not set")
+    return Path(os.path.expandvars(text)).expanduser()
+
+
 def resolve_path(name: str | Path) -> Path:
     """Return the file a profile name points to (``package://fastsim_ros/...`` or a path).
 
@@ -127,7 +146,10 @@ def resolve_path(name: str | Path) -> Path:
     text = str(name)
     if text.startswith(PACKAGE_PREFIX):
         return PACKAGE_ROOT / text[len(PACKAGE_PREFIX):]
-    path = Path(text).expanduser()
+    try:
+        path = expand_path(text)
+    except ValueError as e:
+        raise ProfileError(str(e)) from None
     # a bare file name that is not a file here: one of the shipped profiles by its name
     # (``S1002.prw``, ``UIC60.prr``), so that a first start needs no path into the package
     shipped = SHIPPED_NAMES.get(text.lower()) if path.name == text else None
@@ -192,10 +214,14 @@ def _read_text(path: Path, label: str) -> str:
         raise
     except OSError as e:
         raise ProfileError(f"{label}: cannot read it ({e.strerror or e})") from None
+    if b"\0" in raw:
+        raise ProfileError(f"{label}: not a text file (a NUL byte)")
     try:
         return raw.decode("utf-8-sig")
     except UnicodeDecodeError:
-        raise ProfileError(f"{label}: not a text file (not UTF-8)") from None
+        # a profile written on a Windows machine: a comment's degree sign or umlaut in
+        # Windows-1252 / Latin-1 (the numbers are ASCII either way)
+        return raw.decode("latin-1")
 
 
 _NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?"
