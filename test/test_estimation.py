@@ -186,6 +186,40 @@ def test_fit_recovers_the_exponential_law(solver, hertz):
     assert fit.worst_error_percent < 1.0
 
 
+def test_the_exponential_fits_sigmas_are_those_of_mu_s_a_and_b(solver, hertz):
+    """The fit runs in (mu_s, A, c = (1 - A) B); its sigmas are still those of (mu_s, A, B).
+
+    The linearised covariance ``s^2 (J^T J)^-1`` with ``J`` taken directly in
+    ``(mu_s, A, B)`` at the fitted point (central differences) gives the same
+    standard deviations as the fit's, mapped from its own parameters.
+    """
+    rng = np.random.default_rng(11)
+    cr = curve(30, 6e-2)
+    truth = friction_law("exponential", 0.4, limit_ratio=0.4, decay=0.6)
+    f = solver.solve_batch(hertz.pressure, hertz.x0, hertz.y0, hertz.dx, hertz.dy, cr,
+                           friction=truth, speed=V)[:, 0]
+    measured = f + rng.normal(0.0, 0.002 * LOAD, size=f.shape)
+    fit = fit_friction(solver, hertz, cr, measured, law="exponential", speed=V, mu0=0.3)
+    theta = np.array([fit.mu_s, fit.limit_ratio, fit.decay])
+
+    def residuals(t):
+        law = friction_law("exponential", t[0], limit_ratio=t[1], decay=t[2])
+        return (solver.solve_batch(hertz.pressure, hertz.x0, hertz.y0, hertz.dx, hertz.dy, cr,
+                                   friction=law, speed=V)[:, 0] - measured) / LOAD
+    r = residuals(theta)
+    jac = np.empty((r.size, 3))
+    for k in range(3):
+        h = 1e-4 * theta[k]
+        up, down = theta.copy(), theta.copy()
+        up[k] += h
+        down[k] -= h
+        jac[:, k] = (residuals(up) - residuals(down)) / (2 * h)
+    cov = np.linalg.inv(jac.T @ jac) * float(r @ r) / (r.size - 3)
+    for k, name in enumerate(("mu_s", "limit_ratio", "decay")):
+        assert fit.sigmas[name] == pytest.approx(math.sqrt(cov[k, k]), rel=0.05), name
+    assert abs(fit.decay - 0.6) < 3.0 * fit.sigmas["decay"]
+
+
 def test_fit_refuses_too_few_samples(solver, hertz):
     with pytest.raises(InvalidInputError):
         fit_friction(solver, hertz, curve(1), np.zeros(1), law="constant")

@@ -39,7 +39,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -101,6 +101,23 @@ class ExactSolver:
 
     def __init__(self, nu: float, shear_modulus: float) -> None:
         self.nu, self.shear_modulus = float(nu), float(shear_modulus)
+        # the last area's steady-rolling operator (its FFT spectra, strip blocks and coarse
+        # grids): a fit solves one patch under many creepages and laws
+        self._operator: tuple[bytes, Any, Any] | None = None
+
+    def _area(self, pressure: FloatArray, x0: float, y0: float, dx: float,
+              dy: float) -> tuple[Any, Any]:
+        """Return the smallest area holding the contact and its operator, kept between calls."""
+        from fastsim_ros.contact.area import GridArea
+        from fastsim_ros.contact.rolling import SteadyRollingOperator
+
+        p = np.ascontiguousarray(pressure, dtype=np.float64)
+        key = np.array([x0, y0, dx, dy, *p.shape]).tobytes() + p.tobytes()
+        if self._operator is None or self._operator[0] != key:
+            area = GridArea(float(x0), float(y0), float(dx), float(dy), p).cropped()
+            self._operator = (key, area, SteadyRollingOperator.of(
+                area, nu=self.nu, shear_modulus=self.shear_modulus))
+        return self._operator[1], self._operator[2]
 
     def solve_batch(self, pressure: FloatArray, x0: float, y0: float, dx: float, dy: float,
                     creepages: FloatArray, *, bound: str = "given",
@@ -108,17 +125,18 @@ class ExactSolver:
                     speed: float | None = None) -> FloatArray:
         """Return ``(B, 3)``: ``Fx, Fy`` (N), ``Mz`` (N m) at each row ``xi, eta, phi``."""
         from fastsim_ros.contact import exact
-        from fastsim_ros.contact.area import GridArea
 
         if bound != "given":
             raise InvalidInputError("the exact solver takes the pressure as given "
                                     "(bound given)")
-        area = GridArea(float(x0), float(y0), float(dx), float(dy), np.asarray(pressure))
+        # the cropped grid's cells keep their coordinates: the creepages' reference point
+        # and the forces are those of the given grid
+        area, operator = self._area(pressure, x0, y0, dx, dy)
         out = np.empty((len(creepages), 3))
         for k, (xi, eta, phi) in enumerate(np.asarray(creepages, dtype=np.float64)):
             sol = exact.coulomb(area, float(xi), float(eta), float(phi), nu=self.nu,
                                 shear_modulus=self.shear_modulus, friction=friction,
-                                speed=speed)
+                                speed=speed, operator=operator)
             out[k] = sol.fx, sol.fy, sol.mz
         return out
 
