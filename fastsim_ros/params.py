@@ -318,12 +318,41 @@ def _one_line(error: Exception) -> str:
     return " ".join(str(error).split())
 
 
-def load_params_file(path: Path, node_name: str = "fastsim") -> dict[str, Any]:
+#: parameters rclpy declares on every node: a node's file may set them, the replay has no use
+#: for them (its time is the messages' stamps)
+ROS_NODE_PARAMETERS = ("use_sim_time", "start_type_description_service", "qos_overrides")
+
+
+def _node_key_pattern(key: str) -> re.Pattern[str]:
+    """Return the regular expression of a parameter file's node key, as rcl matches it.
+
+    A key without a leading ``/`` is taken from the root; ``/**`` stands for
+    any number of namespace tokens (none included) and the node, ``*`` for one
+    token or a part of one (ROS 2's parameter file wildcards).
+    """
+    tokens = ("/" + key.lstrip("/")).split("/")[1:]
+    parts = []
+    for k, token in enumerate(tokens):
+        if token == "**":
+            parts.append("(?:/[^/]+)*" if k < len(tokens) - 1 else "(?:/[^/]+)+")
+        else:
+            parts.append("/" + ".*".join("[^/]*".join(re.escape(p) for p in q.split("*"))
+                                         for q in [token]))
+    return re.compile("".join(parts))
+
+
+def load_params_file(path: Path, node_name: str = "fastsim",
+                     namespace: str = "/") -> dict[str, Any]:
     """Read a ROS 2 parameter file (``<node>: ros__parameters: ...``) and check it.
 
-    The node's own section (``fastsim``, ``/fastsim``) or the wildcard
-    ``/**`` is taken; the node's section wins over the wildcard.  Raises
-    ParameterError naming the file on any problem.
+    The sections taken are those whose key names the node as ROS matches
+    it, ``namespace/node_name`` (``/rig1/fastsim``, ``/**``, ``/**/fastsim``,
+    ``/*/fastsim``), and ``fastsim`` or ``/fastsim`` in any namespace (a
+    rig's file written for the node at the root replays under its
+    namespace as well); sections with a wildcard first, then the node's own,
+    each in the file's order (a later one wins).  rclpy's own parameters
+    (:data:`ROS_NODE_PARAMETERS`, e.g. ``use_sim_time``) are accepted and
+    not used.  Raises ParameterError naming the file on any problem.
     """
     try:
         text = Path(path).read_text(encoding="utf-8")
@@ -332,17 +361,23 @@ def load_params_file(path: Path, node_name: str = "fastsim") -> dict[str, Any]:
         raise ParameterError(f"{path}: cannot read parameters: {_one_line(e)}") from None
     if not isinstance(data, dict):
         raise ParameterError(f"{path}: not a ROS 2 parameter file")
+    fqn = f"{namespace.rstrip('/')}/{node_name}"
+    own = (node_name, "/" + node_name)
+    keys = [k for k in data if isinstance(k, str)
+            and (k in own or _node_key_pattern(k).fullmatch(fqn))]
+    keys.sort(key=lambda k: "*" not in k)   # stable: the file's order within each kind
+    if not keys:
+        raise ParameterError(f"{path}: no section for node {fqn!r} ({node_name!r}, {fqn!r} "
+                             "or a wildcard such as '/**')")
     values: dict[str, Any] = {}
-    for key in ("/**", node_name, "/" + node_name):
-        section = data.get(key)
-        if section is None:
-            continue
+    for key in keys:
+        section = data[key]
         params = section.get("ros__parameters") if isinstance(section, dict) else None
         if not isinstance(params, dict):
             raise ParameterError(f"{path}: section {key!r} has no ros__parameters")
         values.update(params)
-    if not values and not any(k in data for k in ("/**", node_name, "/" + node_name)):
-        raise ParameterError(f"{path}: no section for node {node_name!r} or '/**'")
+    for name in ROS_NODE_PARAMETERS:
+        values.pop(name, None)
     try:
         return checked(values)
     except ParameterError as e:

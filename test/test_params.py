@@ -115,6 +115,35 @@ def test_wildcard_section_and_node_section(tmp_path):
     assert values["friction_coefficient"] == 0.4 and values["method"] == "fastsim_ellipse"
 
 
+@pytest.mark.parametrize("key, namespace, taken", [
+    ("/rig1/fastsim", "/rig1", True), ("/**/fastsim", "/rig1", True),
+    ("/**/fastsim", "/", True), ("/*/fastsim", "/rig1", True), ("/rig1/*", "/rig1", True),
+    ("/rig1/fast*", "/rig1", True), ("fastsim", "/rig1", True), ("/fastsim", "/rig1", True),
+    ("/rig2/fastsim", "/rig1", False), ("/*/fastsim", "/", False),
+    ("/**/other", "/rig1", False), ("/rig1/fastsim", "/", False),
+])
+def test_a_section_is_taken_where_ros_would_give_it_to_the_node(
+        tmp_path, key, namespace, taken):
+    """Node keys as ROS matches them against the node's name in its namespace."""
+    path = tmp_path / "p.yaml"
+    path.write_text(f"{key}:\n  ros__parameters:\n    friction_coefficient: 0.4\n")
+    if taken:
+        assert load_params_file(path, namespace=namespace)["friction_coefficient"] == 0.4
+    else:
+        with pytest.raises(ParameterError, match="no section for node"):
+            load_params_file(path, namespace=namespace)
+
+
+def test_the_nodes_own_section_wins_over_wildcards_and_ros_parameters_pass(tmp_path):
+    path = tmp_path / "p.yaml"
+    path.write_text("/rig1/fastsim:\n  ros__parameters:\n    friction_coefficient: 0.4\n"
+                    "/**:\n  ros__parameters:\n    use_sim_time: true\n"
+                    "    friction_coefficient: 0.2\n    method: mae\n")
+    values = load_params_file(path, namespace="/rig1")
+    assert values["friction_coefficient"] == 0.4 and values["method"] == "mae"
+    assert "use_sim_time" not in values  # rclpy's own: accepted, of no use to the replay
+
+
 def test_friction_laws_and_their_parameters_are_dynamic():
     assert params.FRICTION_LAWS == ("constant", "exponential")
     for name in ("friction_law", "friction_limit_ratio", "friction_decay"):

@@ -812,7 +812,7 @@ def test_existing_target_exits_before_work(tmp_path, capsys, existing, flags):
     (["--bogus"], "unrecognized arguments: --bogus"),
     (["-o"], "argument -o/--output: expected one argument"),
     (["--namespace", "rig 1"], "argument --namespace: 'rig 1' is not a ROS namespace"),
-    (["--namespace", "/rig1/"], "argument --namespace: '/rig1/' is not a ROS namespace"),
+    (["--namespace", "/rig1//"], "argument --namespace: '/rig1//' is not a ROS namespace"),
     (["--namespace", "//rig1"], "argument --namespace: '//rig1' is not a ROS namespace"),
 ])
 def test_bad_flags_one_line_exit_2(tmp_path, capsys, args, message):
@@ -864,3 +864,147 @@ if __name__ == "__main__":
     if sys.argv[1:2] != ["--write-golden"] or not set(sys.argv[2:]) <= set(NAMES):
         raise SystemExit("usage: python test/test_replay.py --write-golden [NAME ...]")
     write_golden(tuple(sys.argv[2:]) or NAMES)
+
+
+# ------------------------------------------------------------------ inputs of other writers
+
+def _short_copy(source, target, *, relative=False, wrench_input=False, compression=None,
+                seconds=0.5):
+    """Write the first ``seconds`` of ``source`` again; options as another writer's bag.
+
+    ``relative``: every topic without its leading slash (resolved in the root
+    namespace); ``wrench_input``: a recorded ``contact/left/wrench`` beside each
+    left patch (an output topic: never copied); ``compression``: rosbags'
+    per-message zstd compression (read message by message, not by the chunk).
+    """
+    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+    name = (lambda t: t.lstrip("/")) if relative else (lambda t: t)
+    writer = Writer(target, version=9, storage_plugin=StoragePlugin.MCAP)
+    if compression == "message":
+        writer.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+    wrench_type = TYPES.types["geometry_msgs/msg/WrenchStamped"]
+    with Reader(source) as reader, writer:
+        conns = {c.id: writer.add_connection(name(c.topic), c.msgtype, typestore=TYPES,
+                                             offered_qos_profiles=c.ext.offered_qos_profiles)
+                 for c in reader.connections}
+        recorded = writer.add_connection(name("/contact/left/wrench"), wrench_type.__msgtype__,
+                                         typestore=TYPES) if wrench_input else None
+        t0 = None
+        for conn, log_ns, raw in reader.messages():
+            t0 = log_ns if t0 is None else t0
+            if log_ns - t0 > seconds * 1e9:
+                break
+            writer.write(conns[conn.id], log_ns, raw)
+            if recorded is not None and conn.topic == "/contact/left/patch":
+                msg = TYPES.deserialize_cdr(bytes(raw), conn.msgtype)
+                w = wrench_type(header=msg.header, wrench=TYPES.types[
+                    "geometry_msgs/msg/Wrench"](force=TYPES.types["geometry_msgs/msg/Vector3"](
+                        1.0, 2.0, 3.0), torque=TYPES.types["geometry_msgs/msg/Vector3"](
+                        4.0, 5.0, 6.0)))
+                writer.write(recorded, log_ns, TYPES.serialize_cdr(w, wrench_type.__msgtype__))
+
+
+@pytest.mark.parametrize("compression", [None, "message"], ids=["chunks", "per-message"])
+def test_a_recorded_output_topic_with_a_relative_name_is_not_copied(
+        tmp_path, capsys, compression):
+    """``contact/left/wrench`` in a bag is ``/contact/left/wrench``: an output, not copied.
+
+    The per-message path compared the bag's name as written (it copied the
+    recorded wrenches beside the node's: 100 on the topic instead of 50).
+    """
+    bag = tmp_path / "relative"
+    _short_copy(BAGS / "hertz_ramp", bag, relative=True, wrench_input=True,
+                compression=compression)
+    status, out, err = run([bag, "-o", tmp_path / "out"], capsys)
+    assert status == 0, err
+    topics, _, _ = bag_contents(tmp_path / "out" / "relative")
+    assert "contact/left/wrench" not in topics
+    wrenches = topics["/contact/left/wrench"][1]
+    assert len(wrenches) == 50
+    assert all(m.wrench.force.z > 1e3 for _, m in wrenches)  # the node's: N, not the 3.0
+    assert len(topics["contact/left/patch"][1]) == 50          # inputs copied as named
+
+
+@pytest.mark.parametrize("variant", ["no_chunk_index", "unchunked"])
+def test_a_valid_mcap_without_chunk_indexes_replays(tmp_path, capsys, variant):
+    """An MCAP file with its messages but no chunk index (another writer's options).
+
+    It was refused as "empty bag (no messages)": the indexed path found no
+    chunk to read.  rosbags reads such a file message by message.
+    """
+    from mcap.reader import make_reader
+    from mcap.writer import IndexType, Writer as McapWriter
+    options = ({"index_types": IndexType.NONE} if variant == "no_chunk_index"
+               else {"use_chunking": False})
+    source = next((BAGS / "hertz_ramp").glob("*.mcap"))
+    target = tmp_path / f"{variant}.mcap"
+    with open(source, "rb") as f, open(target, "wb") as g:
+        writer = McapWriter(g, **options)
+        writer.start(profile="ros2", library="another writer")
+        schemas, channels, t0 = {}, {}, None
+        for schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
+            t0 = message.log_time if t0 is None else t0
+            if message.log_time - t0 > 5e8:
+                break
+            if schema.id not in schemas:
+                schemas[schema.id] = writer.register_schema(schema.name, schema.encoding,
+                                                            schema.data)
+            if channel.id not in channels:
+                channels[channel.id] = writer.register_channel(
+                    channel.topic, channel.message_encoding, schemas[schema.id],
+                    channel.metadata)
+            writer.add_message(channels[channel.id], message.log_time, message.data,
+                               message.publish_time, message.sequence)
+        writer.finish()
+    status, out, err = run([target, "-o", tmp_path / "out"], capsys)
+    assert status == 0, err
+    assert "left: 50 patches, 50 wrenches (50 solved" in out
+    topics, _, _ = bag_contents(tmp_path / "out" / variant)
+    assert len(topics["/contact/left/wrench"][1]) == 50
+
+
+def test_inputs_whose_outputs_clash_are_refused_before_any_work(tmp_path, capsys):
+    """``x`` with ``--csv`` writes ``x.csv``; an input named ``x.csv`` would write it too."""
+    (tmp_path / "in").mkdir()
+    for name in ("x", "x.csv"):
+        _short_copy(BAGS / "hertz_ramp", tmp_path / "in" / name, seconds=0.05)
+    out = tmp_path / "out"
+    status, stdout, err = run([tmp_path / "in" / "x", tmp_path / "in" / "x.csv", "-o", out,
+                               "--csv"], capsys)
+    assert status == 2 and stdout == ""
+    (line,) = err.splitlines()
+    assert "x.csv" in line and "would clash" in line
+    assert not out.exists()
+
+
+def test_a_url_input_is_named_by_its_url_and_a_url_out_that_is_a_file_is_refused(
+        tmp_path, capsys):
+    bag = tmp_path / "short"
+    _short_copy(BAGS / "hertz_ramp", bag, seconds=0.05)
+    status, _, err = run([f"file://{bag}", "-o", tmp_path / "out"], capsys)
+    assert status == 0, err
+    _, _, meta = bag_contents(tmp_path / "out" / "short")
+    assert meta["custom_data"]["fastsim.input"] == f"file://{bag}"  # not the local copy
+    (tmp_path / "a_file").write_text("")
+    status, stdout, err = run([bag, "-o", f"file://{tmp_path / 'a_file'}"], capsys)
+    assert status == 2 and "exists and is not a directory" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("address", ["notanaddress", "", "inproc://x", "tcp://host"])
+def test_a_malformed_scheduler_address_is_one_line_exit_2_at_once(tmp_path, capsys, address):
+    started = time.monotonic()
+    with pytest.raises(SystemExit) as info:
+        replay.main([str(BAGS / "hertz_ramp"), "-o", str(tmp_path / "out"), "--scheduler",
+                     address])
+    assert info.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "not a Dask scheduler address" in err
+    assert time.monotonic() - started < 10.0   # no client left to time out
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_namespace_with_a_trailing_slash_is_that_namespace(tmp_path, capsys, rig1_front):
+    status, out, err = run([rig1_front, "-o", tmp_path / "out", "--namespace", "/rig1/"],
+                           capsys)
+    assert status == 0 and err == ""
+    assert "contacts found in the bag (no --params): front; namespace /rig1\n" in out

@@ -154,14 +154,27 @@ def open_writer(path: Path, custom_data: dict[str, str]) -> Writer:
     return writer
 
 
+def resolve(topic: str, namespace: str = "/") -> str:
+    """Return the absolute name of ``topic`` in ``namespace``, as ROS resolves it.
+
+    An absolute name stays; a relative one is put under the namespace (a
+    bag's topic names resolve in the root namespace).
+    """
+    if topic.startswith("/"):
+        return topic
+    return f"{namespace.rstrip('/')}/{topic}"
+
+
 def copy_connections(reader: Reader, writer: Writer, skip: set[str]) -> dict[int, Any]:
     """Add a copy of each input connection (topic, type, definition, QoS) but those in ``skip``.
 
-    Return ``{input connection id: output connection}``.
+    ``skip``: absolute topic names; a bag's relative names are resolved in
+    the root namespace (:func:`resolve`) before they are compared.  Return
+    ``{input connection id: output connection}``.
     """
     copies = {}
     for conn in reader.connections:
-        if conn.topic in skip:
+        if resolve(conn.topic) in skip:
             continue
         msgdef, digest = definition(conn)
         ext = conn.ext

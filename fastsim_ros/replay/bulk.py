@@ -30,6 +30,7 @@ from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRE
                                   Outcome, Pipeline)
 from fastsim_ros.profile_pipeline import AnyPipeline
 from fastsim_ros.replay import bagio, batch, encode, faults, kernels, mcap
+from fastsim_ros.replay.bagio import resolve
 from fastsim_ros.replay.errors import BadInput
 from fastsim_ros.replay.results import Result
 
@@ -40,18 +41,11 @@ WINDOW = 8192
 _DIAG, _WRENCH, _CREEPAGE, _FRAME, _MARKER, _WHEELSET = -1, 0, 1, 2, 4, 5
 
 
-def resolve(topic: str, namespace: str = "/") -> str:
-    """Return the absolute name of ``topic`` in ``namespace`` (see :func:`run.resolve`)."""
-    if topic.startswith("/"):
-        return topic
-    return f"{namespace.rstrip('/')}/{topic}"
-
-
 def open_indexed(source: Path, reader: Any) -> mcap.IndexedMcap | None:
     """Return the input's one MCAP file opened by its index, or ``None``.
 
     ``None`` (rosbags reads it) for several files, per-message or file
-    compression, no summary or no message indexes.
+    compression, no summary, no chunk index or no message indexes.
     """
     storage = reader.storage
     files: list[Any] = getattr(storage, "storages", [storage])
@@ -63,8 +57,11 @@ def open_indexed(source: Path, reader: Any) -> mcap.IndexedMcap | None:
         indexed = mcap.open_indexed(Path(getattr(files[0], "path")))
     except (mcap.McapError, OSError) as e:
         raise BadInput(f"{source}: unreadable: {e}") from None
-    if indexed is not None and not all(c.index_offsets for c in indexed.chunks):
-        indexed.close()  # rosbags reads no chunk without message indexes: read it likewise
+    if indexed is not None and not (indexed.chunks
+                                    and all(c.index_offsets for c in indexed.chunks)):
+        # no chunk index (an unchunked file, or one written without indexes: its messages
+        # are still there), or a chunk without message indexes: rosbags reads it
+        indexed.close()
         return None
     return indexed
 

@@ -17,7 +17,7 @@ from fastsim_ros.profile_pipeline import table_of, wheelset_of
 from fastsim_ros.replay.bagio import input_name
 from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
 from fastsim_ros.replay import storage
-from fastsim_ros.replay.cluster import ClusterError
+from fastsim_ros.replay.cluster import ClusterError, scheduler_address
 from fastsim_ros.replay.errors import problem
 from fastsim_ros.replay.run import PROG, Task, remove_staging, targets, warm_up
 
@@ -46,7 +46,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", action="store_true", help="write OUT/NAME.csv, one row per wrench")
     p.add_argument("--jobs", type=_jobs, default=1, metavar="N",
                    help="replay the inputs on N worker processes (default 1)")
-    p.add_argument("--scheduler", metavar="ADDRESS",
+    p.add_argument("--scheduler", metavar="ADDRESS", type=scheduler_address,
                    help="replay each input as a task on the Dask distributed cluster of this "
                         "scheduler (e.g. tcp://10.0.0.5:8786) instead of on this machine")
     p.add_argument("--no-progress", action="store_true",
@@ -61,9 +61,12 @@ def namespace(text: str) -> str:
     """Return a ROS namespace made absolute (``rig1`` -> ``/rig1``); refuse a malformed one.
 
     Tokens of letters, digits and underscores, not starting with a digit,
-    separated by single slashes (ROS 2 name rules); ``/`` is the root.
+    separated by single slashes (ROS 2 name rules; one trailing slash is
+    dropped); ``/`` is the root.
     """
     name = text if text.startswith("/") else "/" + text
+    if len(name) > 1 and name.endswith("/") and not name.endswith("//"):
+        name = name[:-1]  # /rig1/ as a shell completes a directory-like name: /rig1
     if name == "/":
         return name
     tokens = name[1:].split("/")
@@ -105,7 +108,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     values = defaults()
     if args.params is not None:
         try:
-            values = load_params_file(args.params)
+            values = load_params_file(args.params, namespace=args.namespace)
             if values["patch_source"] == "profiles":  # its profiles read before any work
                 config = PipelineConfig.from_values(values)
                 wheelset = wheelset_of(config)
@@ -119,6 +122,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.scheduler is not None and args.jobs != 1:
         return _fail("--jobs is for this machine, --scheduler for a cluster: give one")
     names: dict[str, Path | str] = {}
+    # every file each input writes in OUT (NAME, NAME.csv, NAME.png): an input named x.csv
+    # replayed with --csv beside one named x would write x.csv twice
+    written: dict[str, Path | str] = {}
     for src in args.inputs:
         name = input_name(src)
         if not name or name.startswith("."):
@@ -126,13 +132,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         if name in names:
             return _fail(f"{src}: same name {name!r} as {names[name]}; outputs would clash")
         names[name] = src
+        for target in targets("", name, args.plot, args.csv):
+            other = written.setdefault(str(target), src)
+            if other is not src:
+                return _fail(f"{src}: its output {target} would also be {other}'s; outputs "
+                             "would clash")
     try:
-        if not storage.is_url(out) and os.path.lexists(out) and not Path(out).is_dir():
+        if storage.is_file(out):
             return _fail(f"{out}: exists and is not a directory")
         for name in names:
             for target in targets(out, name, args.plot, args.csv):
                 if storage.exists(target):
                     return _fail(f"{target}: exists already; not overwritten")
+        made = not storage.exists(out)
         storage.makedirs(out)
     except (OSError, ValueError, ImportError) as e:
         print(f"{PROG}: {out}: cannot make the output directory: {problem(e)}",
@@ -172,6 +184,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     except ClusterError as e:
         executor = None  # nothing to close: the scheduler is gone
+        if made and not storage.is_url(out) and not os.listdir(out):
+            os.rmdir(out)  # never reached: nothing of this run is left
         print(f"{PROG}: {e}; the outputs already written stay", file=sys.stderr, flush=True)
         return 1
     finally:

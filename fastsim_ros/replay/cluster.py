@@ -26,6 +26,8 @@ its own outputs, so what the cluster adds is only where it runs:
 
 from __future__ import annotations
 
+import argparse
+
 import json
 import logging
 import os
@@ -62,6 +64,27 @@ def warm_worker() -> str:
     """Load the compiled kernels (numba's disk cache), once per process: :func:`warm_up`."""
     warm_up()
     return "ok"
+
+
+def scheduler_address(text: str) -> str:
+    """Return a Dask scheduler address checked as Dask parses it (argparse's type).
+
+    ``tcp://host:port`` (or ``host:port``), ``tls://``, ``ws://``, ...: a
+    host and a port.  An address Dask cannot parse is refused here, before
+    a client is made (a client that fails to start is closed by its
+    finaliser 20 s later, with a traceback); ``inproc://`` names a scheduler
+    inside another process's memory, never reachable from this one.
+    """
+    from distributed.comm.addressing import parse_address, parse_host_port
+    try:
+        scheme, location = parse_address(text)
+        if scheme == "inproc":
+            raise ValueError("an inproc:// scheduler lives in its own process only")
+        parse_host_port(location)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a Dask scheduler address (tcp://host:port): {e}") from None
+    return text
 
 
 class Cluster:

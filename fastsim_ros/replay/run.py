@@ -41,6 +41,7 @@ from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
 from fastsim_ros.replay.records import CSV_HEADER, Series, record
 from fastsim_ros.replay.results import Profile, Result
+from fastsim_ros.replay.bagio import resolve
 
 PROG = "fastsim_replay"
 #: key of the checked parameters (JSON) in the output bag's custom_data
@@ -76,7 +77,9 @@ class Task:
     (a cluster): its staging directory then keeps the committed result
     (:data:`JOURNAL`) until the run's client removes it
     (:func:`remove_staging`), so that another attempt finishes that commit
-    and returns that result instead of replaying again.
+    and returns that result instead of replaying again.  ``given``: the input
+    as the user named it, where ``source`` is a local copy of a URL (the
+    output's ``fastsim.input``).
     """
 
     source: Path | str
@@ -91,6 +94,8 @@ class Task:
     progress: bool = False
     path: str = "auto"
     retry: bool = False
+    #: the input as the user named it (a URL fetched to a local copy), for the output's metadata
+    given: str = ""
 
 
 def targets(out: Any, name: str, plot: bool, write_csv: bool) -> list[Any]:
@@ -295,13 +300,14 @@ def _run_fetched(task: Task, profile: bool) -> Result:
                 result.error = f"{task.source}: cannot fetch: {problem(e)}"
                 return result
         if not storage.is_url(task.out):
-            result = _run_local(replace(task, source=source), profile)
+            result = _run_local(replace(task, source=source, given=str(task.source)), profile)
             result.source = str(task.source)
             result.error = result.error.replace(str(source), str(task.source))
             return result
         staged = local / "out"
         staged.mkdir()
-        result = _run_local(replace(task, source=source, out=staged, retry=False), profile)
+        result = _run_local(replace(task, source=source, out=staged, retry=False,
+                                    given=str(task.source)), profile)
         result.source = str(task.source)
         result.error = result.error.replace(str(source), str(task.source))
         result.attempts = attempt
@@ -329,17 +335,6 @@ def _progress(name: str, total: int, enabled: bool) -> Any:
     from tqdm import tqdm  # type: ignore[import-untyped]
     return tqdm(total=total, desc=name, unit="msg", file=sys.stderr, delay=1.0, leave=False,
                 dynamic_ncols=True)
-
-
-def resolve(topic: str, namespace: str = "/") -> str:
-    """Return the absolute name of ``topic`` in ``namespace``, as ROS resolves it.
-
-    An absolute name stays; a relative one is put under the namespace (a
-    bag's topic names resolve in the root namespace).
-    """
-    if topic.startswith("/"):
-        return topic
-    return f"{namespace.rstrip('/')}/{topic}"
 
 
 def _contact_name(name: str) -> bool:
@@ -376,7 +371,9 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
     reader = bagio.open_reader(source)
     csv_file = None
     try:
-        if reader.message_count == 0:
+        # metadata.yaml's count is another writer's word: 0 for a file that holds messages
+        # is possible, so a zero is checked by reading the first message
+        if reader.message_count == 0 and next(iter(reader.messages()), None) is None:
             raise BadInput(f"{source}: empty bag (no messages)")
         values = task.values
         found: tuple[str, ...] = ()
@@ -403,7 +400,7 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
                 + "; nothing solved (are --params and --namespace right?)"
                 + _namespaces_hint(reader.connections, namespace))
         custom = {PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
-                  "fastsim.input": str(source), "fastsim.replay": PROG}
+                  "fastsim.input": task.given or str(source), "fastsim.replay": PROG}
         rows = None
         if task.write_csv:
             csv_file = open(staging / f"{name}.csv", "w", newline="", encoding="utf-8")

@@ -52,6 +52,14 @@ def exists(path: str | Path) -> bool:
     return os.path.lexists(path)
 
 
+def is_file(path: str | Path) -> bool:
+    """Tell whether a local path or a URL is something other than a directory."""
+    if is_url(path):
+        fs, p = filesystem(str(path))
+        return bool(fs.exists(p)) and not fs.isdir(p)
+    return os.path.lexists(path) and not Path(path).is_dir()
+
+
 def makedirs(directory: str | Path) -> None:
     """Make a local directory or a directory URL (and its parents) if missing."""
     if is_url(directory):
