@@ -398,3 +398,34 @@ def test_as_a_program_one_line_and_no_warning(argv, tmp_path):
     assert done.stdout == ""
     assert len(done.stderr.strip().splitlines()) == 1, done.stderr
     assert done.stderr.startswith("fastsim_contact: error: ")
+
+
+@pytest.mark.parametrize("fmt, regular", [
+    ("{:.5g}", True), ("{:.6f}", True), ("{:.4g}", True), ("{:.3g}", False)])
+def test_coordinates_written_with_few_digits_are_the_grid_they_round(tmp_path, capsys, fmt,
+                                                                     regular):
+    """A 70 x 70 ellipse written to 5 or 4 significant digits, or to the micrometre.
+
+    The spacing was the median of the rounded gaps (1.7140e-4 m for
+    1.7142857e-4): its error grew along a row to 2e-6 m and the file was
+    refused as irregular.  The grid is now fitted through every coordinate;
+    a centre more than a hundredth of a cell off it is still irregular (3
+    digits: a third of a cell).
+    """
+    ar = areas.ellipse(6e-3, 4e-3, nx=70, load=6e4)
+    jj, ii = np.nonzero(ar.mask)
+    p = np.asarray(ar.pressure)
+    lines = ["x,y,pressure"] + [f"{fmt.format(float(ar.x[i]))},{fmt.format(float(ar.y[j]))},"
+                                f"{float(p[j, i])!r}" for j, i in zip(jj, ii)]
+    exact = write(tmp_path / "exact.csv", ["x,y,pressure", *cell_rows(ar)])
+    rounded = write(tmp_path / "rounded.csv", lines)
+    rc, out, err = run(capsys, "forces", "--patch", exact, *CREEP, "--json")
+    want = json.loads(out)
+    rc, out, err = run(capsys, "forces", "--patch", rounded, *CREEP, "--json")
+    if not regular:
+        assert_refused(rc, out, err, "not on a regular grid")
+        return
+    assert rc == 0, err
+    got = json.loads(out)
+    for key in ("N", "Fx", "Fy"):
+        assert got[key] == pytest.approx(want[key], abs=2e-4 * 0.3 * want["N"]), key

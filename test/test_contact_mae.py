@@ -218,3 +218,80 @@ def test_auto_split_falls_back_to_centroid_on_a_truncated_ellipse(cut):
 def test_auto_split_keeps_the_join_line_of_semi_ellipses(g1):
     ar = areas.semi_ellipses(g1, 1.0, cells=60)
     assert split_face(ar, "auto") == split_face(ar, "widest_strip")
+
+
+def tread_with_a_sliver(sliver_rows=(2, 3), chord=30):
+    """A tread-like patch and, apart, a sliver of strips as long as its longest chords.
+
+    Rows ``sliver_rows`` carry a ``chord``-cell band (a second, narrow contact
+    band at the patch's edge); rows 8..36 an ellipse whose widest strips also
+    have ``chord`` cells: two bands of strips share the longest chord.
+    """
+    ny, nx, h = 40, 40, 1e-4
+    p = np.zeros((ny, nx))
+    for j in range(8, 37):
+        half = min(chord / 2, 0.5 * chord * 1.15 * math.sqrt(max(0.0, 1 - ((j - 22) / 14.5)**2)))
+        n = int(round(half))
+        if n:
+            x = (np.arange(20 - n, 20 + n) - 19.5) / max(n, 1)
+            p[j, 20 - n:20 + n] = 1e9 * np.sqrt(np.clip(1 - x**2, 0.05, None))
+    for j in sliver_rows:
+        p[j, 5:5 + chord] = 3e8
+    return areas.GridArea(-20 * h, -20 * h, h, h, p)
+
+
+@pytest.mark.parametrize("rule", ["widest_strip", "auto"])
+def test_a_mirror_image_splits_at_the_mirrored_face_with_two_longest_bands(rule):
+    """Two bands apart share the longest chord: the widest is taken, in both orientations.
+
+    The first band from y0 was taken: the sliver at the edge on one side,
+    the tread's widest strips on the mirror image, so a centred wheelset's
+    left and right wheels (mirror images) had different MAE forces (Fx even
+    of opposite signs under spin).
+    """
+    from fastsim_ros.contact import kernels
+    from fastsim_ros.contact.mae import row_extents
+    ar = tread_with_a_sliver()
+    m = ar.mirrored_y()
+    count = row_extents(ar.mask)[0]
+    assert len(np.flatnonzero(count == count.max())) > 2   # the sliver's and the tread's
+    f, fm = split_face(ar, rule), split_face(m, rule)
+    assert fm == ar.ny - f and 8 < f < 37
+    code = {"widest_strip": kernels.RULE_WIDEST_STRIP, "auto": kernels.RULE_AUTO}[rule]
+    assert kernels.split_face(count.astype(np.int64), code) == f
+    assert kernels.split_face(row_extents(m.mask)[0].astype(np.int64), code) == fm
+
+
+def test_two_longest_bands_alike_at_one_distance_split_at_the_centroid():
+    tread = tread_with_a_sliver(sliver_rows=())
+    both = np.zeros((49, 40))
+    both[2:42] = tread.pressure              # the tread's rows 8..36 at 10..38, centred on 24
+    # a sliver on each side, alike, 23.5 rows from the centre, longer than the tread's chords
+    both[0:2, 3:37] = both[47:49, 3:37] = 3e8
+    sym = areas.GridArea(tread.x0, tread.y0, tread.dx, tread.dy, both)
+    from fastsim_ros.contact import kernels
+    from fastsim_ros.contact.mae import row_extents
+    count = row_extents(sym.mask)[0]
+    assert set(np.flatnonzero(count == count.max())) == {0, 1, 47, 48}
+    face = split_face(sym, "centroid")
+    assert face in (24, 25)   # the centre row's faces (the first band's would be 1 or 2)
+    assert split_face(sym, "widest_strip") == face
+    assert kernels.split_face(count.astype(np.int64), kernels.RULE_WIDEST_STRIP) == face
+
+
+@pytest.mark.parametrize("method", ["mae", "mae_calibrated"])
+def test_compiled_mae_forces_of_a_mirror_image_are_mirrored(method):
+    from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
+    solver = (MaeSolver if method == "mae" else CalibratedMaeSolver)(0.28, 8e10)
+    ar = tread_with_a_sliver()
+    m = ar.mirrored_y()
+    for creep in ((0.0, 0.0, 0.5), (1e-3, 0.0, 0.5), (0.0, 1e-3, 0.0)):
+        r = solver.solve(ar, *creep, mu=0.3)
+        rm = solver.solve(m, creep[0], -creep[1], -creep[2], mu=0.3)
+        scale = 0.3 * r.n
+        # y -> -y: eta and phi change sign; Fx stays, Fy and Mz change sign
+        assert abs(rm.fx - r.fx) < 1e-9 * scale and abs(rm.fy + r.fy) < 1e-9 * scale
+        assert abs(rm.mz + r.mz) < 1e-9 * scale * ar.dx * ar.nx
+    r = solver.solve(ar, 0.0, 0.0, 0.5, mu=0.3)
+    rm = solver.solve(m, 0.0, 0.0, 0.5, mu=0.3)
+    assert rm.fx == pytest.approx(-r.fx, rel=1e-9) and abs(r.fx) > 1e-4 * r.n

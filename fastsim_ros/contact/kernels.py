@@ -1041,14 +1041,36 @@ def _centroid_face(count, yc):
 def _widest_strip_face(count, yc):
     """Return the face through the band of strips with the longest chord (or a jump side)."""
     ny = count.shape[0]
-    # the band of strips sharing the longest chord (a staircase ellipse has several)
-    j0 = 0
-    for j in range(1, ny):
-        if count[j] > count[j0]:
-            j0 = j
-    j1 = j0
-    while j1 + 1 < ny and count[j1 + 1] == count[j0]:
-        j1 += 1
+    # the band of strips sharing the longest chord (a staircase ellipse has several); of
+    # several such bands apart, the widest, then the one nearest the centroid, so that a
+    # mirror image in y splits at the mirrored face (the first from y0 did not); two alike
+    # at one distance: the centroid's face
+    longest = 0
+    for j in range(ny):
+        longest = max(longest, count[j])
+    j0 = -1
+    j1 = -1
+    tie = False
+    j = 0
+    while j < ny:
+        if count[j] != longest:
+            j += 1
+            continue
+        k = j
+        while k + 1 < ny and count[k + 1] == longest:
+            k += 1
+        if j0 < 0:
+            j0, j1 = j, k
+        else:
+            wider = (k - j) - (j1 - j0)
+            nearer = abs(0.5 * (j0 + j1) - yc) - abs(0.5 * (j + k) - yc)
+            if wider > 0 or (wider == 0 and nearer > 1e-9):
+                j0, j1, tie = j, k, False
+            elif wider == 0 and abs(nearer) <= 1e-9:
+                tie = True
+        j = k + 1
+    if tie:
+        return _centroid_face(count, yc)
     below = count[j0 - 1] if j0 > 0 else 0
     above = count[j1 + 1] if j1 + 1 < ny else 0
     # chords of centred shapes change by two cells at a time (one at each end)

@@ -97,11 +97,14 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
     near its centre line the ``widest_strip`` zones come out empty and MAE's
     coefficients 30% low, the centroid split's within 4% (docs/validation.md).
     ``centroid``: the face nearest the centroid (the paper's text).
-    ``widest_strip``: through the band of strips with the longest chord: its
-    middle face (on an ellipse with an even number of strips, the centre
-    line), unless the chord drops by over a cell at each end more on one side
-    of the band than on the other (a jump: the join line of two
-    semi-ellipses), where the split takes the band's face on that side.
+    ``widest_strip``: through the band of strips with the longest chord (of
+    several bands apart, the widest, then the one nearest the centroid, so
+    that the mirror image of an area in ``y`` splits at the mirrored face;
+    two alike at one distance: the centroid's face): its middle face (on an
+    ellipse with an even number of strips, the centre line), unless the
+    chord drops by over a cell at each end more on one side of the band
+    than on the other (a jump: the join line of two semi-ellipses), where
+    the split takes the band's face on that side.
     """
     mask = area.mask
     count, _, _ = row_extents(mask)
@@ -116,11 +119,20 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
         yc = float((count * np.arange(area.ny)).sum() / count.sum())
         return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1))
     check_split_rule(rule)
-    # the band of strips sharing the longest chord (a staircase ellipse has several)
-    j0 = int(np.argmax(count))
-    j1 = j0
-    while j1 + 1 < area.ny and count[j1 + 1] == count[j0]:
-        j1 += 1
+    yc = float((count * np.arange(area.ny)).sum() / count.sum())
+    # the band of strips sharing the longest chord (a staircase ellipse has several); of
+    # several such bands apart, the widest, then the one nearest the centroid (a mirror
+    # image in y splits at the mirrored face); two alike at one distance: the centroid's
+    rows = np.flatnonzero(count == count.max())
+    bands = np.split(rows, np.flatnonzero(np.diff(rows) > 1) + 1)
+    width = max(len(b) for b in bands)
+    widest = [b for b in bands if len(b) == width]
+    distance = [abs(0.5 * (b[0] + b[-1]) - yc) for b in widest]
+    nearest = min(distance)
+    if sum(1 for d in distance if abs(d - nearest) <= 1e-9) > 1:
+        return split_face(area, "centroid")
+    band = widest[distance.index(nearest)]
+    j0, j1 = int(band[0]), int(band[-1])
     below = int(count[j0 - 1]) if j0 > 0 else 0
     above = int(count[j1 + 1]) if j1 + 1 < area.ny else 0
     # chords of centred shapes change by two cells at a time (one at each end)
@@ -134,7 +146,6 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
         return j0 + width // 2
     middle = j0 + width // 2
     # an odd band: the face of its middle strip nearer the centroid
-    yc = float((count * np.arange(area.ny)).sum() / count.sum())
     return middle + 1 if yc > middle else middle
 
 
