@@ -990,7 +990,9 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
         + (" (every one)" if len(better) == len(d) else
            f" (not on {', '.join(n for n in d if n not in better)})")
         + ", and smaller than every other method's worst case over all areas: so"
-        + (" `mae_calibrated` is the default of the node and of `fastsim_contact forces`"
+        + (" `mae_calibrated` is the default of the node (and of `fastsim_contact wheelset`;"
+           " `fastsim_contact forces` keeps the paper's `mae`, the default INTERFACE.md fixes"
+           " for that command)"
            " (INTERFACE.md: the default changes when the report shows another method better"
            " on every area)." if len(better) == len(d) else " the default stays `mae`.")
         + " The table that decides it (worst curve error per area, % of mu N):\n")

@@ -234,8 +234,8 @@ def test_bad_friction_flags_one_line_exit_2(capsys, extra, match):
     assert match in err
 
 
-def test_forces_default_method_is_the_calibrated_mae(capsys):
-    """No --method: the calibrated MAE (the default since docs/validation_wider.md)."""
+def test_forces_default_method_is_the_papers_mae(capsys):
+    """No --method: the paper's MAE (INTERFACE.md's default; the node's is mae_calibrated)."""
     from pathlib import Path
     patch = Path(__file__).resolve().parents[1] / "fastsim_ros" / "data" / "example_patch.csv"
     argv = ["forces", "--patch", str(patch), "--xi", "1e-3", "--eta", "-5e-4", "--phi", "0.5",
@@ -243,14 +243,14 @@ def test_forces_default_method_is_the_calibrated_mae(capsys):
     rc, out, err = run(capsys, *argv)
     assert rc == 0 and err == ""
     default = json.loads(out)
-    assert default["method"] == "mae_calibrated"
-    explicit = json.loads(run(capsys, *argv, "--method", "mae_calibrated")[1])
+    assert default["method"] == "mae"
+    explicit = json.loads(run(capsys, *argv, "--method", "mae")[1])
     assert default == explicit
-    paper = json.loads(run(capsys, *argv, "--method", "mae")[1])
-    assert paper["method"] == "mae"
+    calibrated = json.loads(run(capsys, *argv, "--method", "mae_calibrated")[1])
+    assert calibrated["method"] == "mae_calibrated"
     # another method, not a relabelled one: the same zones, other forces
-    assert paper["zones"] == default["zones"]
-    assert abs(paper["Fy"] - default["Fy"]) > 1e-3 * 0.3 * default["N"]
+    assert calibrated["zones"] == default["zones"]
+    assert abs(calibrated["Fy"] - default["Fy"]) > 1e-3 * 0.3 * default["N"]
 
 
 def test_calibrated_mae_coefficients_follow_the_exact_theory_on_unequal_halves(capsys):
