@@ -192,16 +192,19 @@ def build_parser() -> argparse.ArgumentParser:
 # ---------------------------------------------------------------- patch files
 
 
-def _patch_lines(path: Path) -> list[str]:
-    """Return the lines of a patch file: at most MAX_PATCH_BYTES, UTF-8 (a BOM is dropped)."""
+def _patch_lines(path: Path, what: str = "patch file") -> list[str]:
+    """Return the lines of a text file: at most MAX_PATCH_BYTES, UTF-8 (a BOM is dropped).
+
+    ``what`` names the file in the errors (``patch file``, ``measured file``).
+    """
     try:
         with open(path, "rb") as f:
             raw = f.read(MAX_PATCH_BYTES + 1)
     except OSError as e:
-        raise InvalidInputError(f"cannot read patch file {path}: {e.strerror}") from None
+        raise InvalidInputError(f"cannot read {what} {path}: {e.strerror}") from None
     if len(raw) > MAX_PATCH_BYTES:
         raise InvalidInputError(f"{path}: larger than {MAX_PATCH_BYTES // 2**20} MiB, more "
-                                f"than a patch of {MAX_PATCH_CELLS:,} cells needs")
+                                f"than a {what} may be")
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as e:
@@ -338,11 +341,21 @@ def _or_none(v: float) -> float | None:
 # ---------------------------------------------------------------- coefficients
 
 
+def _patch_alone(args: argparse.Namespace) -> None:
+    """Refuse the flags of a shape beside ``--patch`` (one or the other was not meant)."""
+    given = [flag for flag, value in (("--shape", args.shape),
+                                      ("--a-over-b", getattr(args, "a_over_b", None)),
+                                      ("--a", getattr(args, "a", None)),
+                                      ("--b", getattr(args, "b", None))) if value is not None]
+    if given:
+        raise UsageError(f"give either --patch or the shape's flags ({', '.join(given)}), "
+                         "not both")
+
+
 def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridArea], str]:
     """Return a function of the cell count that makes the area, and its description."""
     if args.patch is not None:
-        if args.shape is not None:
-            raise UsageError("give either --shape or --patch, not both")
+        _patch_alone(args)
         patch = read_patch(args.patch)
         return (lambda n: patch), f"patch {args.patch}"
     if args.shape is None:
@@ -527,8 +540,7 @@ def _force_area(args: argparse.Namespace) -> areas.GridArea:
     """
     lo, hi = LIMITS["pressure"]
     if args.patch is not None:
-        if args.shape is not None:
-            raise UsageError("give either --shape or --patch, not both")
+        _patch_alone(args)
         patch = read_patch(args.patch)
         if args.load is None:
             p_max = float(patch.pressure.max())

@@ -74,7 +74,7 @@ def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
     that is not a finite number, a creepage beyond the command line's limits,
     more than :data:`MAX_SAMPLES` rows, no row.
     """
-    rows = cli._rows(path, cli._patch_lines(path))
+    rows = cli._rows(path, cli._patch_lines(path, "measured file"))
     first = next(rows, None)
     if first is None:
         raise InvalidInputError(f"{path}: empty (no header xi,eta,phi,Fx[,Fy])")

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from fastsim_ros.atomic import write_atomically
+from fastsim_ros.atomic import check_target, write_atomically
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import ContactForces
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
@@ -273,8 +273,14 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             raise InvalidInputError("give --dy and --yaw (or --sweep-dy)")
         if args.output is not None or args.plot is not None:
             raise InvalidInputError("-o and --plot belong to --sweep-dy")
+        if args.sweep_yaw is not None:
+            raise InvalidInputError("--sweep-yaw belongs to --sweep-dy")
         cycle, pipeline = solve_pose(args, args.dy, args.yaw)
         return result_of(cycle, pipeline, args.method)
+    if args.dy is not None:
+        raise InvalidInputError("give either --dy or --sweep-dy, not both")
+    if args.yaw is not None and args.sweep_yaw is not None:
+        raise InvalidInputError("give either --yaw or --sweep-yaw, not both")
     return sweep(args)
 
 
@@ -290,9 +296,10 @@ def sweep_poses(args: argparse.Namespace) -> list[tuple[float, float]]:
     y0, y1, step = args.sweep_dy
     if not (step > 0.0) or y1 < y0:
         raise InvalidInputError("--sweep-dy needs Y0 <= Y1 and STEP > 0")
-    n = int(math.floor((y1 - y0) / step + 1e-9)) + 1
-    if n > 10_000:
-        raise InvalidInputError(f"--sweep-dy gives {n} poses, at most 10000")
+    count = (y1 - y0) / step   # a float: inf for an absurd range, compared, never converted
+    if not count < 10_000:
+        raise InvalidInputError(f"--sweep-dy gives {count + 1:.4g} poses, at most 10000")
+    n = int(math.floor(count + 1e-9)) + 1
     dys = [y0 + k * step for k in range(n)]
     if args.sweep_yaw is not None:
         p0, p1 = args.sweep_yaw
@@ -308,6 +315,10 @@ def sweep(args: argparse.Namespace) -> dict[str, Any]:
     if args.output is None:
         raise InvalidInputError("--sweep-dy needs -o OUT.csv")
     poses = sweep_poses(args)
+    # the outputs' places checked before the poses are solved (minutes), not after
+    for target in (args.output, args.plot):
+        if target is not None:
+            check_target(target)
     rows: list[dict[str, Any]] = []
     results: list[dict[str, Any] | None] = []
     for dy, yaw in poses:

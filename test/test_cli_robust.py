@@ -429,3 +429,19 @@ def test_coordinates_written_with_few_digits_are_the_grid_they_round(tmp_path, c
     got = json.loads(out)
     for key in ("N", "Fx", "Fy"):
         assert got[key] == pytest.approx(want[key], abs=2e-4 * 0.3 * want["N"]), key
+
+
+@pytest.mark.parametrize("command", [["forces", *CREEP], ["coefficients"]])
+@pytest.mark.parametrize("extra", [["--a", "6e-3", "--b", "4e-3"], ["--a-over-b", "1"],
+                                   ["--shape", "ellipse"]])
+def test_a_shapes_flags_beside_a_patch_are_refused(tmp_path, capsys, command, extra):
+    """``--patch`` with ``--a``/``--b`` or ``--a-over-b``: which was meant? (they were ignored)."""
+    path = write(tmp_path / "p.csv", ["x,y,pressure", *cell_rows(hertz())])
+    if command[0] == "coefficients" and extra[0] == "--a":
+        return  # coefficients has no --a, --b: argparse refuses them already
+    assert_refused(*run(capsys, *command, "--patch", path, *extra), "give either --patch")
+
+
+def test_estimate_names_its_measured_file_in_read_errors(tmp_path, capsys):
+    rc, out, err = run(capsys, "estimate", *ELLIPSE, "--measured", tmp_path / "none.csv")
+    assert_refused(rc, out, err, f"cannot read measured file {tmp_path / 'none.csv'}")

@@ -169,6 +169,12 @@ def test_a_sweep_writes_its_csv_and_figure(tmp_path, capsys):
     assert all(float(r["wheel_Fz"]) == pytest.approx(1e4, rel=1e-5) for r in rows)
     assert out_png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["sweep.csv", "sweep.png"]
+    # written as any new file is (mkstemp's 0600 kept: others could not read the results)
+    import os
+    umask = os.umask(0)
+    os.umask(umask)
+    for path in (out_csv, out_png):
+        assert path.stat().st_mode & 0o777 == 0o666 & ~umask
 
 
 def test_the_table_output_names_both_wheels(capsys):
@@ -192,8 +198,17 @@ def test_the_table_output_names_both_wheels(capsys):
     (["--dy", "0", "--yaw", "0", "--load", "1e4", "--gauge-width", "9"],
      r"--gauge-width: 9.0 is not allowed; it must be in \[0.3, 3\]"),
     (["--dy", "0", "--yaw", "0", "--load", "1e4", "-o", "x.csv"], "-o and --plot belong"),
+    (["--sweep-dy", "0", "1e300", "1e-300", "--load", "1e4", "-o", "x.csv"],
+     "--sweep-dy gives inf poses, at most 10000"),
+    (["--sweep-dy", "-1e308", "1e308", "1e307", "--load", "1e4", "-o", "x.csv"],
+     "--sweep-dy gives inf poses"),
+    (["--sweep-dy", "0", "2e-3", "1e-3", "--dy", "0", "--load", "1e4", "-o", "x.csv"],
+     "either --dy or --sweep-dy"),
+    (["--dy", "0", "--yaw", "0", "--sweep-yaw", "0", "1e-3", "--load", "1e4"],
+     "--sweep-yaw belongs to --sweep-dy"),
 ], ids=["load-and-dz", "no-dy", "no-load", "negative-load", "nan", "derailment", "cell",
-        "missing-file", "empty-rail", "gauge", "stray-output"])
+        "missing-file", "empty-rail", "gauge", "stray-output", "huge-sweep", "inf-sweep",
+        "dy-and-sweep", "stray-sweep-yaw"])
 def test_bad_input_is_one_line_and_exit_2(capsys, argv, match):
     rc, out, err = run(capsys, "wheelset", *argv)
     assert rc == 2 and out == ""
@@ -230,3 +245,27 @@ def test_a_centred_wheelset_gets_mirrored_forces_on_its_two_wheels(capsys, metho
         assert abs(p["Fx"] - q["Fx"]) < 2e-3 * scale, (p["Fx"], q["Fx"])
         assert abs(p["Fy"] + q["Fy"]) < 2e-3 * scale, (p["Fy"], q["Fy"])
         assert abs(p["Mz"] + q["Mz"]) < 2e-3 * scale * 0.01
+
+
+@pytest.mark.parametrize("bad", ["csv", "plot"])
+def test_a_sweep_target_that_cannot_be_written_is_refused_before_the_poses(tmp_path, capsys,
+                                                                           monkeypatch, bad):
+    """A directory given as -o or --plot: one line, exit 2, before any pose is solved.
+
+    It was found after the sweep (minutes on a real one) as an internal error,
+    exit 1, and a bad --plot left the CSV written.
+    """
+    from fastsim_ros import cli_wheelset
+    (tmp_path / "adir.csv").mkdir()
+    (tmp_path / "adir.png").mkdir()
+
+    def no_pose(*args, **kwargs):
+        raise AssertionError("a pose was solved")
+    monkeypatch.setattr(cli_wheelset, "solve_pose", no_pose)
+    out_csv = tmp_path / ("adir.csv" if bad == "csv" else "sweep.csv")
+    out_png = tmp_path / ("adir.png" if bad == "plot" else "sweep.png")
+    rc, out, err = run(capsys, "wheelset", "--sweep-dy", "0", "4e-3", "2e-3", "--load", "1e4",
+                       "-o", str(out_csv), "--plot", str(out_png))
+    assert rc == 2 and out == "" and err.count("\n") == 1
+    assert "is a directory" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["adir.csv", "adir.png"]
