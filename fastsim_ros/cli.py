@@ -59,7 +59,7 @@ DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
                  "asm_forces": 60}
 #: the methods of ``coefficients`` and of ``forces`` (the first: ``forces``' default)
 COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
-FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
+FORCE_METHODS = ("mae", "mae_calibrated", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at

@@ -378,3 +378,27 @@ def test_the_fft_solver_crops_the_empty_margin_and_answers_on_the_callers_grid()
     assert not padded.tau_x[:3].any() and not padded.slip[-5:].any()
     assert (padded.fx, padded.fy, padded.mz) == pytest.approx((tight.fx, tight.fy, tight.mz),
                                                               rel=1e-12)
+
+
+@pytest.mark.parametrize("law", [None, ExponentialFriction(0.3, 0.4, 0.6)])
+def test_a_warm_start_solves_the_same_problem_in_fewer_newton_steps(law):
+    """``start``: a nearby problem's tractions (a fit's last evaluation) start Newton.
+
+    The answer is the problem's, to the solver's tolerance, whatever the start.
+    """
+    ar = areas.ellipse(6e-3, 4e-3, nx=30, load=5e4)
+    kw = dict(nu=0.28, shear_modulus=8e10, speed=20.0)
+    kw.update(friction=law) if law is not None else kw.update(mu=0.3)
+    near = dict(kw, friction=ExponentialFriction(0.3003, 0.4, 0.6)) if law is not None \
+        else dict(kw, mu=0.3003)
+    prior = exact.coulomb(ar, 3e-3, 0.0, 0.5, **near)
+    start = np.stack([prior.tau_x[ar.mask], prior.tau_y[ar.mask]], axis=1)
+    cold = exact.coulomb(ar, 3e-3, 0.0, 0.5, **kw)
+    warm = exact.coulomb(ar, 3e-3, 0.0, 0.5, start=start, **kw)
+    scale = 0.3 * float(ar.pressure.max())
+    assert np.abs(warm.tau_x - cold.tau_x).max() < 1e-6 * scale
+    assert np.abs(warm.tau_y - cold.tau_y).max() < 1e-6 * scale
+    assert warm.fx == pytest.approx(cold.fx, rel=1e-7)
+    assert warm.iterations < cold.iterations
+    with pytest.raises(InvalidInputError, match="start tractions"):
+        exact.coulomb(ar, 3e-3, 0.0, 0.5, start=start[1:], **kw)

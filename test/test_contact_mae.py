@@ -221,7 +221,7 @@ def test_auto_split_keeps_the_join_line_of_semi_ellipses(g1):
 
 
 def tread_with_a_sliver(sliver_rows=(2, 3), chord=30):
-    """A tread-like patch and, apart, a sliver of strips as long as its longest chords.
+    """Return a tread-like patch and, apart, a sliver of strips as long as its longest chords.
 
     Rows ``sliver_rows`` carry a ``chord``-cell band (a second, narrow contact
     band at the patch's edge); rows 8..36 an ellipse whose widest strips also

@@ -281,7 +281,8 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
             nu: float, shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
             tol: float = 1e-9, max_sweeps: int = 500,
             operator: SteadyRollingOperator | None = None, friction: FrictionLaw | None = None,
-            speed: float | None = None, solver: SolverKind = "fft") -> TractionSolution:
+            speed: float | None = None, solver: SolverKind = "fft",
+            start: FloatArray | None = None) -> TractionSolution:
     """Tractions with Coulomb friction ``|tau| <= mu p``, ``p`` the area's pressure (Pa).
 
     ``friction``: a law (default ``ConstantFriction(mu)``; ``mu``, if given
@@ -300,7 +301,10 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
 
     ``solver="fft"`` (default): semismooth Newton on the whole area, GMRES
     with FFT products and strip-block preconditioning, started from the
-    grid of twice the cell size (:mod:`~fastsim_ros.contact.partial_slip`);
+    grid of twice the cell size (:mod:`~fastsim_ros.contact.partial_slip`),
+    or from ``start`` (Pa, ``(m, 2)``: the tractions of the cells in contact
+    in the mask's order, e.g. a nearby problem's solution, to the same
+    tolerance);
     memory proportional to the cells, at most :data:`MAX_COULOMB_CELLS` cells
     in contact.  ``"dense"``: the reference, block Gauss-Seidel over the
     lateral strips with the dense operator (at most
@@ -329,8 +333,12 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
         # the cells in contact (their order, row by row, is the same on both grids)
         op = _operator(operator, area if operator is not None else area.cropped(), nu,
                        shear_modulus)
+        if start is not None and np.shape(start) != (n, 2):
+            raise InvalidInputError(f"start tractions of shape {np.shape(start)}, the area has "
+                                    f"{n} cells in contact")
         res = solve_area(op, (xi, eta, phi), reference, mu_s=mu, tol=tol, law=slip_law,
-                         speed=v_roll)
+                         speed=v_roll, start=None if start is None
+                         else np.array(start, dtype=np.float64))
         return _solution(area, res.tau, res.slip, reference, res.newton, res.krylov,
                          res.products)
     if solver != "dense":

@@ -424,7 +424,8 @@ def coarsened(area: GridArea) -> GridArea:
 
 def solve_area(op: SteadyRollingOperator, creepages: tuple[float, float, float],
                reference: tuple[float, float], *, mu_s: float, tol: float,
-               law: FrictionLaw | None = None, speed: float = 0.0) -> PartialSlip:
+               law: FrictionLaw | None = None, speed: float = 0.0,
+               start: FloatArray | None = None) -> PartialSlip:
     """Solve the partial-slip problem of ``op``'s area, bound ``mu_s p``, by grid sequencing.
 
     The area on cells twice as large (:func:`coarsened`), while it keeps at
@@ -434,17 +435,19 @@ def solve_area(op: SteadyRollingOperator, creepages: tuple[float, float, float],
     but for a band of cells along their border, and Newton needs a few
     iterations whatever the grid (from the full-adhesion start it needs more
     the finer the grid, as the border moves a few cells per iteration).
+    ``start`` (Pa, ``(m, 2)``, the cells in contact in the mask's order): the
+    tractions of a nearby problem (a fit's previous evaluation) to start
+    Newton from instead; the coarse grid is then skipped.
     """
     area = op.area
     mask = area.mask
-    start = None
     cache: dict[str, SteadyRollingOperator] = op.__dict__.setdefault("_partial_slip_coarse", {})
-    if "op" not in cache:
+    if start is None and "op" not in cache:
         coarse = coarsened(area)
         if np.count_nonzero(coarse.mask) >= COARSEST_CELLS:
             cache["op"] = SteadyRollingOperator.of(coarse, nu=op.nu,
                                                    shear_modulus=op.shear_modulus)
-    if "op" in cache:
+    if start is None and "op" in cache:
         rough = solve_area(cache["op"], creepages, reference, mu_s=mu_s, tol=max(tol, 1e-3),
                            law=law, speed=speed)
         cop = cache["op"]

@@ -104,6 +104,8 @@ class ExactSolver:
         # the last area's steady-rolling operator (its FFT spectra, strip blocks and coarse
         # grids): a fit solves one patch under many creepages and laws
         self._operator: tuple[bytes, Any, Any] | None = None
+        # the last solution's tractions at each creepage on that area (Pa, (m, 2))
+        self._starts: dict[tuple[float, float, float], FloatArray] = {}
 
     def _area(self, pressure: FloatArray, x0: float, y0: float, dx: float,
               dy: float) -> tuple[Any, Any]:
@@ -117,6 +119,7 @@ class ExactSolver:
             area = GridArea(float(x0), float(y0), float(dx), float(dy), p).cropped()
             self._operator = (key, area, SteadyRollingOperator.of(
                 area, nu=self.nu, shear_modulus=self.shear_modulus))
+            self._starts = {}
         return self._operator[1], self._operator[2]
 
     def solve_batch(self, pressure: FloatArray, x0: float, y0: float, dx: float, dy: float,
@@ -132,11 +135,18 @@ class ExactSolver:
         # the cropped grid's cells keep their coordinates: the creepages' reference point
         # and the forces are those of the given grid
         area, operator = self._area(pressure, x0, y0, dx, dy)
+        starts = self._starts
+        mask = area.mask
         out = np.empty((len(creepages), 3))
         for k, (xi, eta, phi) in enumerate(np.asarray(creepages, dtype=np.float64)):
-            sol = exact.coulomb(area, float(xi), float(eta), float(phi), nu=self.nu,
-                                shear_modulus=self.shear_modulus, friction=friction,
-                                speed=speed, operator=operator)
+            # a fit evaluates the same creepages under nearby laws: each solve starts from
+            # the last one's tractions at its creepages (Newton's few last steps, not the
+            # coarse grid's solve and the whole way)
+            key = (float(xi), float(eta), float(phi))
+            sol = exact.coulomb(area, *key, nu=self.nu, shear_modulus=self.shear_modulus,
+                                friction=friction, speed=speed, operator=operator,
+                                start=starts.get(key))
+            starts[key] = np.stack([sol.tau_x[mask], sol.tau_y[mask]], axis=1)
             out[k] = sol.fx, sol.fy, sol.mz
         return out
 
