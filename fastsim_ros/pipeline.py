@@ -251,7 +251,7 @@ class ContactReport:
 
 class _ContactState:
     __slots__ = ("last_stamp_ns", "last_frame", "last_marker_ns", "wrench",
-                 "wrench_fresh", "stats", "reader", "frame_out", "result", "solved", "slope")
+                 "stats", "reader", "frame_out", "result", "solved", "slope")
 
     def __init__(self) -> None:
         self.reader = CloudReader()  # the topic's header parsed once
@@ -264,7 +264,6 @@ class _ContactState:
         # the latest wrench in the wheelset frame: (stamp, force, torque)
         self.wrench: tuple[int, tuple[float, float, float], tuple[float, float, float]] | None
         self.wrench = None
-        self.wrench_fresh = False
         self.stats = ContactStats()
         # the latest solve (friction estimation's measurement model): patch, creepages, forces
         self.solved: tuple[ContactPatch, Creepage, ContactForces] | None = None
@@ -374,7 +373,10 @@ class Pipeline:
         # transient rolling's reset counts per contact, shared by its successive memories (a
         # method or rolling change starts a new memory; the counts carry on)
         self._reset_counts: dict[str, dict[str, int]] = {}
-        self._fresh = 0  # contacts with a wrench not yet in a wheelset wrench
+        # the wheelset wrench's rig cycle: the last sum's stamp, the shortest interval between
+        # one contact's successive wrenches (ns; None until seen)
+        self._last_sum_ns: int | None = None
+        self._cycle_ns: int | None = None
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
@@ -743,7 +745,6 @@ class Pipeline:
             if state.last_stamp_ns is not None and stamp < state.last_stamp_ns:
                 raise RejectedInput("old_stamp", f"stamp {stamp} ns is older than the last, "
                                     f"{state.last_stamp_ns} ns")
-            state.last_stamp_ns = stamp
             done = None
             state.slope = None
             if given is not None:
@@ -777,6 +778,9 @@ class Pipeline:
             stats.window_rejected += 1
             stats.last_detail = str(e)
             return Outcome(contact, stamp, e.reason, e.detail)
+        # the last stamp is the last patch taken (a rejected one, a NaN stamped an hour ahead,
+        # made every later patch of the contact old)
+        state.last_stamp_ns = stamp
         stats.counts[SOLVED] += 1
         changed = _frame_moved(state.last_frame, patch.frame)
         if changed:
@@ -927,6 +931,7 @@ class Pipeline:
         return memory
 
     def _no_contact(self, contact: str, state: _ContactState, stamp: int) -> Outcome:
+        state.last_stamp_ns = stamp
         state.stats.counts[NO_CONTACT] += 1
         state.solved = None
         memory = self._memory(contact)
@@ -988,25 +993,44 @@ class Pipeline:
 
     def _add_wrench(self, state: _ContactState, stamp: int, force: tuple[float, float, float],
                     torque: tuple[float, float, float]) -> WheelsetWrench | None:
-        """Keep the contact's wrench; return the wheelset wrench if every contact has a new one."""
+        """Keep the contact's wrench; return the wheelset wrench if it completes a rig cycle.
+
+        A rig cycle (INTERFACE.md: every contact has a wrench newer than
+        those of the last sum): every contact has a wrench stamped after the
+        last sum's stamp, and once the rig's cycle is known (the shortest
+        interval seen between one contact's successive wrenches) they are one
+        cycle's, their stamps within half of it of each other.  With a flag
+        per contact instead, one rejected patch of the contact that arrives
+        first paired every later sum with the other contact's wrench of the
+        cycle before; now that pairing is never made once a cycle is known,
+        and before it at most once (:func:`fastsim_ros.replay.kernels.advance`
+        is the replay's copy of this rule).
+        """
+        old = state.wrench
+        if old is not None and stamp > old[0]:
+            gap = stamp - old[0]
+            if self._cycle_ns is None or gap < self._cycle_ns:
+                self._cycle_ns = gap
         state.wrench = (stamp, force, torque)
-        if not state.wrench_fresh:
-            state.wrench_fresh = True
-            self._fresh += 1
-        if self._fresh < len(self._contacts):  # some contact has no new wrench yet
-            return None
-        self._fresh = 0
+        lo = hi = stamp
+        for s in self._contacts.values():
+            if s.wrench is None:
+                return None
+            lo = min(lo, s.wrench[0])
+            hi = max(hi, s.wrench[0])
+        if self._last_sum_ns is not None and lo <= self._last_sum_ns:
+            return None  # some contact has no wrench newer than the last sum
+        if self._cycle_ns is not None and not 2 * (hi - lo) < self._cycle_ns:
+            return None  # not one cycle's: the oldest's own next wrench is still to come
+        self._last_sum_ns = hi
         fs = [0.0, 0.0, 0.0]
         ts = [0.0, 0.0, 0.0]
-        newest = stamp
         for s in self._contacts.values():
             assert s.wrench is not None
-            newest = max(newest, s.wrench[0])
             for k in range(3):
                 fs[k] += s.wrench[1][k]
                 ts[k] += s.wrench[2][k]
-            s.wrench_fresh = False
-        return WheelsetWrench(newest, (fs[0], fs[1], fs[2]), (ts[0], ts[1], ts[2]))
+        return WheelsetWrench(hi, (fs[0], fs[1], fs[2]), (ts[0], ts[1], ts[2]))
 
     def _markers_due(self, state: _ContactState, stamp: int) -> bool:
         if not self._markers:

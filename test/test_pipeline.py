@@ -318,6 +318,59 @@ def test_wheelset_wrench_sums_the_contacts_once_per_cycle():
     assert solve(pipe, egg(), stamp=T0 + 20 * MS).wheelset is None
 
 
+@pytest.mark.parametrize("failing", ["left", "right"])
+def test_the_wheelset_wrench_stays_one_cycles_after_a_rejected_patch(failing):
+    """A NaN patch in one cycle: every later sum is that cycle's own two wrenches.
+
+    The contacts arrive left, then right, each cycle.  With a flag per
+    contact, one rejected left patch paired every later sum with the right
+    wrench of the cycle before (stamped with the left one's), for good.
+    """
+    pipe = make(contacts=["left", "right"])
+    gamma = 0.1
+    where = {"left": dict(origin=(0.0, 0.75, -R), normal=contact_normal(gamma, "left")),
+             "right": dict(origin=(0.0, -0.75, -R), normal=contact_normal(gamma, "right"))}
+    sums = []
+    for k in range(8):
+        t = T0 + k * MS
+        # another creepage each cycle: each cycle's wrenches are its own
+        pipe.on_wheel_twist(cdr(rolling_twist(1e-3 * (1 + k), stamp_ns=t)))
+        wrench = {}
+        for contact in ("left", "right"):
+            area = egg() if contact == "left" else egg().mirrored_y()
+            pressure = area.pressure.copy()
+            if k == 2 and contact == failing:
+                pressure[5, 5] = math.nan
+            out = solve(pipe, area, stamp=t, contact=contact, pressure=pressure,
+                        **where[contact])
+            if out.status == "solved":
+                axes = np.array(out.frame.axes)
+                wrench[contact] = axes.T @ [out.forces.fx, out.forces.fy, out.forces.n]
+            if out.wheelset is not None:
+                sums.append((k, out.wheelset, dict(wrench)))
+    assert [k for k, _, _ in sums] == [0, 1, 3, 4, 5, 6, 7]
+    for k, ws, wrench in sums:
+        assert ws.stamp_ns == T0 + k * MS
+        np.testing.assert_allclose(ws.force, wrench["left"] + wrench["right"], rtol=1e-12,
+                                   atol=1e-6)
+
+
+def test_a_rejected_patch_stamped_ahead_does_not_make_later_ones_old():
+    """A NaN stamped an hour ahead is rejected; the contact's next patch is served.
+
+    The rejected patch's stamp was kept as the contact's last: every later
+    patch was ``old_stamp`` until a restart.
+    """
+    pipe = make()
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    bad = egg().pressure.copy()
+    bad[5, 5] = math.nan
+    ahead = solve(pipe, egg(), stamp=T0 + 3600 * 10**9, pressure=bad)
+    assert ahead.status == "nonfinite"
+    assert solve(pipe, egg(), stamp=T0 + 10 * MS).status == "solved"
+    assert solve(pipe, egg(), stamp=T0 + 5 * MS).status == "old_stamp"   # older than taken
+
+
 def test_update_friction_and_method_while_running():
     pipe = make()
     pipe.on_wheel_twist(cdr(rolling_twist(2e-2, stamp_ns=T0)))

@@ -173,6 +173,10 @@ def varied_bag(path):
             lraw = cdr(cloud_msg(hertz, stamp_ns=t, pressure=three, **left))     # degenerate
         elif k == 26:
             lraw = lraw[:60]                                                   # malformed
+        elif k == 28:   # a NaN stamped an hour ahead: rejected, and no later patch old for it
+            bad = hertz.pressure.copy()
+            bad[12, 12] = math.nan
+            lraw = cdr(cloud_msg(hertz, stamp_ns=t + 3600 * 10**9, pressure=bad, **left))
         elif k == 27:
             bad = egg.pressure.copy()
             bad[5, 5] = -1.0
@@ -231,6 +235,18 @@ def test_batched_path_equals_the_per_message_path_on_every_branch(tmp_path, vari
         assert counts["left"][reason] >= 1, reason
     assert counts["right"]["negative_pressure"] == 1 and counts["right"]["no_contact"] == 2
     assert counts["left"]["no_contact"] >= 3    # the grids of no cells
+    assert counts["left"]["old_stamp"] == 1 and counts["left"]["nonfinite"] >= 2
+    # the wheelset wrench is one cycle's, the contacts' wrenches of its own stamp, after the
+    # rejections of the contact that arrives first too (they paired left k with right k - 1)
+
+    def stamp(m):   # a decoded message as plain dicts
+        return m["header"]["stamp"]["sec"] * 10**9 + m["header"]["stamp"]["nanosec"]
+    wrenches = {c: {stamp(m) for _, m in reference[1][f"/contact/{c}/wrench"][1]}
+                for c in ("left", "right")}
+    sums = reference[1]["/wheelset/wrench"][1]
+    assert len(sums) > 50
+    for _, m in sums:
+        assert stamp(m) in wrenches["left"] and stamp(m) in wrenches["right"], stamp(m)
     if variant == "small_grids_only":
         assert counts["left"]["too_large"] == 100   # the 20 x 32 patches
     rows = [line.split(",") for line in reference[0].splitlines()[1:]]

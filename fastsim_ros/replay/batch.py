@@ -298,6 +298,8 @@ class _ContactState:
         self.wrench_stamp = np.zeros(n, dtype=np.int64)
         self.wrench = np.zeros((n, 6))
         self.fresh = np.zeros(n, dtype=np.bool_)
+        # the rig cycle's rule (kernels.advance): a sum made, its stamp, the cycle (-1: unknown)
+        self.sums = np.array([0, 0, -1], dtype=np.int64)
         self.counts = np.zeros((n, len(STATUSES)), dtype=np.int64)
         self.window_inputs = np.zeros(n, dtype=np.int64)
         self.window_rejected = np.zeros(n, dtype=np.int64)
@@ -429,11 +431,13 @@ class Batch:
         at = index[kind == 2]
         contact_of = self.of_contact[w.channel[at]]
         p, groups, singles = self._decode(w, at, contact_of)
-        self._old_stamps(p)
         t1 = time.perf_counter()
         todo = self._kinematics(p, base)
         t2 = time.perf_counter()
         self._solve_all(p, todo, groups, singles)
+        # old stamps once every patch's own verdict is known: a patch is old against the last
+        # one taken (solved or empty), as the pipeline has it
+        self._old_stamps(p)
         t3 = time.perf_counter()
         self._advance(p)
         t4 = time.perf_counter()
@@ -631,23 +635,31 @@ class Batch:
         return patch
 
     def _old_stamps(self, p: Patches) -> None:
-        """``old_stamp``: older than the newest stamp of the contact's patches before it."""
+        """``old_stamp``: older than the contact's last patch taken (solved or empty) before it.
+
+        Run after the patches' own verdicts: the old ones among them (solved
+        or rejected for a later check) become ``old_stamp``, as the pipeline's
+        check before the others makes them; a rejected patch does not move
+        the last stamp (the pipeline's rule).
+        """
         st = self.state
         parsed = p.parsed & (p.status != _WRONG_FRAME)
         for c in range(len(self.contacts)):
             mine = np.flatnonzero((p.contact == c) & parsed)
             if mine.size == 0:
                 continue
-            s = p.stamp[mine]
-            last = st.last_stamp[c] if st.has_stamp[c] else _FIRST
-            before = np.maximum(np.concatenate(([last], np.maximum.accumulate(s)[:-1])), last)
-            old = s < before
-            for i, b in zip(mine[old].tolist(), before[old].tolist()):
-                p.status[i] = _OLD
-                p.detail[i] = (f"old_stamp: stamp {int(p.stamp[i])} ns is older than the "
-                               f"last, {int(b)} ns")
-            st.last_stamp[c] = max(int(s.max()), int(last))
-            st.has_stamp[c] = True
+            last = int(st.last_stamp[c]) if st.has_stamp[c] else None
+            stamps = p.stamp[mine].tolist()
+            taken = np.isin(p.status[mine], (_SOLVED, _EMPTY)).tolist()
+            for i, s, ok in zip(mine.tolist(), stamps, taken):
+                if last is not None and s < last:
+                    p.status[i] = _OLD
+                    p.detail[i] = f"old_stamp: stamp {s} ns is older than the last, {last} ns"
+                elif ok:
+                    last = s
+            if last is not None:
+                st.last_stamp[c] = last
+                st.has_stamp[c] = True
 
     # ---------------------------------------------------------------- kinematics
 
@@ -787,7 +799,7 @@ class Batch:
         kernels.advance(p.contact, p.stamp, p.status, p.frame, p.force, FRAME_TOLERANCE,
                         self.markers_on, self.marker_period, st.last_frame, st.has_frame,
                         st.last_marker, st.has_marker, st.wrench_stamp, st.wrench, st.fresh,
-                        p.changed, p.marker, p.cycle, p.cycle_stamp, p.cycle_wrench)
+                        st.sums, p.changed, p.marker, p.cycle, p.cycle_stamp, p.cycle_wrench)
         rejected = p.status >= len((SOLVED, NO_CONTACT))
         for c in range(len(self.contacts)):
             mine = p.contact == c
@@ -879,5 +891,5 @@ def warm_up() -> None:
     flags = np.zeros(1, dtype=np.bool_)
     kernels.advance(one, one, one, np.zeros((1, 12)), np.zeros((1, 4)), FRAME_TOLERANCE, True,
                     0, np.zeros((1, 12)), flags.copy(), one.copy(), flags.copy(), one.copy(),
-                    np.zeros((1, 6)), flags.copy(), flags.copy(), flags.copy(), flags.copy(),
-                    one.copy(), np.zeros((1, 6)))
+                    np.zeros((1, 6)), flags.copy(), np.array([0, 0, -1], dtype=np.int64),
+                    flags.copy(), flags.copy(), flags.copy(), one.copy(), np.zeros((1, 6)))

@@ -196,7 +196,7 @@ SOLVED, NO_CONTACT = 0, 1
 @njit(cache=True)
 def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, period,
             last_frame, has_frame, last_marker, has_marker, wrench_stamp, wrench, fresh,
-            changed, marker, cycle, cycle_stamp, cycle_wrench):
+            sums, changed, marker, cycle, cycle_stamp, cycle_wrench):
     """Walk the patches in order with the pipeline's per-contact rules that carry state.
 
     Per patch ``i`` of contact ``contact_of[i]`` with ``status[i]``
@@ -204,9 +204,14 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
     moved since the contact's last published frame (``changed``, origin or
     an axis by more than ``tolerance``), whether a marker is due
     (``marker``: none within ``period`` ns of stamps), and whether it
-    completes a rig cycle (``cycle``: every contact has a new wrench; then
-    ``cycle_stamp`` the newest and ``cycle_wrench`` the sum of force and
-    torque in the wheelset frame, in the contacts' order).  ``force[i]``:
+    completes a rig cycle (``cycle``: the pipeline's rule,
+    :meth:`fastsim_ros.pipeline.Pipeline._add_wrench`: every contact has a
+    wrench stamped after the last sum, within half the rig's cycle of each
+    other once a cycle is known; then ``cycle_stamp`` the newest
+    and ``cycle_wrench`` the sum of force and torque in the wheelset frame,
+    in the contacts' order).  ``fresh[c]``: contact ``c`` has a wrench;
+    ``sums``: whether a sum was made, the last sum's stamp, the shortest
+    interval between one contact's successive wrenches (-1 until seen).  ``force[i]``:
     ``Fx, Fy, N, Mz`` in the contact frame ``frame[i]`` (origin, ``e_x``,
     ``e_y``, ``e_z``).  The arithmetic is the pipeline's, term for term.
     The state arrays (per contact) are read and updated.
@@ -257,25 +262,36 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
         else:
             for k in range(6):
                 wrench[c, k] = 0.0
+        if fresh[c] and stamp[i] > wrench_stamp[c]:
+            gap = stamp[i] - wrench_stamp[c]
+            if sums[2] < 0 or gap < sums[2]:
+                sums[2] = gap
         wrench_stamp[c] = stamp[i]
         fresh[c] = True
         complete = True
+        lo = stamp[i]
+        hi = stamp[i]
         for k in range(nc):
             if not fresh[k]:
                 complete = False
+            else:
+                lo = min(lo, wrench_stamp[k])
+                hi = max(hi, wrench_stamp[k])
+        if complete and sums[0] == 1 and lo <= sums[1]:
+            complete = False
+        if complete and sums[2] >= 0:
+            complete = 2 * (hi - lo) < sums[2]
         if complete:
-            newest = stamp[i]
             for k in range(6):
                 cycle_wrench[i, k] = 0.0
             for k in range(nc):
-                if wrench_stamp[k] > newest:
-                    newest = wrench_stamp[k]
                 for j in range(3):
                     cycle_wrench[i, j] += wrench[k, j]
                     cycle_wrench[i, 3 + j] += wrench[k, 3 + j]
-                fresh[k] = False
+            sums[0] = 1
+            sums[1] = hi
             cycle[i] = True
-            cycle_stamp[i] = newest
+            cycle_stamp[i] = hi
         if markers_on:
             due = True
             if has_marker[c]:
