@@ -382,7 +382,7 @@ COEFFICIENT_KEYS = ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33
 def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``coefficients``: a dict of the results."""
     from fastsim_ros.contact import exact
-    from fastsim_ros.contact.mae import mae_coefficients, mae_fastsim_coefficients, mae_geometry
+    from fastsim_ros.contact.mae import mae_area_coefficients, mae_fastsim_coefficients
     from fastsim_ros.contact.mae_calibrated import mae_calibrated_coefficients
     from fastsim_ros.contact.pairs import pair_factors
     from fastsim_ros.contact.tables import coefficient_table
@@ -403,7 +403,7 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
             _check_exact_grid(ar, forces=False)
             c = exact.creep_coefficients(ar, nu=args.nu)
         elif args.method == "mae":
-            c = mae_coefficients(mae_geometry(ar), coefficient_table(args.nu))
+            c = mae_area_coefficients(ar, coefficient_table(args.nu))
         elif args.method == "mae_calibrated":
             # full adhesion, about the area's origin (as every method here)
             c = mae_calibrated_coefficients(ar, coefficient_table(args.nu),

@@ -1004,6 +1004,16 @@ def split_face(count, rule):
     ``count[j]``: cells in contact in strip ``j``.  The three rules of
     :func:`fastsim_ros.contact.mae.split_face`, branch for branch.
     """
+    return split_rule(count, rule)[0]
+
+
+@njit(cache=True, error_model="numpy")
+def split_rule(count, rule):
+    """Return ``(f, tie)``: :func:`split_face`, and :func:`fastsim_ros.contact.mae.split_tie`.
+
+    ``tie``: the rule's split line runs through the middle of strip ``f``
+    (both its faces alike: :func:`mae_flexibility` averages the two).
+    """
     ny = count.shape[0]
     total = 0
     moment = 0
@@ -1012,21 +1022,23 @@ def split_face(count, rule):
         moment += count[j] * j
     yc = moment / total
     if rule == RULE_CENTROID:
-        return _centroid_face(count, yc)
-    f = _widest_strip_face(count, yc)
+        return _centroid_face(count, yc, moment, total)
+    f, tie = _widest_strip_face(count, yc, moment, total)
     if rule == RULE_AUTO:
         below = 0
         for j in range(f):
             below += count[j]
         share = below / total
         if min(share, 1.0 - share) < MIN_ZONE_SHARE:
-            return _centroid_face(count, yc)
-    return f
+            return _centroid_face(count, yc, moment, total)
+    return f, tie
 
 
 @njit(cache=True, error_model="numpy")
-def _centroid_face(count, yc):
-    """Return the face nearest the centroid row coordinate ``yc`` (within the contact)."""
+def _centroid_face(count, yc, moment, total):
+    """Return the face nearest the centroid row coordinate ``yc`` (within the contact), tie."""
+    if moment % total == 0:   # the centroid at a strip's centre: its two faces alike
+        return moment // total, True
     ny = count.shape[0]
     r0 = 0
     while count[r0] == 0:
@@ -1034,12 +1046,12 @@ def _centroid_face(count, yc):
     r1 = ny - 1
     while count[r1] == 0:
         r1 -= 1
-    return min(max(round(yc + 0.5), r0), r1 + 1)  # Python's round: half to even
+    return min(max(round(yc + 0.5), r0), r1 + 1), False  # Python's round: half to even
 
 
 @njit(cache=True, error_model="numpy")
-def _widest_strip_face(count, yc):
-    """Return the face through the band of strips with the longest chord (or a jump side)."""
+def _widest_strip_face(count, yc, moment, total):
+    """Return the face through the band of strips with the longest chord (or a jump side), tie."""
     ny = count.shape[0]
     # the band of strips sharing the longest chord (a staircase ellipse has several); of
     # several such bands apart, the widest, then the one nearest the centroid, so that a
@@ -1070,22 +1082,25 @@ def _widest_strip_face(count, yc):
                 tie = True
         j = k + 1
     if tie:
-        return _centroid_face(count, yc)
+        return _centroid_face(count, yc, moment, total)
     below = count[j0 - 1] if j0 > 0 else 0
     above = count[j1 + 1] if j1 + 1 < ny else 0
     # chords of centred shapes change by two cells at a time (one at each end)
     drop_below = count[j0] - below
     drop_above = count[j0] - above
     if drop_below > drop_above + 2:
-        return j0
+        return j0, False
     if drop_above > drop_below + 2:
-        return j1 + 1
+        return j1 + 1, False
     width = j1 - j0 + 1
     if width % 2 == 0:
-        return j0 + width // 2
+        return j0 + width // 2, False
     middle = j0 + width // 2
-    # an odd band: the face of its middle strip nearer the centroid
-    return middle + 1 if yc > middle else middle
+    # an odd band: the face of its middle strip nearer the centroid; the centroid at the
+    # strip's centre: both faces alike (the lower one given)
+    if moment == middle * total:
+        return middle, True
+    return (middle + 1 if yc > middle else middle), False
 
 
 @njit(cache=True, error_model="numpy")
@@ -1176,7 +1191,7 @@ def ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy):
 
 @njit(cache=True, error_model="numpy")
 def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, strips,
-                calibrated, pair_knots, pair_values):
+                calibrated, pair_knots, pair_values, shift=0):
     """MAE steps 1-3 and 6: validate, split, size the zones, look up, give ``L1 .. L4``.
 
     Writes ``geo`` (length :data:`GEO_SIZE`): centroid ``x_c, y_c``, split
@@ -1190,7 +1205,8 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, 
     (:func:`calibrate`, pair factors ``pair_values`` on the nodes
     ``pair_knots``; unread otherwise).  Return ``(status, info)``; ``info`` is
     the offending ``a/b`` of a zone outside the table (the geometry is
-    complete then, the flexibilities are not).
+    complete then, the flexibilities are not).  ``shift``: the split that
+    many faces above the rule's (1: a tie's other face).
     """
     status = check_grid(x0, y0, dx, dy)
     if status != OK:
@@ -1203,7 +1219,7 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, 
     x_c = x0 + dx * (si / n)
     y_c = y0 + dy * (sj / n)
     e_xc, e_yc, e_a, e_b = ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy)
-    f = split_face(count, rule)
+    f = split_face(count, rule) + shift
     y_s = y0 + (f - 0.5) * dy
     geo[G_XC] = x_c
     geo[G_YC] = y_c
@@ -1388,6 +1404,42 @@ def mae_strip_flexibility(geo, flex):
         for k in range(4):
             v = geo[base + k]
             flex[k, j] = math.inf if math.isnan(v) else v
+
+
+@njit(cache=True, error_model="numpy")
+def mae_flexibility(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, strips,
+                    calibrated, pair_knots, pair_values, flex):
+    """:func:`mae_prepare`, then each strip's ``L1 .. L4`` into ``flex``; return its status.
+
+    Where the rule's split is a tie (:func:`split_rule`: the line through
+    the middle of a strip, as on a patch symmetric in ``y`` with an odd
+    number of strips) the two faces' strip stiffnesses ``1/L`` are averaged and
+    ``geo``'s sweep line ``y_s`` is their mean, the middle of that strip
+    (:func:`fastsim_ros.contact.mae.mirror_geometries`): either face alone
+    gave an ellipse ``C~13`` of -0.03 and a yaw moment from nothing.
+    """
+    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
+                               strips, calibrated, pair_knots, pair_values)
+    if status != OK:
+        return status, info
+    mae_strip_flexibility(geo, flex)
+    if not split_rule(strips[0], rule)[1]:
+        return OK, 0.0
+    other = np.empty(GEO_SIZE)
+    other_env = np.empty_like(env)
+    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, other,
+                               other_env, strips, calibrated, pair_knots, pair_values, 1)
+    if status != OK:
+        return status, info
+    upper = np.empty_like(flex)
+    mae_strip_flexibility(other, upper)
+    # the strips' stiffness 1/L averaged (mae.averaged_flexibility): the full-adhesion
+    # coefficients, linear in it, the two splits' mean
+    for k in range(4):
+        for j in range(flex.shape[1]):
+            flex[k, j] = 2.0 / (1.0 / flex[k, j] + 1.0 / upper[k, j])
+    geo[G_YS] = 0.5 * (geo[G_YS] + other[G_YS])
+    return OK, 0.0
 
 
 # ---------------------------------------------------------------- traction bounds
@@ -1582,13 +1634,12 @@ def mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic, shea
     if status != OK:
         return status, info, geo, env, flex, bound
     strips = np.empty((3, ny), dtype=np.int64)
-    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
-                               strips, calibrated, pair_knots, pair_values)
+    status, info = mae_flexibility(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo,
+                                   env, strips, calibrated, pair_knots, pair_values, flex)
     if status != OK:
         return status, info, geo, env, flex, bound
     if parabolic:
         parabolic_bound(p, dx, dy, mu, geo[G_LOAD], bound)
-    mae_strip_flexibility(geo, flex)
     return OK, 0.0, geo, env, flex, bound
 
 
@@ -1733,12 +1784,11 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
         p = ps[pb]
         same = _same_patch(b, pb, prev_pb, x0, y0, dx, dy)
         if not same:
-            status, info = mae_prepare(p, x0[b], y0[b], dx[b], dy[b], rule, shear_modulus,
-                                       knots, polys, geo, env, strips, calibrated,
-                                       pair_knots, pair_values)
+            status, info = mae_flexibility(p, x0[b], y0[b], dx[b], dy[b], rule, shear_modulus,
+                                           knots, polys, geo, env, strips, calibrated,
+                                           pair_knots, pair_values, flex)
             if status != OK:
                 return status, b, info
-            mae_strip_flexibility(geo, flex)
         if parabolic and not (same and mu[b] == mu[b - 1]):
             parabolic_bound(p, dx[b], dy[b], mu[b], geo[G_LOAD], bound)
         prev_pb = pb

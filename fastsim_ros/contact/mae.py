@@ -106,20 +106,40 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
     than on the other (a jump: the join line of two semi-ellipses), where
     the split takes the band's face on that side.
     """
-    mask = area.mask
-    count, _, _ = row_extents(mask)
+    return _split(row_extents(area.mask)[0], rule)[0]
+
+
+def split_tie(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> bool:
+    """Tell whether the rule's split line runs through the middle of a strip.
+
+    Then the faces on either side of that strip serve alike (a patch
+    symmetric in ``y`` with an odd number of strips: its centre line is no
+    cell face), :func:`split_face` gives the lower one, and the MAE methods
+    take both splits' strip stiffnesses ``1/L``, averaged (:func:`mirror_geometries`):
+    one of them alone gave an ellipse ``C~13`` of -0.03 and a yaw moment from
+    nothing on a centred wheelset.
+    """
+    return _split(row_extents(area.mask)[0], rule)[1]
+
+
+def _split(count: NDArray[np.int_], rule: SplitRule) -> tuple[int, bool]:
+    """Return the split face of :func:`split_face` and whether it is :func:`split_tie`'s tie."""
+    ny = count.size
+    total = int(count.sum())
+    moment = int((count * np.arange(ny)).sum())
+    yc = moment / total
     if rule == "auto":
-        f = split_face(area, "widest_strip")
-        share = float(count[:f].sum()) / float(count.sum())
+        f, tie = _split(count, "widest_strip")
+        share = float(count[:f].sum()) / float(total)
         if min(share, 1.0 - share) < MIN_ZONE_SHARE:
-            return split_face(area, "centroid")
-        return f
+            return _split(count, "centroid")
+        return f, tie
     if rule == "centroid":
         rows = np.flatnonzero(count)
-        yc = float((count * np.arange(area.ny)).sum() / count.sum())
-        return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1))
+        if moment % total == 0:   # the centroid at a strip's centre: its two faces alike
+            return moment // total, True
+        return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1)), False
     check_split_rule(rule)
-    yc = float((count * np.arange(area.ny)).sum() / count.sum())
     # the band of strips sharing the longest chord (a staircase ellipse has several); of
     # several such bands apart, the widest, then the one nearest the centroid (a mirror
     # image in y splits at the mirrored face); two alike at one distance: the centroid's
@@ -130,23 +150,26 @@ def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
     distance = [abs(0.5 * (b[0] + b[-1]) - yc) for b in widest]
     nearest = min(distance)
     if sum(1 for d in distance if abs(d - nearest) <= 1e-9) > 1:
-        return split_face(area, "centroid")
+        return _split(count, "centroid")
     band = widest[distance.index(nearest)]
     j0, j1 = int(band[0]), int(band[-1])
     below = int(count[j0 - 1]) if j0 > 0 else 0
-    above = int(count[j1 + 1]) if j1 + 1 < area.ny else 0
+    above = int(count[j1 + 1]) if j1 + 1 < ny else 0
     # chords of centred shapes change by two cells at a time (one at each end)
     drop_below, drop_above = count[j0] - below, count[j0] - above
     if drop_below > drop_above + 2:
-        return j0
+        return j0, False
     if drop_above > drop_below + 2:
-        return j1 + 1
+        return j1 + 1, False
     width = j1 - j0 + 1
     if width % 2 == 0:
-        return j0 + width // 2
+        return j0 + width // 2, False
     middle = j0 + width // 2
-    # an odd band: the face of its middle strip nearer the centroid
-    return middle + 1 if yc > middle else middle
+    # an odd band: the face of its middle strip nearer the centroid; the centroid at the
+    # strip's centre: both faces alike (the lower one given)
+    if moment == middle * total:
+        return middle, True
+    return (middle + 1 if yc > middle else middle), False
 
 
 def _zone(area: GridArea, rows: NDArray[np.bool_], x_c: float, y_s: float,
@@ -178,18 +201,72 @@ def _zone(area: GridArea, rows: NDArray[np.bool_], x_c: float, y_s: float,
     return Zone(zone_area, a, b, g, a_eq, a_eq / g)
 
 
-def mae_geometry(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> MaeGeometry:
-    """MAE steps 1-3: centroid, split line and the two zones' semi-ellipses."""
+def mae_geometry(area: GridArea, rule: SplitRule = DEFAULT_SPLIT, *,
+                 shift: int = 0) -> MaeGeometry:
+    """MAE steps 1-3: centroid, split line and the two zones' semi-ellipses.
+
+    ``shift``: the split ``shift`` faces above the rule's (1: the other face
+    of a tie, :func:`split_tie`).
+    """
     mask = area.mask
     n = np.count_nonzero(mask)
     jj, ii = np.nonzero(mask)
     x_c = float(area.x[ii].sum() / n)
     y_c = float(area.y[jj].sum() / n)
-    f = split_face(area, rule)
+    f = split_face(area, rule) + shift
     y_s = float(area.y0 + (f - 0.5) * area.dy)
     rows = np.arange(area.ny) < f
     return MaeGeometry(x_c, y_c, y_s, rule, _zone(area, rows, x_c, y_s, True),
                        _zone(area, ~rows, x_c, y_s, False), area.area)
+
+
+def mirror_geometries(area: GridArea,
+                      rule: SplitRule = DEFAULT_SPLIT) -> tuple[MaeGeometry, ...]:
+    """Return the geometry of the rule's split, and of the other face where it is a tie.
+
+    (:func:`split_tie`): the MAE methods then average the two splits' strip
+    stiffnesses (:func:`averaged_flexibility`) and sweep from the middle
+    of the strip between them.
+    """
+    first = mae_geometry(area, rule)
+    if not split_tie(area, rule):
+        return (first,)
+    return first, mae_geometry(area, rule, shift=1)
+
+
+def averaged_flexibility(flexibilities: list[StripFlexibility]) -> StripFlexibility:
+    """Return the strips' flexibilities (m/Pa) over the splits of a tie: stiffness averaged.
+
+    A strip's traction in adhesion is its rigid slip over ``L``: averaging
+    ``1/L`` makes the full-adhesion coefficients ``C~11``, ``C~22``,
+    ``C~23`` the mean of the two splits' exactly.
+    """
+    if len(flexibilities) == 1:
+        return flexibilities[0]
+    n = len(flexibilities)
+    return StripFlexibility(*(n / sum(1.0 / getattr(f, name) for f in flexibilities)
+                              for name in ("l1", "l2", "l3", "spin")))
+
+
+def sweep_point(geometries: tuple[MaeGeometry, ...]) -> tuple[float, float]:
+    """Return the sweep point ``S = (x_c, y_s)`` (m): the splits' mean ``y_s`` in a tie."""
+    return (geometries[0].x_c, sum(g.y_s for g in geometries) / len(geometries))
+
+
+def mae_area_coefficients(area: GridArea, table: CoefficientTable, *,
+                          reference: tuple[float, float] = (0.0, 0.0),
+                          rule: SplitRule = DEFAULT_SPLIT) -> CreepCoefficients:
+    """Return MAE's coefficients of an area (:func:`mae_coefficients` of its split).
+
+    In a tie (:func:`split_tie`) the two splits' coefficients, averaged: a
+    patch symmetric in ``y`` then has ``C~13 = 0`` on any grid.
+    """
+    each = [mae_coefficients(g, table, reference) for g in mirror_geometries(area, rule)]
+    if len(each) == 1:
+        return each[0]
+    mean = {name: sum(getattr(c, name) for c in each) / len(each)
+            for name in ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33")}
+    return CreepCoefficients(**mean, area=each[0].area, reference=each[0].reference)
 
 
 def mae_coefficients(geometry: MaeGeometry, table: CoefficientTable,
@@ -301,13 +378,14 @@ def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: Flo
     ``speed``: rolling speed ``|V|`` (m/s) for such a law; ``shear_modulus``:
     combined ``G`` (Pa); ``table``: coefficients at the material's ``nu``.
     """
-    geometry = mae_geometry(area, rule)
-    zones = zone_flexibilities(geometry, table, shear_modulus)
+    geometries = mirror_geometries(area, rule)
+    pairs = [zone_flexibilities(g, table, shear_modulus) for g in geometries]
     res = fastsim(area, xi, eta, phi, bound=bound,
-                  flexibility=strip_flexibility(area, geometry, zones),
-                  sweep_point=(geometry.x_c, geometry.y_s), reference=reference,
+                  flexibility=averaged_flexibility([strip_flexibility(area, g, z)
+                                                    for g, z in zip(geometries, pairs)]),
+                  sweep_point=sweep_point(geometries), reference=reference,
                   friction=friction, speed=speed)
-    return MaeResult(res.fx, res.fy, res.mz, res, geometry, zones)
+    return MaeResult(res.fx, res.fy, res.mz, res, geometries[0], pairs[0])
 
 
 def mae_fastsim_coefficients(area: GridArea, table: CoefficientTable, *,

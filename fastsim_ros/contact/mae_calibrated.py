@@ -66,8 +66,9 @@ from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone,
-                                     ZoneFlexibility, ZonePair, row_extents, mae_geometry,
-                                     strip_flexibility, zone_flexibility)
+                                     ZoneFlexibility, ZonePair, averaged_flexibility,
+                                     mirror_geometries, row_extents,
+                                     strip_flexibility, sweep_point, zone_flexibility)
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
 from fastsim_ros.contact.rules import chord_bend_offset
 from fastsim_ros.contact.tables import CoefficientTable
@@ -263,15 +264,16 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
     :func:`zone_coefficients`'; ``without``: rules left out (:data:`RULES`;
     ``"rigid_slip"``: FastSim's radial return).
     """
-    geometry = mae_geometry(area, rule)
-    zones = calibrated_flexibilities(area, geometry, table, pairs, shear_modulus, share=share,
-                                     without=without)
-    flex: StripFlexibility = strip_flexibility(area, geometry, zones)
+    geometries = mirror_geometries(area, rule)
+    zone_pairs = [calibrated_flexibilities(area, g, table, pairs, shear_modulus, share=share,
+                                           without=without) for g in geometries]
+    flex: StripFlexibility = averaged_flexibility([strip_flexibility(area, g, z)
+                                                   for g, z in zip(geometries, zone_pairs)])
     res = fastsim(area, xi, eta, phi, bound=bound, flexibility=flex,
-                  sweep_point=(geometry.x_c, geometry.y_s), reference=reference,
+                  sweep_point=sweep_point(geometries), reference=reference,
                   friction=friction, speed=speed,
                   slip_rule="radial" if "rigid_slip" in without else "rigid_slip")
-    return MaeResult(res.fx, res.fy, res.mz, res, geometry, zones)
+    return MaeResult(res.fx, res.fy, res.mz, res, geometries[0], zone_pairs[0])
 
 
 def mae_calibrated_coefficients(area: GridArea, table: CoefficientTable, pairs: PairFactors, *,

@@ -403,12 +403,12 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
     ny, nx = p.shape
     env = np.empty((2, nx), dtype=np.int64)
     strips = np.empty((3, ny), dtype=np.int64)
-    status, info = k.mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo,
-                                 env, strips, calibrated, pair_knots, pair_values)
+    flex = np.empty((4, ny))
+    status, info = k.mae_flexibility(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys,
+                                     geo, env, strips, calibrated, pair_knots, pair_values,
+                                     flex)
     if status != k.OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
-    flex = np.empty((4, ny))
-    k.mae_strip_flexibility(geo, flex)
     # MAE step 7: creepages moved to S = (x_c, y_s) (kernels.mae_sweep)
     x_c = geo[k.G_XC]
     y_s = geo[k.G_YS]
