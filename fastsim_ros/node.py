@@ -256,7 +256,9 @@ class _FrontEnd:
         # the outputs somebody subscribes to, kept by DDS's matched events: only
         # those are encoded and published (a message to nobody is work for nothing)
         self._wanted: set[str] = set()
-        self._rejections = ThrottledLog(node.get_logger())
+        # one throttle per contact: a contact that keeps failing must not hide another's
+        # rejections behind its own "(and N more)"
+        self._rejections = {c: ThrottledLog(node.get_logger()) for c in config.contacts}
         outputs = {f"contact/{c}/{kind}": msgtype for c in config.contacts
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
@@ -372,9 +374,13 @@ class _FrontEnd:
     def _publish(self, outcome: Outcome) -> None:
         """Publish an outcome's messages (CDR bytes), or log why there are none."""
         if not outcome.has_wrench:
-            if self._rejections.due():
-                self._rejections.warning(f"{outcome.contact}: patch rejected, "
-                                         f"{outcome.status}: {outcome.detail}")
+            log = self._rejections.get(outcome.contact)
+            if log is None:   # an outcome of no configured contact (a pose's): its own
+                node: Node = self  # type: ignore[assignment]
+                log = self._rejections[outcome.contact] = ThrottledLog(node.get_logger())
+            if log.due():
+                log.warning(f"{outcome.contact}: patch rejected, "
+                            f"{outcome.status}: {outcome.detail}")
             return
         pubs = self._pubs
         try:

@@ -283,6 +283,9 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
         raise RejectedInput("nonfinite", "NaN or infinite values in the patch")
     if status == kernels.NEGATIVE:
         raise RejectedInput("negative_pressure", f"pressure down to {low:.4g} Pa")
+    if status == kernels.TOO_HIGH:
+        raise RejectedInput("too_large", f"pressure up to {float(pressure.max()):.4g} Pa, "
+                            f"above {kernels.MAX_PRESSURE:g} Pa")
     if cells == 0:
         return None
     if cells < MIN_CONTACT_CELLS or ny < 2 or nx < 2:

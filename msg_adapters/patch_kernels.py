@@ -16,7 +16,10 @@ import math
 from numba import njit
 
 #: statuses of :func:`adapt`: the points, then the contact frame
-OK, NONFINITE, NEGATIVE, ZERO_NORMAL, NORMAL_ALONG_X = 0, 1, 2, 3, 4
+OK, NONFINITE, NEGATIVE, ZERO_NORMAL, NORMAL_ALONG_X, TOO_HIGH = 0, 1, 2, 3, 4, 5
+#: the largest pressure a patch may carry (Pa): a thousand times any steel's yield, as
+#: ``fastsim_contact``'s limit (a 1e30 Pa cell gave a wrench of 7.6e25 N)
+MAX_PRESSURE = 1e13
 #: what :func:`adapt` writes into its ``out`` array, by index
 (STATUS, CELLS, P_SUM, P_MIN, ORIGIN, E_X, E_Y, E_Z, X0, DX, WORST_X, Y0, DY,
  WORST_Y) = (0, 1, 2, 3, 4, 7, 10, 13, 16, 17, 18, 19, 20, 21)
@@ -28,7 +31,8 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
     """Copy the pressure (Pa) out of the cloud, derive the contact frame, fit the grid.
 
     Fills ``pressure[j, i]`` (float64) and ``out`` (float64, OUT_SIZE), by
-    the indices above: ``STATUS`` (OK, NONFINITE, NEGATIVE; after the
+    the indices above: ``STATUS`` (OK, NONFINITE, NEGATIVE, TOO_HIGH (a
+    pressure above :data:`MAX_PRESSURE`); after the
     frame, ZERO_NORMAL or NORMAL_ALONG_X), ``CELLS`` (points of positive
     pressure), ``P_SUM``, ``P_MIN``; when the points are finite,
     non-negative, some in contact, on a grid of 2 x 2 or more: the frame
@@ -44,6 +48,7 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
     cells = 0
     p_sum = 0.0
     p_min = math.inf
+    p_max = -math.inf
     status = OK
     s0 = s1 = s2 = s3 = s4 = s5 = 0.0
     # the field offsets in locals: read once, not at every point (pressure, written
@@ -66,6 +71,8 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
             pressure[j, i] = p
             if p < p_min:
                 p_min = p
+            if p > p_max:
+                p_max = p
             if p > 0.0:
                 cells += 1
                 p_sum += p
@@ -77,6 +84,8 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
                 s5 += p * n2
     if status == OK and p_min < 0.0:
         status = NEGATIVE
+    if status == OK and p_max > MAX_PRESSURE:
+        status = TOO_HIGH
     out[STATUS] = status
     out[CELLS] = cells
     out[P_SUM] = p_sum

@@ -509,3 +509,14 @@ def test_the_warm_ups_cover_the_hot_path():
                           capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split("\n")[-2] == "[]", done.stdout
+
+
+def test_a_pressure_beyond_any_material_is_too_large():
+    """1e30 Pa on one cell: rejected as ``too_large`` (a wrench of 7.6e25 N was published)."""
+    pipe = make()
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    huge = egg().pressure.copy()
+    huge[5, 5] = 1e30
+    out = solve(pipe, egg(), stamp=T0 + 1 * MS, pressure=huge)
+    assert out.status == "too_large" and "1e+30 Pa" in out.detail
+    assert solve(pipe, egg(), stamp=T0 + 2 * MS).status == "solved"

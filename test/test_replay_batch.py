@@ -173,6 +173,10 @@ def varied_bag(path):
             lraw = cdr(cloud_msg(hertz, stamp_ns=t, pressure=three, **left))     # degenerate
         elif k == 26:
             lraw = lraw[:60]                                                   # malformed
+        elif k == 29:   # a pressure beyond any material's: too_large
+            huge = hertz.pressure.copy()
+            huge[12, 12] = 1e30
+            lraw = cdr(cloud_msg(hertz, stamp_ns=t, pressure=huge, **left))
         elif k == 28:   # a NaN stamped an hour ahead: rejected, and no later patch old for it
             bad = hertz.pressure.copy()
             bad[12, 12] = math.nan
@@ -248,7 +252,9 @@ def test_batched_path_equals_the_per_message_path_on_every_branch(tmp_path, vari
     for _, m in sums:
         assert stamp(m) in wrenches["left"] and stamp(m) in wrenches["right"], stamp(m)
     if variant == "small_grids_only":
-        assert counts["left"]["too_large"] == 100   # the 20 x 32 patches
+        assert counts["left"]["too_large"] == 100 + 1   # the 20 x 32 patches, 1e30 Pa
+    else:
+        assert counts["left"]["too_large"] == 1         # 1e30 Pa
     rows = [line.split(",") for line in reference[0].splitlines()[1:]]
     assert any(float(r[5]) < 0 for r in rows if r[5])   # running backwards: V < 0
 
