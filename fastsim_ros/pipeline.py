@@ -373,10 +373,8 @@ class Pipeline:
         # transient rolling's reset counts per contact, shared by its successive memories (a
         # method or rolling change starts a new memory; the counts carry on)
         self._reset_counts: dict[str, dict[str, int]] = {}
-        # the wheelset wrench's rig cycle: the last sum's stamp, the shortest interval between
-        # one contact's successive wrenches (ns; None until seen)
+        # the last wheelset wrench's stamp (ns): a sum needs every contact's wrench newer
         self._last_sum_ns: int | None = None
-        self._cycle_ns: int | None = None
         self._topics = {name: _ContactTopics(name) for name in config.contacts}
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
@@ -995,34 +993,23 @@ class Pipeline:
                     torque: tuple[float, float, float]) -> WheelsetWrench | None:
         """Keep the contact's wrench; return the wheelset wrench if it completes a rig cycle.
 
-        A rig cycle (INTERFACE.md: every contact has a wrench newer than
-        those of the last sum): every contact has a wrench stamped after the
-        last sum's stamp, and once the rig's cycle is known (the shortest
-        interval seen between one contact's successive wrenches) they are one
-        cycle's, their stamps within half of it of each other.  With a flag
-        per contact instead, one rejected patch of the contact that arrives
-        first paired every later sum with the other contact's wrench of the
-        cycle before; now that pairing is never made once a cycle is known,
-        and before it at most once (:func:`fastsim_ros.replay.kernels.advance`
-        is the replay's copy of this rule).
+        INTERFACE.md's rule by the stamps: every contact has a wrench newer
+        than those of the last sum, i.e. stamped after the last sum's stamp
+        (the newest of its wrenches).  A flag per contact instead paired,
+        after one rejected patch of the contact that arrives first, every
+        later sum with the other contact's wrench of the cycle before, for
+        good; by the stamps that pairing happens once and the next cycle is
+        whole again (:func:`fastsim_ros.replay.kernels.advance` is the
+        replay's copy of this rule).
         """
-        old = state.wrench
-        if old is not None and stamp > old[0]:
-            gap = stamp - old[0]
-            if self._cycle_ns is None or gap < self._cycle_ns:
-                self._cycle_ns = gap
         state.wrench = (stamp, force, torque)
-        lo = hi = stamp
+        newest = stamp
         for s in self._contacts.values():
-            if s.wrench is None:
-                return None
-            lo = min(lo, s.wrench[0])
-            hi = max(hi, s.wrench[0])
-        if self._last_sum_ns is not None and lo <= self._last_sum_ns:
-            return None  # some contact has no wrench newer than the last sum
-        if self._cycle_ns is not None and not 2 * (hi - lo) < self._cycle_ns:
-            return None  # not one cycle's: the oldest's own next wrench is still to come
-        self._last_sum_ns = hi
+            if s.wrench is None or (self._last_sum_ns is not None
+                                    and s.wrench[0] <= self._last_sum_ns):
+                return None  # some contact has no wrench newer than the last sum
+            newest = max(newest, s.wrench[0])
+        self._last_sum_ns = newest
         fs = [0.0, 0.0, 0.0]
         ts = [0.0, 0.0, 0.0]
         for s in self._contacts.values():
@@ -1030,7 +1017,7 @@ class Pipeline:
             for k in range(3):
                 fs[k] += s.wrench[1][k]
                 ts[k] += s.wrench[2][k]
-        return WheelsetWrench(hi, (fs[0], fs[1], fs[2]), (ts[0], ts[1], ts[2]))
+        return WheelsetWrench(newest, (fs[0], fs[1], fs[2]), (ts[0], ts[1], ts[2]))
 
     def _markers_due(self, state: _ContactState, stamp: int) -> bool:
         if not self._markers:

@@ -249,8 +249,13 @@ def test_batched_path_equals_the_per_message_path_on_every_branch(tmp_path, vari
                 for c in ("left", "right")}
     sums = reference[1]["/wheelset/wrench"][1]
     assert len(sums) > 50
-    for _, m in sums:
-        assert stamp(m) in wrenches["left"] and stamp(m) in wrenches["right"], stamp(m)
+    # a sum with the other contact's wrench of the cycle before: at most once per rejection
+    # (a flag per contact made every later sum so, after the first rejected left patch)
+    mixed = [stamp(m) for _, m in sums
+             if not (stamp(m) in wrenches["left"] and stamp(m) in wrenches["right"])]
+    rejected = sum(n for c in ("left", "right") for reason, n in counts[c].items()
+                   if reason not in ("solved", "no_contact"))
+    assert len(mixed) <= min(rejected, 12), mixed
     if variant == "small_grids_only":
         assert counts["left"]["too_large"] == 100 + 1   # the 20 x 32 patches, 1e30 Pa
     else:

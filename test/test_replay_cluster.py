@@ -216,9 +216,12 @@ def test_a_lost_scheduler_is_one_line_and_the_written_outputs_stay(tmp_path, clu
                 assert sum(1 for _ in reader.messages()) == reader.message_count > 4000
 
 
-def test_an_unreachable_scheduler_is_one_line(tmp_path):
+def test_an_unreachable_scheduler_is_one_line(tmp_path, monkeypatch):
+    monkeypatch.setitem(ENV, "FASTSIM_DASK_CONNECT_TIMEOUT", "2")   # not the default 10 s
+    started = time.monotonic()
     proc = replay(BAGS / "hertz_ramp", "-o", tmp_path / "out", "--scheduler",
                   "tcp://127.0.0.1:9", timeout=120)
+    assert time.monotonic() - started < 9.0
     assert proc.returncode == 1
     assert proc.stderr.count("\n") == 1
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in proc.stderr

@@ -298,8 +298,8 @@ class _ContactState:
         self.wrench_stamp = np.zeros(n, dtype=np.int64)
         self.wrench = np.zeros((n, 6))
         self.fresh = np.zeros(n, dtype=np.bool_)
-        # the rig cycle's rule (kernels.advance): a sum made, its stamp, the cycle (-1: unknown)
-        self.sums = np.array([0, 0, -1], dtype=np.int64)
+        # the rig cycle's rule (kernels.advance): whether a sum was made, its stamp
+        self.sums = np.array([0, 0], dtype=np.int64)
         self.counts = np.zeros((n, len(STATUSES)), dtype=np.int64)
         self.window_inputs = np.zeros(n, dtype=np.int64)
         self.window_rejected = np.zeros(n, dtype=np.int64)
@@ -891,5 +891,5 @@ def warm_up() -> None:
     flags = np.zeros(1, dtype=np.bool_)
     kernels.advance(one, one, one, np.zeros((1, 12)), np.zeros((1, 4)), FRAME_TOLERANCE, True,
                     0, np.zeros((1, 12)), flags.copy(), one.copy(), flags.copy(), one.copy(),
-                    np.zeros((1, 6)), flags.copy(), np.array([0, 0, -1], dtype=np.int64),
+                    np.zeros((1, 6)), flags.copy(), np.array([0, 0], dtype=np.int64),
                     flags.copy(), flags.copy(), flags.copy(), one.copy(), np.zeros((1, 6)))

@@ -27,9 +27,9 @@ its own outputs, so what the cluster adds is only where it runs:
 from __future__ import annotations
 
 import argparse
-
 import json
 import logging
+import math
 import os
 import subprocess
 import sys
@@ -44,8 +44,19 @@ from fastsim_ros.replay.errors import problem
 from fastsim_ros.replay.results import Result
 from fastsim_ros.replay.run import Task, run_task, warm_up
 
-#: seconds to wait for the scheduler when connecting
+#: seconds to wait for the scheduler when connecting (``FASTSIM_DASK_CONNECT_TIMEOUT``: a
+#: slow network may need more, a test of an unreachable address less)
 CONNECT_TIMEOUT = 10.0
+
+
+def connect_timeout() -> float:
+    """Return the seconds to wait for the scheduler: the environment's, else the default."""
+    text = os.environ.get("FASTSIM_DASK_CONNECT_TIMEOUT", "")
+    try:
+        value = float(text)
+    except ValueError:
+        return CONNECT_TIMEOUT
+    return value if math.isfinite(value) and value > 0.0 else CONNECT_TIMEOUT
 
 
 #: Dask settings (environment variables) for a cluster that replays bags: no statistical
@@ -99,7 +110,8 @@ class Cluster:
         self.progress = progress
         self.futures: list[Any] = []
         try:
-            self.client = Client(address, timeout=f"{CONNECT_TIMEOUT}s", set_as_default=False)
+            self.client = Client(address, timeout=f"{connect_timeout()}s",
+                                 set_as_default=False)
         except (OSError, TimeoutError, ValueError) as e:
             raise ClusterError(f"cannot reach the Dask scheduler at {address}: "
                                f"{problem(e)}") from None

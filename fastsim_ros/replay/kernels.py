@@ -206,12 +206,10 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
     (``marker``: none within ``period`` ns of stamps), and whether it
     completes a rig cycle (``cycle``: the pipeline's rule,
     :meth:`fastsim_ros.pipeline.Pipeline._add_wrench`: every contact has a
-    wrench stamped after the last sum, within half the rig's cycle of each
-    other once a cycle is known; then ``cycle_stamp`` the newest
-    and ``cycle_wrench`` the sum of force and torque in the wheelset frame,
-    in the contacts' order).  ``fresh[c]``: contact ``c`` has a wrench;
-    ``sums``: whether a sum was made, the last sum's stamp, the shortest
-    interval between one contact's successive wrenches (-1 until seen).  ``force[i]``:
+    wrench stamped after the last sum; then ``cycle_stamp`` the newest and
+    ``cycle_wrench`` the sum of force and torque in the wheelset frame, in
+    the contacts' order).  ``fresh[c]``: contact ``c`` has a wrench;
+    ``sums``: whether a sum was made, the last sum's stamp.  ``force[i]``:
     ``Fx, Fy, N, Mz`` in the contact frame ``frame[i]`` (origin, ``e_x``,
     ``e_y``, ``e_z``).  The arithmetic is the pipeline's, term for term.
     The state arrays (per contact) are read and updated.
@@ -262,10 +260,6 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
         else:
             for k in range(6):
                 wrench[c, k] = 0.0
-        if fresh[c] and stamp[i] > wrench_stamp[c]:
-            gap = stamp[i] - wrench_stamp[c]
-            if sums[2] < 0 or gap < sums[2]:
-                sums[2] = gap
         wrench_stamp[c] = stamp[i]
         fresh[c] = True
         complete = True
@@ -279,8 +273,6 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
                 hi = max(hi, wrench_stamp[k])
         if complete and sums[0] == 1 and lo <= sums[1]:
             complete = False
-        if complete and sums[2] >= 0:
-            complete = 2 * (hi - lo) < sums[2]
         if complete:
             for k in range(6):
                 cycle_wrench[i, k] = 0.0
