@@ -314,14 +314,16 @@ def _check_material(nu: float, shear_modulus: float | None = None) -> None:
     _in_range("--shear-modulus", shear_modulus, "shear_modulus", " Pa")
 
 
-def _check_exact_grid(area: areas.GridArea, *, forces: bool) -> None:
+def _check_exact_grid(area: areas.GridArea, *, forces: bool,
+                      command: str = "forces --method exact") -> None:
+    """Refuse a grid the exact solver cannot take; ``command`` names the one refused."""
     if area.nx > MAX_STRIP_CELLS:
         raise InvalidInputError(f"the exact solver takes at most {MAX_STRIP_CELLS} cells along "
                                 f"x (its strips' operator blocks are dense), got {area.nx}")
     n = int(np.count_nonzero(area.mask))
     if forces and n > MAX_EXACT_FORCE_CELLS:
         raise InvalidInputError(
-            f"forces --method exact takes at most {MAX_EXACT_FORCE_CELLS:,} cells in contact, "
+            f"{command} takes at most {MAX_EXACT_FORCE_CELLS:,} cells in contact, "
             f"got {n:,}: use fewer --cells or a coarser patch")
 
 

@@ -148,7 +148,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             raise InvalidInputError(f"--method exact (the default) takes at most "
                                     f"{MAX_EXACT_SAMPLES} samples, got {creepages.shape[0]}: "
                                     "give fewer, or --method mae_calibrated")
-        cli._check_exact_grid(patch, forces=True)
+        cli._check_exact_grid(patch, forces=True,
+                              command="estimate's exact model (the default)")
         solver = ExactSolver(args.nu, args.shear_modulus)
     else:
         solver = solver_for(args.method, args.nu, args.shear_modulus)

@@ -900,3 +900,14 @@ def test_the_command_line_alone_recovers_mu_from_its_own_exact_curve(capsys, tmp
     assert result["method"] == "exact"
     assert abs(result["mu_static"] - 0.35) < 0.01 * 0.35
     assert result["worst_error_percent_mu_N"] < 1.0
+
+
+def test_a_patch_too_fine_for_the_default_exact_model_is_one_line(capsys, tmp_path):
+    """``--cells 200`` is more than the exact model takes: one line naming ``estimate``'s model."""
+    from fastsim_ros import cli
+    path = tmp_path / "m.csv"
+    path.write_text("xi,eta,phi,Fx\n0.001,0,0,-5000\n0.003,0,0,-9000\n0.006,0,0,-10000\n")
+    assert cli.main(["estimate", "--measured", str(path), "--shape", "ellipse", "--a", "6e-3",
+                     "--b", "4e-3", "--load", "5e4", "--cells", "200"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "estimate's exact model (the default) takes at most" in err
