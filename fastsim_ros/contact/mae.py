@@ -201,19 +201,18 @@ def _zone(area: GridArea, rows: NDArray[np.bool_], x_c: float, y_s: float,
     return Zone(zone_area, a, b, g, a_eq, a_eq / g)
 
 
-def mae_geometry(area: GridArea, rule: SplitRule = DEFAULT_SPLIT, *,
-                 shift: int = 0) -> MaeGeometry:
-    """MAE steps 1-3: centroid, split line and the two zones' semi-ellipses.
+def mae_geometry(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> MaeGeometry:
+    """MAE steps 1-3: centroid, split line and the two zones' semi-ellipses."""
+    return _geometry_at(area, rule, split_face(area, rule))
 
-    ``shift``: the split ``shift`` faces above the rule's (1: the other face
-    of a tie, :func:`split_tie`).
-    """
+
+def _geometry_at(area: GridArea, rule: SplitRule, f: int) -> MaeGeometry:
+    """Return :func:`mae_geometry` with the split along face ``f``."""
     mask = area.mask
     n = np.count_nonzero(mask)
     jj, ii = np.nonzero(mask)
     x_c = float(area.x[ii].sum() / n)
     y_c = float(area.y[jj].sum() / n)
-    f = split_face(area, rule) + shift
     y_s = float(area.y0 + (f - 0.5) * area.dy)
     rows = np.arange(area.ny) < f
     return MaeGeometry(x_c, y_c, y_s, rule, _zone(area, rows, x_c, y_s, True),
@@ -228,10 +227,10 @@ def mirror_geometries(area: GridArea,
     stiffnesses (:func:`averaged_flexibility`) and sweep from the middle
     of the strip between them.
     """
-    first = mae_geometry(area, rule)
-    if not split_tie(area, rule):
-        return (first,)
-    return first, mae_geometry(area, rule, shift=1)
+    f, tie = _split(row_extents(area.mask)[0], rule)
+    if not tie:
+        return (_geometry_at(area, rule, f),)
+    return _geometry_at(area, rule, f), _geometry_at(area, rule, f + 1)
 
 
 def averaged_flexibility(flexibilities: list[StripFlexibility]) -> StripFlexibility:

@@ -153,10 +153,9 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
                 # B = c / (1 - A): its variance through the map's Jacobian (nan unless both
                 # A and c are determined)
                 a_, c_ = float(theta[1]), float(theta[2])
-                grad = np.array([0.0, c_ / (1.0 - a_) ** 2, 1.0 / (1.0 - a_)]) \
-                    if a_ < 1.0 else np.full(3, math.nan)
-                var_b = float(grad[1:] @ cov[1:, 1:] @ grad[1:])
-                cov[2, 2] = var_b
+                grad = (np.array([c_ / (1.0 - a_) ** 2, 1.0 / (1.0 - a_)]) if a_ < 1.0
+                        else np.full(2, math.nan))   # dB/dA, dB/dc
+                cov[2, 2] = float(grad @ cov[1:, 1:] @ grad)
             for i in range(p):
                 if math.isfinite(cov[i, i]):
                     sigmas[names[i]] = math.sqrt(max(float(cov[i, i]), 0.0))

@@ -297,9 +297,9 @@ class _ContactState:
         self.has_marker = np.zeros(n, dtype=np.bool_)
         self.wrench_stamp = np.zeros(n, dtype=np.int64)
         self.wrench = np.zeros((n, 6))
-        self.fresh = np.zeros(n, dtype=np.bool_)
-        # the rig cycle's rule (kernels.advance): whether a sum was made, its stamp
-        self.sums = np.array([0, 0], dtype=np.int64)
+        self.has_wrench = np.zeros(n, dtype=np.bool_)
+        # the last wheelset wrench's stamp (kernels.advance; the int64 minimum before one)
+        self.last_sum = np.array([_FIRST], dtype=np.int64)
         self.counts = np.zeros((n, len(STATUSES)), dtype=np.int64)
         self.window_inputs = np.zeros(n, dtype=np.int64)
         self.window_rejected = np.zeros(n, dtype=np.int64)
@@ -798,8 +798,9 @@ class Batch:
         st = self.state
         kernels.advance(p.contact, p.stamp, p.status, p.frame, p.force, FRAME_TOLERANCE,
                         self.markers_on, self.marker_period, st.last_frame, st.has_frame,
-                        st.last_marker, st.has_marker, st.wrench_stamp, st.wrench, st.fresh,
-                        st.sums, p.changed, p.marker, p.cycle, p.cycle_stamp, p.cycle_wrench)
+                        st.last_marker, st.has_marker, st.wrench_stamp, st.wrench,
+                        st.has_wrench, st.last_sum, p.changed, p.marker, p.cycle, p.cycle_stamp,
+                        p.cycle_wrench)
         rejected = p.status >= len((SOLVED, NO_CONTACT))
         for c in range(len(self.contacts)):
             mine = p.contact == c
@@ -891,5 +892,5 @@ def warm_up() -> None:
     flags = np.zeros(1, dtype=np.bool_)
     kernels.advance(one, one, one, np.zeros((1, 12)), np.zeros((1, 4)), FRAME_TOLERANCE, True,
                     0, np.zeros((1, 12)), flags.copy(), one.copy(), flags.copy(), one.copy(),
-                    np.zeros((1, 6)), flags.copy(), np.array([0, 0], dtype=np.int64),
+                    np.zeros((1, 6)), flags.copy(), np.array([_FIRST], dtype=np.int64),
                     flags.copy(), flags.copy(), flags.copy(), one.copy(), np.zeros((1, 6)))

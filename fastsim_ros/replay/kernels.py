@@ -195,8 +195,8 @@ SOLVED, NO_CONTACT = 0, 1
 
 @njit(cache=True)
 def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, period,
-            last_frame, has_frame, last_marker, has_marker, wrench_stamp, wrench, fresh,
-            sums, changed, marker, cycle, cycle_stamp, cycle_wrench):
+            last_frame, has_frame, last_marker, has_marker, wrench_stamp, wrench, has_wrench,
+            last_sum, changed, marker, cycle, cycle_stamp, cycle_wrench):
     """Walk the patches in order with the pipeline's per-contact rules that carry state.
 
     Per patch ``i`` of contact ``contact_of[i]`` with ``status[i]``
@@ -208,13 +208,14 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
     :meth:`fastsim_ros.pipeline.Pipeline._add_wrench`: every contact has a
     wrench stamped after the last sum; then ``cycle_stamp`` the newest and
     ``cycle_wrench`` the sum of force and torque in the wheelset frame, in
-    the contacts' order).  ``fresh[c]``: contact ``c`` has a wrench;
-    ``sums``: whether a sum was made, the last sum's stamp.  ``force[i]``:
+    the contacts' order).  ``has_wrench[c]``: contact ``c`` has a wrench;
+    ``last_sum[0]``: the last sum's stamp (the int64 minimum before the
+    first).  ``force[i]``:
     ``Fx, Fy, N, Mz`` in the contact frame ``frame[i]`` (origin, ``e_x``,
     ``e_y``, ``e_z``).  The arithmetic is the pipeline's, term for term.
     The state arrays (per contact) are read and updated.
     """
-    nc = fresh.size
+    nc = has_wrench.size
     for i in range(contact_of.size):
         c = contact_of[i]
         s = status[i]
@@ -261,27 +262,24 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
             for k in range(6):
                 wrench[c, k] = 0.0
         wrench_stamp[c] = stamp[i]
-        fresh[c] = True
+        has_wrench[c] = True
         complete = True
         lo = stamp[i]
         hi = stamp[i]
         for k in range(nc):
-            if not fresh[k]:
+            if not has_wrench[k]:
                 complete = False
             else:
                 lo = min(lo, wrench_stamp[k])
                 hi = max(hi, wrench_stamp[k])
-        if complete and sums[0] == 1 and lo <= sums[1]:
-            complete = False
-        if complete:
+        if complete and lo > last_sum[0]:
             for k in range(6):
                 cycle_wrench[i, k] = 0.0
             for k in range(nc):
                 for j in range(3):
                     cycle_wrench[i, j] += wrench[k, j]
                     cycle_wrench[i, 3 + j] += wrench[k, 3 + j]
-            sums[0] = 1
-            sums[1] = hi
+            last_sum[0] = hi
             cycle[i] = True
             cycle_stamp[i] = hi
         if markers_on:
