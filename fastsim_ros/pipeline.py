@@ -612,6 +612,7 @@ class Pipeline:
         solved: list[tuple[ContactPatch, Creepage, ContactForces]] = []
         normal_x = predicted = load = used = adhesion = slope = 0.0
         marched = True  # every contact's slope came with its solve
+        slopes: list[tuple[float, float]] = []
         for state in self._contacts.values():
             taken = state.solved
             if taken is None:
@@ -622,6 +623,7 @@ class Pipeline:
                 marched = False
             else:
                 slope += ex[0] * state.slope[0] + ey[0] * state.slope[1]
+                slopes.append(state.slope)
             solved.append(taken)
             normal_x += ez[0] * f.n
             predicted += ex[0] * f.fx + ey[0] * f.fy
@@ -656,7 +658,11 @@ class Pipeline:
             try:
                 if marched and model.has_slope and ekf.mu == mu:
                     # the node's cycle: the model and its slope at the prior are the
-                    # published solve's (update, to the bit, without its sequences)
+                    # published solve's (update, to the bit, without its sequences), times
+                    # the knee factor where the model carries it (CreepModel.knee_factor)
+                    if model.knee_corrected:
+                        predicted, slope = self._knee_corrected(model, samples(), solved,
+                                                                slopes, mu)
                     step = ekf.update_scalar(
                         measured[0] - normal_x, predicted, slope, load,
                         model_error(mu, adhesion, share),
@@ -683,6 +689,26 @@ class Pipeline:
             if c is not None:  # only mu_s (slot 7) depends on mu
                 self._compiled = c[:7] + (self._mu,) + c[8:]
         return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
+
+    @staticmethod
+    def _knee_corrected(model: CreepModel, samples: list[ContactSample],
+                        solved: list[tuple[ContactPatch, Creepage, ContactForces]],
+                        slopes: list[tuple[float, float]], mu: float) -> tuple[float, float]:
+        """Return the model's value and slope at ``mu`` from the published solves and marches.
+
+        Per contact ``kappa F`` and ``kappa dF/dmu_s + F dkappa/dmu_s``
+        (:meth:`CreepModel.knee_factor`), projected on the measured ``x``:
+        :meth:`CreepModel.predict` and :meth:`CreepModel.slope` without a
+        solve (the published forces and the march's slope are theirs).
+        """
+        predicted = slope = 0.0
+        for (_, _, f), (dfx, dfy), sample in zip(solved, slopes, samples):
+            kappa, dkappa = model.knee_factor(sample, mu)
+            (px, py), = sample.projection
+            force = px * f.fx + py * f.fy
+            predicted += kappa * force
+            slope += kappa * (px * dfx + py * dfy) + dkappa * force
+        return predicted, slope
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
         """Return the wheel and rail twists a patch stamped ``stamp_ns`` is solved with.

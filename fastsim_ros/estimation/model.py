@@ -28,6 +28,18 @@ knee's 5.9% of mu N at k = 0.67, 1% at k = 0.92), below 0.05 of it in
 partial slip (``k`` < 0.55), so the 0.5 is an honest bound.  In full slip
 ``s`` vanishes and the load cell's noise is left.
 
+The knee (:mod:`fastsim_ros.contact.knee`): FastSim's force against the
+exact theory's is off by a function of the normalised creepage (1.6% of
+``mu N`` above it in early partial slip, up to 6.6% below it at the knee of
+the curve, the same on every ellipse to a point).  With ``knee`` (the
+default) the model's force is the method's times the tabulated knee factor
+``kappa(s)``, ``s = |F_lin| / (mu_s N)`` on the patch's equivalent ellipse,
+and its slope in ``mu_s`` is that product's (``d kappa / d mu_s = -(s /
+mu_s) d kappa / d s``): the estimate reads the exact theory's friction from
+a force at the knee, where the method's own force read as friction was 3-8%
+off.  Not with the parabolic bound (another knee, not tabulated) nor where
+the equivalent ellipse is outside Kalker's tables (factor 1).
+
 Reverse running (rolling speed ``V < 0``) is solved as the pipeline solves
 it (INTERFACE.md "Creepages"): the patch turned by 180 degrees about ``z``,
 spin negated, ``(-Fx', -Fy')`` reported, so the model's forces are the
@@ -51,6 +63,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipse
 from fastsim_ros.contact.compiled import _law as _kernel_law
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, friction_law
+from fastsim_ros.contact.knee import knee_factors, linear_force
 
 FloatArray = NDArray[np.float64]
 Solver = MaeSolver | EquivalentEllipseSolver
@@ -178,16 +191,16 @@ class ContactSample(NamedTuple):
         return float(self.pressure.sum()) * self.dx * self.dy
 
 
-def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float, float]] | None:
+def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, ...]] | None:
     """Return ``solve(p, x0, y0, dx, dy, xi, eta, phi, law, speed, slope)`` for MAE.
 
-    ``slope`` False: ``(Fx, Fy, k)`` from the compiled kernel
-    :meth:`MaeSolver.solve_arrays` calls, with the same arguments (bit for
-    bit its forces), without the wrapping the estimator pays per solve
-    (argument checks, the result object).  ``slope`` True: ``(dFx/dmu_s,
-    dFy/dmu_s, k)``, the march's own derivative
-    (:func:`fastsim_ros.contact.kernels.mae_solve_mu_slope`), the EKF's
-    slope.  None for the other solvers.
+    ``(Fx, Fy, k, dFx/dmu_s, dFy/dmu_s)``: the forces from the compiled
+    kernel :meth:`MaeSolver.solve_arrays` calls, with the same arguments
+    (bit for bit its forces), without the wrapping the estimator pays per
+    solve (argument checks, the result object); with ``slope`` the march's
+    own derivatives from the same march
+    (:func:`fastsim_ros.contact.kernels.mae_solve_mu_slope`, the EKF's
+    slope), else zeros.  None for the other solvers.
     """
     if not isinstance(solver, MaeSolver):
         return None
@@ -199,7 +212,7 @@ def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float,
 
     def solve(p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
               eta: float, phi: float, law: tuple[int, FloatArray, float, bool],
-              speed: float, slope: bool = False) -> tuple[float, float, float]:
+              speed: float, slope: bool = False) -> tuple[float, ...]:
         code, prm, mu, slip_dependent = law
         if not p.flags.c_contiguous:
             p = np.ascontiguousarray(p)
@@ -208,15 +221,15 @@ def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, float,
             r = kernels.mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule,
                                            parabolic, shear, knots, polys, code, prm, v,
                                            calibrated, pair_knots, pair_values)
-            a, b = r[8], r[9]
+            d_x, d_y = r[8], r[9]
         else:
             r = kernels.mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule,
                                   parabolic, shear, knots, polys, code, prm, v, no_float,
                                   no_float, no_bool, False, calibrated, pair_knots, pair_values)
-            a, b = r[2], r[3]
+            d_x = d_y = 0.0
         if r[0]:
             _raise(r[0], r[1], knots)
-        return a, b, r[6] / r[7]
+        return r[2], r[3], r[6] / r[7], d_x, d_y
     return solve
 
 
@@ -226,7 +239,9 @@ class CreepModel:
 
     ``law``: ``"constant"`` or ``"exponential"``; ``limit_ratio`` ``A`` in
     ``(0, 1]`` and ``decay`` ``B`` (s/m) of ``mu(v) = mu_s ((1 - A) exp(-B v)
-    + A)``; ``bound``: the traction bound (``"given"`` or ``"parabolic"``).
+    + A)``; ``bound``: the traction bound (``"given"`` or ``"parabolic"``);
+    ``knee``: the method's force times the knee factor (module docstring;
+    with the given bound only).
     """
 
     solver: Solver
@@ -234,6 +249,7 @@ class CreepModel:
     limit_ratio: float = 1.0
     decay: float = 0.0
     bound: str = "given"
+    knee: bool = True
 
     def friction(self, mu_s: float, limit_ratio: float | None = None,
                  decay: float | None = None) -> FrictionLaw:
@@ -250,6 +266,53 @@ class CreepModel:
         object.__setattr__(self, "_marched_slope", self._kernel is not None)  # type: ignore
         # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
         object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
+        object.__setattr__(self, "_knee", knee_factors(self.solver.nu)
+                           if self.knee and not check_bound(self.bound) else None)
+        object.__setattr__(self, "_ell", np.empty(kernels.ELL_SIZE))
+
+    @property
+    def knee_corrected(self) -> bool:
+        """Whether the model's forces carry the knee factor (``knee`` and the given bound)."""
+        return self._knee is not None  # type: ignore[attr-defined]
+
+    def knee_factor(self, sample: ContactSample, mu_s: float) -> tuple[float, float]:
+        """Return ``(kappa, d kappa / d mu_s)`` of one sample at ``mu_s``; ``(1, 0)`` without.
+
+        ``kappa(s)`` at ``s = |F_lin| / (mu_s N)``, ``F_lin`` Kalker's linear
+        force on the patch's equivalent ellipse at the creepages moved to
+        its centre, as the solver takes the patch (reversed when ``V <
+        0``: the spin's share of ``F_lin`` turns with the rolling direction).
+        """
+        knee = self._knee  # type: ignore[attr-defined]
+        if knee is None:
+            return 1.0, 0.0
+        p, x0, y0, phi = sample.pressure, sample.x0, sample.y0, sample.phi
+        if sample.speed < 0.0:  # as _solve
+            p = p[::-1, ::-1]
+            x0 = -(x0 + (p.shape[1] - 1) * sample.dx)
+            y0 = -(y0 + (p.shape[0] - 1) * sample.dy)
+            phi = -phi
+        if not p.flags.c_contiguous:
+            p = np.ascontiguousarray(p)
+        ell = self._ell  # type: ignore[attr-defined]
+        s = self.solver
+        status, _ = kernels.equivalent_prepare(p, float(x0), float(y0), float(sample.dx),
+                                               float(sample.dy), s.shear_modulus, s._knots,
+                                               s._polys, ell)
+        load = ell[kernels.ELL_LOAD]
+        if status != kernels.OK or not load > 0.0:
+            return 1.0, 0.0
+        # creepages at the ellipse's centre (spin about the grid's origin, as the kernels)
+        x_c, y_c = ell[kernels.ELL_XC], ell[kernels.ELL_YC]
+        fx, fy = linear_force(ell[kernels.ELL_A], ell[kernels.ELL_B], ell[kernels.ELL_L1],
+                              ell[kernels.ELL_L2], ell[kernels.ELL_L3],
+                              sample.xi - phi * y_c, sample.eta + phi * x_c, phi)
+        f2 = fx * fx + fy * fy
+        if not f2 > 0.0:
+            return 1.0, 0.0
+        sn = math.sqrt(f2) / (mu_s * load)
+        kappa, slope = knee.factor(sn, ell[kernels.ELL_A] / ell[kernels.ELL_B], fx * fx / f2)
+        return kappa, -slope * sn / mu_s
 
     def contact_forces(self, sample: ContactSample, mu_s: float) -> tuple[float, float]:
         """Return the creep forces ``(Fx, Fy)`` (N, contact frame) of one sample at ``mu_s``."""
@@ -275,15 +338,21 @@ class CreepModel:
         if kernel is not None:  # the kernel solve_arrays calls, without its wrapping
             if kernel_law is None:
                 kernel_law = self._kernel_law(self.friction(mu_s) if law is None else law)
-            fx, fy, k = kernel(p, x0, y0, sample.dx, sample.dy, sample.xi, sample.eta, phi,
-                               kernel_law, abs(sample.speed), slope)
+            fx, fy, k, dfx, dfy = kernel(p, x0, y0, sample.dx, sample.dy, sample.xi,
+                                         sample.eta, phi, kernel_law, abs(sample.speed), slope)
+            kappa, dkappa = self.knee_factor(sample, mu_s)
+            if slope:  # d(kappa F)/dmu_s = kappa dF/dmu_s + F dkappa/dmu_s
+                fx, fy = kappa * dfx + dkappa * fx, kappa * dfy + dkappa * fy
+            elif kappa != 1.0:
+                fx, fy = kappa * fx, kappa * fy
         else:
             law = self.friction(mu_s) if law is None else law
             f = self.solver.solve_arrays(p, x0, y0, sample.dx, sample.dy, sample.xi,
                                          sample.eta, phi,
                                          bound=self.bound,  # type: ignore[arg-type]
                                          friction=law, speed=abs(sample.speed))
-            fx, fy, k = f.fx, f.fy, f.slip_fraction
+            kappa = self.knee_factor(sample, mu_s)[0]
+            fx, fy, k = kappa * f.fx, kappa * f.fy, f.slip_fraction
         return (-fx, -fy, k) if reverse else (fx, fy, k)
 
     @property

@@ -1,0 +1,186 @@
+"""FastSim's knee against the exact theory: a factor on the creep force's magnitude.
+
+FastSim's creep force rises from zero traction at the leading edge of every
+strip and is capped by ``mu p``; with the pressure as given (elliptical
+across a Hertzian patch, ``bound="given"``) a thin band of adhesion stays at
+the leading edge however large the creepage, so its curve reaches full slip
+only slowly, while the exact theory's stick area vanishes at a finite
+creepage.  Measured against :func:`fastsim_ros.contact.exact.coulomb` on
+Hertzian ellipses, at the same creepage the magnitude of FastSim's force is
+up to 1.6% of ``mu N`` above the exact one in the early partial slip and
+up to 6.6% below it at the knee (``docs/validation_estimation.md``).
+
+Both curves are functions of one variable on an ellipse: the creepage
+normalised by its saturation value,
+
+    s = |F_lin| / (mu_s N),
+
+``F_lin`` the force of Kalker's linear theory (full adhesion, the force
+FastSim's flexibilities reproduce: :func:`linear_force`), ``mu_s`` the static
+coefficient, ``N`` the load.  FastSim's curve ``|F| / (mu N)`` against ``s``
+is the same on every ellipse (its flexibilities make it so); the exact one
+moves with the ellipse's ``a/b``, the creepage's direction and ``nu`` by
+about a point of ``mu N`` at the knee.  So the *knee factor*
+
+    kappa(s, a/b, direction, nu) = |F_exact| / |F_fastsim|   at the same s
+
+is tabulated with the exact solver (``fastsim_ros/data/fastsim_knee_factors.csv``,
+made by ``scripts/make_knee_table.py``, provenance in its header) for pure
+longitudinal and pure lateral creepage, and :meth:`KneeFactors.factor`
+interpolates it: linearly in ``s``, linearly in ``log(a/b)`` (the nearest
+edge outside the nodes), between the two directions by the share
+``w = F_lin,x^2 / |F_lin|^2`` of the linear force along ``x``, in ``nu`` by
+the quadratic through the three tabulated values.  Beyond the last node in
+``s`` (full slip) ``kappa - 1`` falls as ``1/s^2``, as FastSim's remaining
+adhesion band does; ``kappa(0) = 1``.
+
+Assumptions stated: the factor of a Hertzian ellipse serves any patch (on
+MAE's patches it is taken at the equivalent ellipse's ``a/b``); Coulomb
+friction (under a slip-dependent law ``s`` is taken at ``mu_s``: measured,
+the exponential law of ``docs/validation_estimation.md`` moves the exact
+curve's knee by 0.2 point of ``mu N`` against FastSim's); spin enters only
+through ``F_lin`` (the tables hold no spin); the pressure as the traction
+bound (``bound="given"``: Kalker's parabolic bound has another knee and is
+not corrected).  Its use: the friction estimator's measurement model
+(:mod:`fastsim_ros.estimation.model`), where the knee's error read as a
+friction error was the estimate's largest; the published forces are the
+method's own.
+
+Units: SI (N, m, Pa); ``s`` and ``kappa`` dimensionless.  No ROS, no SciPy.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from importlib import resources
+
+import numpy as np
+from numpy.typing import NDArray
+
+from fastsim_ros.contact.errors import DataError, OutOfTableError
+
+FloatArray = NDArray[np.float64]
+
+KNEE_FILE = "fastsim_knee_factors.csv"
+#: the creepage directions tabulated (pure xi, pure eta)
+DIRECTIONS = ("xi", "eta")
+
+
+def linear_force(a: float, b: float, l1: float, l2: float, l3: float, xi: float, eta: float,
+                 phi: float) -> tuple[float, float]:
+    """Return ``(F_x, F_y)`` (N): Kalker's linear force with the creepages' sign.
+
+    An ellipse of semi-axes ``a`` (along x), ``b`` (m) with Kalker's
+    flexibilities ``l1, l2, l3`` (m/Pa, METHOD.md 2: ``L1 = 8 a / (3 G
+    C11)``, ``L2 = 8 a / (3 G C22)``, ``L3 = pi a sqrt(a/b) / (4 G C23)``)
+    under ``xi``, ``eta`` (1) at its centre and spin ``phi`` (1/m):
+    ``G a b (C11 xi, C22 eta) + G (ab)^1.5 C23 (0, phi)`` (Kalker's
+    normalisation), written with the ``L``'s (``G a b C11 = 8 a^2 b / (3
+    L1)``: FastSim's strips in adhesion, ``sum 2 a_y^2 xi / L1``; ``G (ab)^1.5
+    C23 = pi a^3 b / (4 L3)``).  The creep force is minus this in full
+    adhesion.
+    """
+    k1 = 8.0 * a * a * b / (3.0 * l1)
+    k2 = 8.0 * a * a * b / (3.0 * l2)
+    k3 = math.pi * a * a * a * b / (4.0 * l3)
+    return k1 * xi, k2 * eta + k3 * phi
+
+
+@dataclass(frozen=True, eq=False)
+class KneeFactors:
+    """The knee factors at one Poisson ratio (module docstring).
+
+    ``log_aspect``: the nodes' ``log(a/b)``, ``(na,)``; ``s``: the nodes in
+    ``s``, ``(ns,)`` from 0; ``kappa``: ``(2, na, ns)``, pure ``xi`` then pure
+    ``eta``.
+    """
+
+    nu: float
+    log_aspect: FloatArray
+    s: FloatArray
+    kappa: FloatArray
+
+    def factor(self, s: float, aspect: float, share_x: float) -> tuple[float, float]:
+        """Return ``(kappa, d kappa / d s)`` at ``s`` (>= 0), ``a/b`` and the share along x.
+
+        ``share_x``: ``F_lin,x^2 / |F_lin|^2`` in ``[0, 1]``.  A scalar
+        function (one per contact per rig cycle): no arrays made.
+        """
+        la = self.log_aspect
+        t = math.log(aspect) if aspect > 0.0 else -math.inf
+        if not t > la[0]:
+            ia, wa = 0, 0.0
+        elif not t < la[-1]:
+            ia, wa = len(la) - 2, 1.0
+        else:
+            ia = int(np.searchsorted(la, t)) - 1
+            wa = (t - la[ia]) / (la[ia + 1] - la[ia])
+        kap = self.kappa
+        sn = self.s
+        last = sn[-1]
+        if s >= last:
+            # full slip: FastSim's adhesion band shrinks as 1/s, its force's deficit as 1/s^2
+            tail = (last / s) ** 2 if s > 0.0 else 1.0
+            k = 0.0
+            for d, wd in ((0, share_x), (1, 1.0 - share_x)):
+                k += wd * ((1.0 - wa) * kap[d, ia, -1] + wa * kap[d, ia + 1, -1])
+            return 1.0 + (k - 1.0) * tail, -2.0 * (k - 1.0) * tail / s
+        i = max(int(np.searchsorted(sn, s, side="right")) - 1, 0)
+        h = sn[i + 1] - sn[i]
+        u = (s - sn[i]) / h
+        k = dk = 0.0
+        for d, wd in ((0, share_x), (1, 1.0 - share_x)):
+            k0 = (1.0 - wa) * kap[d, ia, i] + wa * kap[d, ia + 1, i]
+            k1 = (1.0 - wa) * kap[d, ia, i + 1] + wa * kap[d, ia + 1, i + 1]
+            k += wd * (k0 + u * (k1 - k0))
+            dk += wd * (k1 - k0) / h
+        return k, dk
+
+
+def _read() -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Return the file's nodes ``nu``, ``a/b``, ``s`` and ``kappa[nu, dir, a/b, s]``."""
+    try:
+        text = resources.files("fastsim_ros.data").joinpath(KNEE_FILE).read_text("utf-8")
+    except (OSError, ModuleNotFoundError) as exc:
+        raise DataError(f"cannot read the knee factors {KNEE_FILE}: {exc}") from exc
+    rows = [r for r in csv.DictReader(io.StringIO(
+        "\n".join(line for line in text.splitlines() if not line.startswith("#"))))]
+    try:
+        nus = sorted({float(r["nu"]) for r in rows})
+        aspects = sorted({float(r["a_over_b"]) for r in rows})
+        ss = sorted({float(r["s"]) for r in rows})
+        kappa = np.full((len(nus), 2, len(aspects), len(ss)), np.nan)
+        for r in rows:
+            kappa[nus.index(float(r["nu"])), DIRECTIONS.index(r["direction"]),
+                  aspects.index(float(r["a_over_b"])), ss.index(float(r["s"]))] = \
+                float(r["kappa"])
+    except (KeyError, ValueError) as exc:
+        raise DataError(f"malformed knee factors {KNEE_FILE}: {exc}") from exc
+    if not np.all(np.isfinite(kappa)) or len(nus) != 3 or ss[0] != 0.0:
+        raise DataError(f"incomplete knee factors {KNEE_FILE}: every (nu, direction, a/b, s) "
+                        "of three nu values, s from 0")
+    return np.array(nus), np.array(aspects), np.array(ss), kappa
+
+
+@lru_cache(maxsize=8)
+def knee_factors(nu: float) -> KneeFactors:
+    """Return the knee factors at Poisson ratio ``nu`` (the tables' ``0 <= nu <= 0.5``)."""
+    nus, aspects, ss, kappa = _read()
+    nu = float(nu)
+    if not (nus[0] <= nu <= nus[-1]):
+        raise OutOfTableError(f"nu = {nu} outside the knee factors' {nus[0]:g} .. {nus[-1]:g}")
+    # the quadratic through the three tabulated nu (Lagrange)
+    n0, n1, n2 = nus
+    w = np.array([(nu - n1) * (nu - n2) / ((n0 - n1) * (n0 - n2)),
+                  (nu - n0) * (nu - n2) / ((n1 - n0) * (n1 - n2)),
+                  (nu - n0) * (nu - n1) / ((n2 - n0) * (n2 - n1))])
+    at_nu = np.tensordot(w, kappa, axes=1)
+    at_nu.setflags(write=False)
+    log_aspect = np.log(aspects)
+    log_aspect.setflags(write=False)
+    ss.setflags(write=False)
+    return KneeFactors(nu, log_aspect, ss, at_nu)
