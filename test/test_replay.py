@@ -321,15 +321,12 @@ def test_adhesion_rig_estimates_the_exact_theorys_friction(contents):
     Issue 28's target: beyond the linear range mu within 2% of the truth
     within 0.2 s of each step and the 2-sigma band covering it at least 95%
     of the time; in the linear range the estimate moves less than 1% while
-    sigma grows.  Measured by the exact theory, the model's error at the
-    knee of the curve (3-8% of mu there, docs/validation_estimation.md) is
-    what the estimate can be trusted to until the creepage reaches full
-    slip: there the 2% holds where the bag's creepage gets beyond the knee
-    within 0.2 s (the dry -> wet step at 1.5 s) and from the ramp's full
-    slip on (the last 0.5 s of each dry stretch), and where it does not
-    (after the wet -> dry step at 3 s the creepage stays at the dry knee
-    for 0.5 s: up to 4.7% off) sigma says so: the band still covers the
-    truth and sigma is above 2% of mu wherever the error is.
+    sigma grows.  Measured by the exact theory: the method's own force at
+    the knee of the curve is 3-6% of mu N off it (3-8% of mu,
+    docs/validation_estimation.md), and after the wet -> dry step at 3 s the
+    creepage stays at the dry knee for half a second; the estimator's model
+    carries the knee factor (fastsim_ros/contact/knee.py), which brings it
+    within about 1% of mu N of the exact theory there.
     """
     truth, steps, spells = adhesion_truth()
     _, msgs = contents["adhesion_rig"][0]["/friction/estimate"]
@@ -347,11 +344,7 @@ def test_adhesion_rig_estimates_the_exact_theorys_friction(contents):
     ends = [start for start, _ in steps[1:]] + [t[-1] + 1.0]
     for (start, mu_s), end in zip(steps, ends):
         settled = (t >= start + 0.2) & (t < end) & ~linear
-        # where the estimate is off by more than 2%, its sigma says it may be
-        assert np.all((error[settled] < 0.02) | (sigma[settled] > 0.02 * mu[settled]))
-        assert np.all(error[(t >= end - 0.5) & (t < end) & ~linear] < 0.02), start
-    wet = (t >= steps[1][0] + 0.2) & (t < steps[2][0]) & ~linear
-    assert error[wet].max() < 0.02  # the dry -> wet step: within 2% from 0.2 s on
+        assert settled.sum() > 50 and error[settled].max() < 0.02, start
     for a, b in spells:
         inside = np.nonzero((t >= a) & (t < b))[0]
         before = inside[0] - 1
