@@ -46,7 +46,7 @@ OUT = Path(__file__).resolve().parent.parent / "fastsim_ros" / "data" / KNEE_FIL
 
 
 def unit_linear(solver: CalibratedMaeSolver, ar, direction: str) -> float:
-    """Return |F_lin| (N) per unit creepage along ``direction`` on the area's equivalent ellipse."""
+    """Return |F_lin| (N) per unit creepage along ``direction`` (the area's equivalent ellipse)."""
     ell = np.empty(k.ELL_SIZE)
     status, _ = k.equivalent_prepare(np.ascontiguousarray(ar.pressure), ar.x0, ar.y0, ar.dx,
                                      ar.dy, G, solver._knots, solver._polys, ell)
