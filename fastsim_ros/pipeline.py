@@ -661,8 +661,7 @@ class Pipeline:
                     # published solve's (update, to the bit, without its sequences), times
                     # the knee factor where the model carries it (CreepModel.knee_factor)
                     if model.knee_corrected:
-                        predicted, slope = self._knee_corrected(model, samples(), solved,
-                                                                slopes, mu)
+                        predicted, slope = self._knee_corrected(model, solved, slopes, mu)
                     step = ekf.update_scalar(
                         measured[0] - normal_x, predicted, slope, load,
                         model_error(mu, adhesion, share),
@@ -691,23 +690,24 @@ class Pipeline:
         return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
 
     @staticmethod
-    def _knee_corrected(model: CreepModel, samples: list[ContactSample],
+    def _knee_corrected(model: CreepModel,
                         solved: list[tuple[ContactPatch, Creepage, ContactForces]],
                         slopes: list[tuple[float, float]], mu: float) -> tuple[float, float]:
         """Return the model's value and slope at ``mu`` from the published solves and marches.
 
         Per contact ``kappa F`` and ``kappa dF/dmu_s + F dkappa/dmu_s``
-        (:meth:`CreepModel.knee_factor`), projected on the measured ``x``:
+        (:meth:`CreepModel.knee_factor`), projected on the wheelset's ``x``:
         :meth:`CreepModel.predict` and :meth:`CreepModel.slope` without a
         solve (the published forces and the march's slope are theirs).
         """
         predicted = slope = 0.0
-        for (_, _, f), (dfx, dfy), sample in zip(solved, slopes, samples):
-            kappa, dkappa = model.knee_factor(sample, mu)
-            (px, py), = sample.projection
-            force = px * f.fx + py * f.fy
+        for (p, c, f), (dfx, dfy) in zip(solved, slopes):
+            kappa, dkappa = model.knee_factor_of(p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi,
+                                                 c.eta, c.phi, c.speed, mu)
+            ex, ey, _ = p.frame.axes
+            force = ex[0] * f.fx + ey[0] * f.fy
             predicted += kappa * force
-            slope += kappa * (px * dfx + py * dfy) + dkappa * force
+            slope += kappa * (ex[0] * dfx + ey[0] * dfy) + dkappa * force
         return predicted, slope
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:

@@ -159,3 +159,36 @@ def test_reverse_running_turns_the_spins_share():
         area.pressure, area.x0, area.y0, area.dx, area.dy, 2e-3, 0.0, 0.0, v, ((1.0, 0.0),)),
         0.3)[0] for v in (20.0, -20.0)]
     assert plain[0] == pytest.approx(plain[1], rel=1e-9)  # no spin: the same s either way
+
+
+@pytest.mark.parametrize("xi, eta, phi, speed", [(3e-3, 0.0, 0.0, 20.0),
+                                                 (1e-3, -2e-3, 1.5, 20.0),
+                                                 (2e-3, 1e-3, -0.7, -15.0)])
+def test_the_compiled_factor_is_the_references(xi, eta, phi, speed):
+    """The kernel (one call per contact per cycle) against the numpy modules composed."""
+    from fastsim_ros.contact.equivalent import equivalent_ellipse
+    from fastsim_ros.contact.fastsim import kalker_flexibility
+    from fastsim_ros.contact.tables import coefficient_table
+
+    area = flange_root_patch(cells=30)
+    mu, nu = 0.3, 0.28
+    model = CreepModel(CalibratedMaeSolver(nu, G))
+    sample = ContactSample(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,
+                           speed, ((1.0, 0.0),))
+    kappa, dkappa = model.knee_factor(sample, mu)
+    # the reference: the patch as the solver takes it (turned for V < 0), numpy's ellipse
+    ar, spin = area, phi
+    if speed < 0.0:
+        from fastsim_ros.contact.area import GridArea
+        p = area.pressure[::-1, ::-1]
+        ar = GridArea(-(area.x0 + (p.shape[1] - 1) * area.dx),
+                      -(area.y0 + (p.shape[0] - 1) * area.dy), area.dx, area.dy, p)
+        spin = -phi
+    e = equivalent_ellipse(ar)
+    table = coefficient_table(nu)
+    ls = kalker_flexibility(e.a, e.b, *table.kalker(e.a / e.b), G)
+    fx, fy = linear_force(e.a, e.b, *ls, xi - spin * e.y_c, eta + spin * e.x_c, spin)
+    s = math.hypot(fx, fy) / (mu * float(ar.pressure.sum()) * ar.dx * ar.dy)
+    ref, dref = knee_factors(nu).factor(s, e.a / e.b, fx * fx / (fx * fx + fy * fy))
+    assert kappa == pytest.approx(ref, rel=1e-9)
+    assert dkappa == pytest.approx(-dref * s / mu, rel=1e-6)

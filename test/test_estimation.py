@@ -917,9 +917,9 @@ def test_the_published_solve_carries_the_slope(speed, law):
     assert abs(state.slope[0]) > 0.1 * s[0].load  # beyond the linear range: observable
     # the estimator's model value and slope from them: the knee-corrected model's
     assert model.knee_corrected
-    x = [s[0]._replace(projection=((1.0, 0.0),))]
-    predicted, slope = pipe._knee_corrected(model, x, [(p, creep, on.forces)],
-                                            [state.slope], 0.3)
+    ex, ey, _ = p.frame.axes
+    x = [s[0]._replace(projection=((ex[0], ey[0]),))]
+    predicted, slope = pipe._knee_corrected(model, [(p, creep, on.forces)], [state.slope], 0.3)
     assert predicted == pytest.approx(model.predict(x, 0.3)[0], rel=1e-12)
     assert slope == pytest.approx(model.slope(x, 0.3)[0], rel=1e-12)
 

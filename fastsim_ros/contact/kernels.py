@@ -37,7 +37,7 @@ import math
 import numpy as np
 from numba import njit
 
-from fastsim_ros.contact import rules
+from fastsim_ros.contact import knee, rules
 
 #: order of the coefficients in the ``polys`` array
 TABLE_NAMES = ("C11", "C22", "C23", "C33", "c11", "c12", "c13", "c21", "c22", "c23")
@@ -1557,6 +1557,41 @@ def equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell):
     ell[ELL_L2] = l2
     ell[ELL_L3] = l3
     return OK, 0.0
+
+
+#: :func:`fastsim_ros.contact.knee.linear_force` and :func:`~fastsim_ros.contact.knee.interpolate`,
+#: compiled: the reference's formulas, no copies
+knee_linear_force = njit(cache=True, error_model="numpy")(knee.linear_force)
+knee_interpolate = njit(cache=True, error_model="numpy")(knee.interpolate)
+
+
+@njit(cache=True, error_model="numpy")
+def knee_factor(p, x0, y0, dx, dy, xi, eta, phi, mu, shear_modulus, knots, polys, ell,
+                log_aspect, s_nodes, kappa):
+    """Return ``(kappa, d kappa / d mu_s)``: the knee factor of a patch at ``mu_s = mu``.
+
+    :meth:`fastsim_ros.estimation.model.CreepModel.knee_factor`, one call:
+    the equivalent ellipse (:func:`equivalent_prepare`, into ``ell``),
+    Kalker's linear force at the creepages moved to its centre (spin
+    ``phi`` about the grid's origin), ``s = |F_lin| / (mu N)`` and the
+    table's factor (:class:`fastsim_ros.contact.knee.KneeFactors`' arrays);
+    ``(1, 0)`` where the ellipse is outside Kalker's tables or carries no
+    load or force.
+    """
+    status, _ = equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell)
+    load = ell[ELL_LOAD]
+    if status != OK or not load > 0.0:
+        return 1.0, 0.0
+    a = ell[ELL_A]
+    b = ell[ELL_B]
+    fx, fy = knee_linear_force(a, b, ell[ELL_L1], ell[ELL_L2], ell[ELL_L3],
+                               xi - phi * ell[ELL_YC], eta + phi * ell[ELL_XC], phi)
+    f2 = fx * fx + fy * fy
+    if not f2 > 0.0:
+        return 1.0, 0.0
+    s = math.sqrt(f2) / (mu * load)
+    k, dk = knee_interpolate(log_aspect, s_nodes, kappa, s, math.log(a / b), fx * fx / f2)
+    return k, -dk * s / mu
 
 
 @njit(cache=True, error_model="numpy")

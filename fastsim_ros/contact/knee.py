@@ -117,38 +117,65 @@ class KneeFactors:
     def factor(self, s: float, aspect: float, share_x: float) -> tuple[float, float]:
         """Return ``(kappa, d kappa / d s)`` at ``s`` (>= 0), ``a/b`` and the share along x.
 
-        ``share_x``: ``F_lin,x^2 / |F_lin|^2`` in ``[0, 1]``.  A scalar
-        function (one per contact per rig cycle): no arrays made.
+        ``share_x``: ``F_lin,x^2 / |F_lin|^2`` in ``[0, 1]``
+        (:func:`interpolate`, the formula the kernels compile).
         """
-        la = self.log_aspect
         t = math.log(aspect) if aspect > 0.0 else -math.inf
-        if not t > la[0]:
-            ia, wa = 0, 0.0
-        elif not t < la[-1]:
-            ia, wa = len(la) - 2, 1.0
+        k, dk = interpolate(self.log_aspect, self.s, self.kappa, float(s), t, float(share_x))
+        return float(k), float(dk)
+
+
+def interpolate(log_aspect: FloatArray, s_nodes: FloatArray, kappa: FloatArray, s: float,
+                t: float, share_x: float) -> tuple[float, float]:
+    """Return ``(kappa, d kappa / d s)`` from the table at ``s``, ``t = log(a/b)``, ``share_x``.
+
+    Linear in ``s`` and in ``t`` (the nearest edge outside the nodes), the
+    two directions weighed by ``share_x`` and ``1 - share_x``; beyond the
+    last node in ``s``, ``kappa - 1`` as ``1/s^2``.  Plain arithmetic on
+    the arrays: compiled by :mod:`~fastsim_ros.contact.kernels` as it is (one
+    formula for both paths).
+    """
+    na = log_aspect.shape[0]
+    if not t > log_aspect[0]:
+        ia, wa = 0, 0.0
+    elif not t < log_aspect[na - 1]:
+        ia, wa = na - 2, 1.0
+    else:
+        ia, hi = 0, na - 1  # bisection: log_aspect[ia] <= t < log_aspect[ia + 1]
+        while hi - ia > 1:
+            mid = (ia + hi) // 2
+            if log_aspect[mid] <= t:
+                ia = mid
+            else:
+                hi = mid
+        wa = (t - log_aspect[ia]) / (log_aspect[ia + 1] - log_aspect[ia])
+    ns = s_nodes.shape[0]
+    last = s_nodes[ns - 1]
+    k = 0.0
+    dk = 0.0
+    if s >= last:
+        # full slip: FastSim's adhesion band shrinks as 1/s, its force's deficit as 1/s^2
+        for d in range(2):
+            wd = share_x if d == 0 else 1.0 - share_x
+            k += wd * ((1.0 - wa) * kappa[d, ia, ns - 1] + wa * kappa[d, ia + 1, ns - 1])
+        tail = (last / s) ** 2
+        return 1.0 + (k - 1.0) * tail, -2.0 * (k - 1.0) * tail / s
+    i, hi = 0, ns - 1  # bisection: s_nodes[i] <= s < s_nodes[i + 1]
+    while hi - i > 1:
+        mid = (i + hi) // 2
+        if s_nodes[mid] <= s:
+            i = mid
         else:
-            ia = int(np.searchsorted(la, t)) - 1
-            wa = (t - la[ia]) / (la[ia + 1] - la[ia])
-        kap = self.kappa
-        sn = self.s
-        last = sn[-1]
-        if s >= last:
-            # full slip: FastSim's adhesion band shrinks as 1/s, its force's deficit as 1/s^2
-            tail = (last / s) ** 2 if s > 0.0 else 1.0
-            k = 0.0
-            for d, wd in ((0, share_x), (1, 1.0 - share_x)):
-                k += wd * ((1.0 - wa) * kap[d, ia, -1] + wa * kap[d, ia + 1, -1])
-            return 1.0 + (k - 1.0) * tail, -2.0 * (k - 1.0) * tail / s
-        i = max(int(np.searchsorted(sn, s, side="right")) - 1, 0)
-        h = sn[i + 1] - sn[i]
-        u = (s - sn[i]) / h
-        k = dk = 0.0
-        for d, wd in ((0, share_x), (1, 1.0 - share_x)):
-            k0 = (1.0 - wa) * kap[d, ia, i] + wa * kap[d, ia + 1, i]
-            k1 = (1.0 - wa) * kap[d, ia, i + 1] + wa * kap[d, ia + 1, i + 1]
-            k += wd * (k0 + u * (k1 - k0))
-            dk += wd * (k1 - k0) / h
-        return k, dk
+            hi = mid
+    h = s_nodes[i + 1] - s_nodes[i]
+    u = (s - s_nodes[i]) / h
+    for d in range(2):
+        wd = share_x if d == 0 else 1.0 - share_x
+        k0 = (1.0 - wa) * kappa[d, ia, i] + wa * kappa[d, ia + 1, i]
+        k1 = (1.0 - wa) * kappa[d, ia, i + 1] + wa * kappa[d, ia + 1, i + 1]
+        k += wd * (k0 + u * (k1 - k0))
+        dk += wd * (k1 - k0) / h
+    return k, dk
 
 
 def _read() -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:

@@ -63,7 +63,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipse
 from fastsim_ros.contact.compiled import _law as _kernel_law
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, friction_law
-from fastsim_ros.contact.knee import knee_factors, linear_force
+from fastsim_ros.contact.knee import knee_factors
 
 FloatArray = NDArray[np.float64]
 Solver = MaeSolver | EquivalentEllipseSolver
@@ -283,36 +283,30 @@ class CreepModel:
         its centre, as the solver takes the patch (reversed when ``V <
         0``: the spin's share of ``F_lin`` turns with the rolling direction).
         """
+        return self.knee_factor_of(sample.pressure, sample.x0, sample.y0, sample.dx,
+                                   sample.dy, sample.xi, sample.eta, sample.phi, sample.speed,
+                                   mu_s)
+
+    def knee_factor_of(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float,
+                       xi: float, eta: float, phi: float, speed: float,
+                       mu_s: float) -> tuple[float, float]:
+        """:meth:`knee_factor` of a sample's fields (the node's cycle: no sample made)."""
         knee = self._knee  # type: ignore[attr-defined]
         if knee is None:
             return 1.0, 0.0
-        p, x0, y0, phi = sample.pressure, sample.x0, sample.y0, sample.phi
-        if sample.speed < 0.0:  # as _solve
+        if speed < 0.0:  # as _solve
             p = p[::-1, ::-1]
-            x0 = -(x0 + (p.shape[1] - 1) * sample.dx)
-            y0 = -(y0 + (p.shape[0] - 1) * sample.dy)
+            x0 = -(x0 + (p.shape[1] - 1) * dx)
+            y0 = -(y0 + (p.shape[0] - 1) * dy)
             phi = -phi
         if not p.flags.c_contiguous:
             p = np.ascontiguousarray(p)
-        ell = self._ell  # type: ignore[attr-defined]
         s = self.solver
-        status, _ = kernels.equivalent_prepare(p, float(x0), float(y0), float(sample.dx),
-                                               float(sample.dy), s.shear_modulus, s._knots,
-                                               s._polys, ell)
-        load = ell[kernels.ELL_LOAD]
-        if status != kernels.OK or not load > 0.0:
-            return 1.0, 0.0
-        # creepages at the ellipse's centre (spin about the grid's origin, as the kernels)
-        x_c, y_c = ell[kernels.ELL_XC], ell[kernels.ELL_YC]
-        fx, fy = linear_force(ell[kernels.ELL_A], ell[kernels.ELL_B], ell[kernels.ELL_L1],
-                              ell[kernels.ELL_L2], ell[kernels.ELL_L3],
-                              sample.xi - phi * y_c, sample.eta + phi * x_c, phi)
-        f2 = fx * fx + fy * fy
-        if not f2 > 0.0:
-            return 1.0, 0.0
-        sn = math.sqrt(f2) / (mu_s * load)
-        kappa, slope = knee.factor(sn, ell[kernels.ELL_A] / ell[kernels.ELL_B], fx * fx / f2)
-        return kappa, -slope * sn / mu_s
+        return kernels.knee_factor(  # type: ignore[no-any-return]
+            p, float(x0), float(y0), float(dx), float(dy), float(xi), float(eta), float(phi),
+            float(mu_s), s.shear_modulus, s._knots, s._polys,
+            self._ell,  # type: ignore[attr-defined]
+            knee.log_aspect, knee.s, knee.kappa)
 
     def contact_forces(self, sample: ContactSample, mu_s: float) -> tuple[float, float]:
         """Return the creep forces ``(Fx, Fy)`` (N, contact frame) of one sample at ``mu_s``."""
