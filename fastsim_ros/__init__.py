@@ -36,7 +36,8 @@ def _numba_cache_dir() -> str:
 #: directory is keyed on their contents and a changed formula can never load a
 #: stale kernel (``test_pipeline_kernels`` checks the list against the sources:
 #: every module with compiled functions, and what they import, is here)
-_KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/transient.py",
+_KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/knee.py",
+                   "contact/transient.py",
                    "pipeline_kernels.py", "replay/kernels.py",
                    "../msg_adapters/patch_kernels.py", "../msg_adapters/patch.py")
 
