@@ -34,6 +34,10 @@ FloatArray = NDArray[np.float64]
 MU_RANGE = (1e-3, 5.0)
 LIMIT_RATIO_RANGE = (1e-3, 1.0)
 DECAY_RANGE = (0.0, 1e4)
+#: mu_s is not determined by samples whose largest sensitivity ``r = |dF/dmu_s| / N`` is
+#: below this (the node's default ``friction_min_sensitivity``: the linear range, where the
+#: exact theory's force, and so the knee-corrected model's, depends on mu only as s^2)
+MIN_SENSITIVITY = 0.02
 
 
 def _decay(limit_ratio: float, c: float) -> float:
@@ -72,13 +76,16 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
                  measured: ArrayLike,
                  *, law: str = "constant", speed: float | None = None, bound: str = "given",
                  mu0: float = 0.3, limit_ratio0: float = 0.5,
-                 decay0: float = 1.0) -> FrictionFit:
+                 decay0: float = 1.0, knee: bool = False) -> FrictionFit:
     """Fit ``law`` to ``measured`` (``(n,)`` Fx or ``(n, 2)`` Fx, Fy in N) at ``creepages``.
 
     ``creepages``: ``(n, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about the
     area's origin; ``speed``: the rolling speed ``|V|`` (m/s), required by
     the exponential law; ``mu0``, ``limit_ratio0``, ``decay0`` (s/m): the
-    starting point.
+    starting point.  ``knee``: a fast solver's forces times the knee factor
+    at the fitted ``mu_s`` (:meth:`~fastsim_ros.estimation.model.CreepModel.knee_factor`,
+    the node's estimator's model; not with the exact solver or the
+    parabolic bound).
     """
     from scipy.optimize import least_squares
 
@@ -101,6 +108,13 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
         raise InvalidInputError(f"{n} samples cannot determine {p} parameter(s): give more")
     load = float(area.load)
     evaluations = [0]
+    corrected = None
+    if knee and not isinstance(solver, ExactSolver):
+        from fastsim_ros.estimation.model import CreepModel
+        corrected = CreepModel(solver, bound=bound)
+        if not corrected.knee_corrected:
+            corrected = None
+    p_area = np.ascontiguousarray(area.pressure, dtype=np.float64)
 
     def forces(theta: FloatArray) -> FloatArray:
         evaluations[0] += 1
@@ -112,6 +126,11 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
         out = solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, cr,
                                  bound=bound, friction=f,  # type: ignore[arg-type]
                                  speed=None if speed is None else abs(speed))
+        if corrected is not None:
+            for row, (xi, eta, phi) in zip(out, cr):
+                row[:2] *= corrected.knee_factor_of(p_area, area.x0, area.y0, area.dx,
+                                                    area.dy, xi, eta, phi, 1.0,
+                                                    float(theta[0]))[0]
         return out[:, :z.shape[1]]
 
     def residuals(theta: FloatArray) -> FloatArray:
@@ -144,6 +163,9 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
     jac = np.asarray(sol.jac, dtype=np.float64)
     norms = np.linalg.norm(jac, axis=0) if np.all(np.isfinite(jac)) else np.zeros(p)
     seen = np.flatnonzero(norms > 1e-12 * max(float(norms.max()), 1e-300))
+    # the residuals are forces over N: mu_s's column holds each sample's sensitivity r
+    if float(np.max(np.abs(jac[:, 0]), initial=0.0)) < MIN_SENSITIVITY:
+        seen = seen[seen != 0]
     if seen.size:
         jtj = jac[:, seen].T @ jac[:, seen]
         if np.linalg.cond(jtj) < 1e14:
