@@ -141,13 +141,9 @@ def interpolate(log_aspect: FloatArray, s_nodes: FloatArray, kappa: FloatArray, 
     elif not t < log_aspect[na - 1]:
         ia, wa = na - 2, 1.0
     else:
-        ia, hi = 0, na - 1  # bisection: log_aspect[ia] <= t < log_aspect[ia + 1]
-        while hi - ia > 1:
-            mid = (ia + hi) // 2
-            if log_aspect[mid] <= t:
-                ia = mid
-            else:
-                hi = mid
+        ia = 0  # log_aspect[ia] <= t < log_aspect[ia + 1] (nine nodes: a scan)
+        while log_aspect[ia + 1] <= t:
+            ia += 1
         wa = (t - log_aspect[ia]) / (log_aspect[ia + 1] - log_aspect[ia])
     ns = s_nodes.shape[0]
     last = s_nodes[ns - 1]
@@ -160,13 +156,9 @@ def interpolate(log_aspect: FloatArray, s_nodes: FloatArray, kappa: FloatArray, 
             k += wd * ((1.0 - wa) * kappa[d, ia, ns - 1] + wa * kappa[d, ia + 1, ns - 1])
         tail = (last / s) ** 2
         return 1.0 + (k - 1.0) * tail, -2.0 * (k - 1.0) * tail / s
-    i, hi = 0, ns - 1  # bisection: s_nodes[i] <= s < s_nodes[i + 1]
-    while hi - i > 1:
-        mid = (i + hi) // 2
-        if s_nodes[mid] <= s:
-            i = mid
-        else:
-            hi = mid
+    i = 0  # s_nodes[i] <= s < s_nodes[i + 1] (s < last here: a scan of a few dozen nodes)
+    while s_nodes[i + 1] <= s:
+        i += 1
     h = s_nodes[i + 1] - s_nodes[i]
     u = (s - s_nodes[i]) / h
     for d in range(2):
