@@ -667,6 +667,8 @@ class Pipeline:
                         model_error(mu, adhesion, share),
                         lambda m: model.predict_with_error(samples(), m, share)[1])
                 else:  # a slope the march did not give, or an estimate off the published mu
+                    if model.knee_corrected:  # the published forces times their factors
+                        predicted = self._knee_corrected(model, solved, None, mu)[0]
                     step = ekf.update((measured[0] - normal_x,),
                                       lambda m: model.predict(samples(), m), load, (predicted,),
                                       model_error(mu, adhesion, share),
@@ -692,22 +694,26 @@ class Pipeline:
     @staticmethod
     def _knee_corrected(model: CreepModel,
                         solved: list[tuple[ContactPatch, Creepage, ContactForces]],
-                        slopes: list[tuple[float, float]], mu: float) -> tuple[float, float]:
+                        slopes: list[tuple[float, float]] | None,
+                        mu: float) -> tuple[float, float]:
         """Return the model's value and slope at ``mu`` from the published solves and marches.
 
         Per contact ``kappa F`` and ``kappa dF/dmu_s + F dkappa/dmu_s``
         (:meth:`CreepModel.knee_factor`), projected on the wheelset's ``x``:
         :meth:`CreepModel.predict` and :meth:`CreepModel.slope` without a
-        solve (the published forces and the march's slope are theirs).
+        solve (the published forces and the march's slope are theirs);
+        ``slopes`` None: the value alone (slope 0).
         """
         predicted = slope = 0.0
-        for (p, c, f), (dfx, dfy) in zip(solved, slopes):
+        for k, (p, c, f) in enumerate(solved):
             kappa, dkappa = model.knee_factor_of(p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi,
                                                  c.eta, c.phi, c.speed, mu)
             ex, ey, _ = p.frame.axes
             force = ex[0] * f.fx + ey[0] * f.fy
             predicted += kappa * force
-            slope += kappa * (ex[0] * dfx + ey[0] * dfy) + dkappa * force
+            if slopes is not None:
+                dfx, dfy = slopes[k]
+                slope += kappa * (ex[0] * dfx + ey[0] * dfy) + dkappa * force
         return predicted, slope
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:

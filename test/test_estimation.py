@@ -384,8 +384,14 @@ def wrench_msg(force, stamp_ns, frame_id="wheelset"):
     return w
 
 
-def test_pipeline_estimates_mu_and_solves_with_it(hertz):
-    """A rig cycle: twist, measured wrench (the truth's wheelset force + noise), patch."""
+@pytest.mark.parametrize("method", ["mae_calibrated", "fastsim_ellipse"])
+def test_pipeline_estimates_mu_and_solves_with_it(hertz, method):
+    """A rig cycle: twist, measured wrench (the truth's wheelset force + noise), patch.
+
+    ``fastsim_ellipse``: the slope by a forward difference of the model and
+    the model at the prior from the published forces, both times the knee
+    factor (the prior's once without it: an innovation off by the factor).
+    """
     from rclpy.serialization import deserialize_message
     from geometry_msgs.msg import Vector3Stamped
     from fastsim_ros.pipeline import (FRICTION_ESTIMATE_TOPIC, MEASURED_WRENCH_TOPIC, Pipeline,
@@ -393,7 +399,8 @@ def test_pipeline_estimates_mu_and_solves_with_it(hertz):
     from ros_messages import cdr, cloud_msg, rolling_twist
 
     def make(**values):
-        return Pipeline(PipelineConfig.from_values(dict(contacts=["left"], **values)))
+        return Pipeline(PipelineConfig.from_values(dict(contacts=["left"], method=method,
+                                                        **values)))
 
     truth = make(friction_coefficient=0.35)
     pipe = make(friction_coefficient=0.2, friction_estimation="on",
@@ -436,14 +443,23 @@ def test_pipeline_estimates_mu_and_solves_with_it(hertz):
         assert (msg.vector.x, msg.vector.y) == (out.friction.mu, out.friction.sigma)
         assert msg.header.frame_id == "wheelset"
     last = estimates[-1]
-    assert abs(last.mu - 0.35) < 0.01 * 0.35 and last.sigma < 0.01
+    # the load cell's noise leaves sigma near 2% of mu after 60 cycles: the band covers the
+    # truth; the march's slope (mae_calibrated) lands within 1% on this noise, the forward
+    # difference's (fastsim_ellipse, another gain) 1.0% (before its prior carried the knee
+    # factor: 8.6% low)
+    assert abs(last.mu - 0.35) <= 2.0 * last.sigma and last.sigma < 0.01
+    assert abs(last.mu - 0.35) < (0.01 if method == "mae_calibrated" else 0.015) * 0.35
     assert 0.0 < last.utilisation <= 1.0
     # the next cycle's wrench uses the estimate: the compiled path's arguments are those a
     # pipeline configured with it builds
     assert pipe._mu == last.mu
-    fresh = Pipeline(PipelineConfig.from_values(dict(contacts=["left"],
+    fresh = Pipeline(PipelineConfig.from_values(dict(contacts=["left"], method=method,
                                                      friction_coefficient=last.mu)))
-    assert all(a is b or np.array_equal(a, b) for a, b in zip(pipe._compiled, fresh._compiled))
+    if method == "fastsim_ellipse":  # no compiled path: the solver's call takes mu each time
+        assert pipe._compiled is None and fresh._compiled is None
+    else:
+        assert all(a is b or np.array_equal(a, b)
+                   for a, b in zip(pipe._compiled, fresh._compiled))
     values = {v.key: v.value for v in pipe.diagnostics(t0).status[0].values}
     assert float(values["friction_estimation/mu"]) == pytest.approx(last.mu, rel=1e-5)
     assert values["friction_estimation/updated"] == "60"
