@@ -13,9 +13,16 @@ method is Kalker's FastSim), and their ratio
     kappa = |F_exact| / |F_fastsim|   (1 at s = 0).
 
 Grids: ``CELLS`` x ``CELLS``; the exact force is also solved on
-``COARSE`` x ``COARSE`` cells and the change of kappa (``kappa_err``) is its
-discretisation's error estimate (the fast force is the same on both grids
-to 0.1%: FastSim's curve in ``s`` does not depend on the grid).  Writes
+``COARSE`` x ``COARSE`` cells and the change of kappa is written
+(``kappa_err``; the fast force is the same on both grids to 0.1%: FastSim's
+curve in ``s`` does not depend on the grid).  That change is not the
+table's error: the exact force converges slowly and not monotonically in
+the cell, and where 40 and 60 cells agree finer grids still move it
+(measured at nu 0.25, a/b 1, pure xi: kappa at s = 1, 1.5, 2 is 0.9925,
+1.0443, 1.0613 on 60 cells, 0.9886, 1.0411, 1.0599 on 100 and 0.9868,
+1.0398, 1.0592 on 158, where ``kappa_err`` says 0.00002 at s = 1.5): the
+table is about half a point of kappa above the converged one at the knee
+(a 130-cell table, 4 s a solve, would take two hours).  Writes
 ``fastsim_ros/data/fastsim_knee_factors.csv`` (provenance in its header).
 Usage: ``python scripts/make_knee_table.py``: about five minutes on one core.
 """
@@ -97,7 +104,8 @@ def main() -> None:
         f"mu {MU}, {CELLS} x {CELLS} cells; pure xi or pure eta at s = |F_lin| / (mu N) "
         "(F_lin: fastsim_ros/contact/knee.py linear_force on the equivalent ellipse);",
         "# kappa = |F_exact| / |F_fastsim| at the same creepage; kappa_err: its change with "
-        f"the exact force on {COARSE} x {COARSE} cells (largest {worst:.4f}).",
+        f"the exact force on {COARSE} x {COARSE} cells (largest {worst:.4f}), not its error: "
+        "finer grids lower kappa at the knee by about 0.005 more (scripts/make_knee_table.py).",
         "nu,a_over_b,direction,s,kappa,kappa_err"]
     lines = header + [f"{nu:g},{aspect:g},{d},{s:g},{kf:.5f},{err:.5f}"
                       for nu, aspect, d, s, kf, err in rows]

@@ -27,12 +27,13 @@ about a point of ``mu N`` at the knee.  So the *knee factor*
 is tabulated with the exact solver (``fastsim_ros/data/fastsim_knee_factors.csv``,
 made by ``scripts/make_knee_table.py``, provenance in its header) for pure
 longitudinal and pure lateral creepage, and :meth:`KneeFactors.factor`
-interpolates it: linearly in ``s``, linearly in ``log(a/b)`` (the nearest
-edge outside the nodes), between the two directions by the share
+interpolates it: a cubic Hermite in ``s`` (its slope continuous), linearly
+in ``log(a/b)`` (the nearest edge outside the nodes), between the two
+directions by the share
 ``w = F_lin,x^2 / |F_lin|^2`` of the linear force along ``x``, in ``nu`` by
 the quadratic through the three tabulated values.  Beyond the last node in
-``s`` (full slip) ``kappa - 1`` falls as ``1/s^2``, as FastSim's remaining
-adhesion band does; ``kappa(0) = 1``.
+``s`` (full slip) ``kappa - 1`` falls as ``1/s^3``, as the deficit of
+FastSim's remaining adhesion band does; ``kappa(0) = 1``.
 
 Assumptions stated: the factor of a Hertzian ellipse serves any patch (on
 MAE's patches it is taken at the equivalent ellipse's ``a/b``); Coulomb
@@ -135,11 +136,14 @@ def interpolate(log_aspect: FloatArray, s_nodes: FloatArray, kappa: FloatArray, 
                 t: float, share_x: float) -> tuple[float, float]:
     """Return ``(kappa, d kappa / d s)`` from the table at ``s``, ``t = log(a/b)``, ``share_x``.
 
-    Linear in ``s`` and in ``t`` (the nearest edge outside the nodes), the
-    two directions weighed by ``share_x`` and ``1 - share_x``; beyond the
-    last node in ``s``, ``kappa - 1`` as ``1/s^2``.  Plain arithmetic on
-    the arrays: compiled by :mod:`~fastsim_ros.contact.kernels` as it is (one
-    formula for both paths).
+    Linear in ``t`` (the nearest edge outside the nodes), the two directions
+    weighed by ``share_x`` and ``1 - share_x``; in ``s`` a cubic Hermite
+    between the nodes with the three-point slopes (so ``d kappa / d s``,
+    the filter's slope, has no jump at a node), the last node's slope the
+    tail's; beyond the last node ``kappa - 1`` falls as ``1/s^3`` (FastSim's
+    leading-edge adhesion band is ``d ~ 1/s^2`` long and holds a deficit ``~
+    d^1.5``).  Plain arithmetic on the arrays: compiled by
+    :mod:`~fastsim_ros.contact.kernels` as it is (one formula for both paths).
     """
     na = log_aspect.shape[0]
     if not t > log_aspect[0]:
@@ -153,26 +157,51 @@ def interpolate(log_aspect: FloatArray, s_nodes: FloatArray, kappa: FloatArray, 
         wa = (t - log_aspect[ia]) / (log_aspect[ia + 1] - log_aspect[ia])
     ns = s_nodes.shape[0]
     last = s_nodes[ns - 1]
-    k = 0.0
-    dk = 0.0
-    if s >= last:
-        # full slip: FastSim's adhesion band shrinks as 1/s, its force's deficit as 1/s^2
+    i = ns - 1
+    if s < last:
+        i = 0  # s_nodes[i] <= s < s_nodes[i + 1] (a scan of a few dozen nodes)
+        while s_nodes[i + 1] <= s:
+            i += 1
+    # the table's values (both directions and a/b weighed) at nodes i - 1 .. i + 2
+    v0 = v1 = v2 = v3 = 0.0
+    for q in range(4):
+        j = min(max(i - 1 + q, 0), ns - 1)
+        v = 0.0
         for d in range(2):
             wd = share_x if d == 0 else 1.0 - share_x
-            k += wd * ((1.0 - wa) * kappa[d, ia, ns - 1] + wa * kappa[d, ia + 1, ns - 1])
-        tail = (last / s) ** 2
-        return 1.0 + (k - 1.0) * tail, -2.0 * (k - 1.0) * tail / s
-    i = 0  # s_nodes[i] <= s < s_nodes[i + 1] (s < last here: a scan of a few dozen nodes)
-    while s_nodes[i + 1] <= s:
-        i += 1
+            v += wd * ((1.0 - wa) * kappa[d, ia, j] + wa * kappa[d, ia + 1, j])
+        if q == 0:
+            v0 = v
+        elif q == 1:
+            v1 = v
+        elif q == 2:
+            v2 = v
+        else:
+            v3 = v
+    if i == ns - 1:
+        tail = (last / s) ** 3
+        return 1.0 + (v1 - 1.0) * tail, -3.0 * (v1 - 1.0) * tail / s
     h = s_nodes[i + 1] - s_nodes[i]
+    secant = (v2 - v1) / h
+    # the slopes at the segment's ends: three-point (non-uniform spacing), one-sided at s = 0,
+    # the tail's at the last node
+    if i == 0:
+        m1 = secant
+    else:
+        hp = s_nodes[i] - s_nodes[i - 1]
+        m1 = (hp * secant + h * (v1 - v0) / hp) / (hp + h)
+    if i + 1 == ns - 1:
+        m2 = -3.0 * (v2 - 1.0) / last
+    else:
+        hn = s_nodes[i + 2] - s_nodes[i + 1]
+        m2 = (hn * secant + h * (v3 - v2) / hn) / (h + hn)
     u = (s - s_nodes[i]) / h
-    for d in range(2):
-        wd = share_x if d == 0 else 1.0 - share_x
-        k0 = (1.0 - wa) * kappa[d, ia, i] + wa * kappa[d, ia + 1, i]
-        k1 = (1.0 - wa) * kappa[d, ia, i + 1] + wa * kappa[d, ia + 1, i + 1]
-        k += wd * (k0 + u * (k1 - k0))
-        dk += wd * (k1 - k0) / h
+    u2 = u * u
+    u3 = u2 * u
+    k = ((2.0 * u3 - 3.0 * u2 + 1.0) * v1 + (u3 - 2.0 * u2 + u) * h * m1
+         + (3.0 * u2 - 2.0 * u3) * v2 + (u3 - u2) * h * m2)
+    dk = ((6.0 * u2 - 6.0 * u) * (v1 - v2) / h + (3.0 * u2 - 4.0 * u + 1.0) * m1
+          + (3.0 * u2 - 2.0 * u) * m2)
     return k, dk
 
 

@@ -294,6 +294,7 @@ class CreepModel:
         knee = self._knee  # type: ignore[attr-defined]
         if knee is None:
             return 1.0, 0.0
+        _positive_mu(mu_s)  # s = |F_lin| / (mu_s N): a mu the laws refuse has none
         if speed < 0.0:  # as _solve
             p = p[::-1, ::-1]
             x0 = -(x0 + (p.shape[1] - 1) * dx)
