@@ -35,6 +35,7 @@ import numpy as np
 from fastsim_ros import params as parameters
 from fastsim_ros import pipeline_kernels as fast
 from fastsim_ros.contact import compiled
+from fastsim_ros.contact.area import turned_grid
 from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
@@ -980,9 +981,7 @@ class Pipeline:
         xi, eta, phi = creep.xi, creep.eta, creep.phi
         reverse = creep.speed < 0.0
         if reverse:  # turn the patch by 180 degrees about z: the leading edge at +x
-            p = p[::-1, ::-1]
-            x0 = -(x0 + (p.shape[1] - 1) * dx)
-            y0 = -(y0 + (p.shape[0] - 1) * dy)
+            p, x0, y0 = turned_grid(p, x0, y0, dx, dy)
             phi = -phi
         start = time.perf_counter()
         try:

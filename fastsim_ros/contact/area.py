@@ -132,6 +132,20 @@ def _cell_centres(lo: float, hi: float, n: int) -> FloatArray:
     return lo + h * (np.arange(n, dtype=np.float64) + 0.5)
 
 
+def turned_grid(pressure: FloatArray, x0: float, y0: float, dx: float,
+                dy: float) -> tuple[FloatArray, float, float]:
+    """Return ``(pressure, x0, y0)`` of the grid turned by 180 degrees about ``z``.
+
+    Reverse running (INTERFACE.md "Creepages", rolling speed ``V < 0``) is
+    solved on the patch turned so that its leading edge is at ``+x``: cell
+    ``[j, i]`` goes to ``[ny - 1 - j, nx - 1 - i]`` (a view, not a copy) and
+    cell ``[0, 0]``'s centre to minus the old last cell's.  The spin changes
+    sign with it, the forces are turned back by the caller.
+    """
+    p = pressure[::-1, ::-1]
+    return (p, -(x0 + (p.shape[1] - 1) * dx), -(y0 + (p.shape[0] - 1) * dy))
+
+
 def ellipse(a: float, b: float, *, nx: int, ny: int | None = None,
             load: float | None = None, pressure: str = "hertz") -> GridArea:
     """Make an ellipse with semi-axes ``a`` (along x) and ``b`` (m) on ``nx`` x ``ny`` cells.

@@ -57,6 +57,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from fastsim_ros.contact import kernels
+from fastsim_ros.contact.area import turned_grid
 from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipseSolver,
                                           MaeSolver, _raise)
@@ -291,15 +292,21 @@ class CreepModel:
                        xi: float, eta: float, phi: float, speed: float,
                        mu_s: float) -> tuple[float, float]:
         """:meth:`knee_factor` of a sample's fields (the node's cycle: no sample made)."""
+        if self._knee is None:  # type: ignore[attr-defined]
+            return 1.0, 0.0
+        if speed < 0.0:  # as _solve
+            p, x0, y0 = turned_grid(p, x0, y0, dx, dy)
+            phi = -phi
+        return self._knee_as_solved(p, x0, y0, dx, dy, xi, eta, phi, mu_s)
+
+    def _knee_as_solved(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float,
+                        xi: float, eta: float, phi: float,
+                        mu_s: float) -> tuple[float, float]:
+        """:meth:`knee_factor_of` on the patch as the solver takes it (turned if ``V < 0``)."""
         knee = self._knee  # type: ignore[attr-defined]
         if knee is None:
             return 1.0, 0.0
         _positive_mu(mu_s)  # s = |F_lin| / (mu_s N): a mu the laws refuse has none
-        if speed < 0.0:  # as _solve
-            p = p[::-1, ::-1]
-            x0 = -(x0 + (p.shape[1] - 1) * dx)
-            y0 = -(y0 + (p.shape[0] - 1) * dy)
-            phi = -phi
         if not p.flags.c_contiguous:
             p = np.ascontiguousarray(p)
         s = self.solver
@@ -325,9 +332,7 @@ class CreepModel:
         p, x0, y0, phi = sample.pressure, sample.x0, sample.y0, sample.phi
         reverse = sample.speed < 0.0
         if reverse:  # as Pipeline._solve: the leading edge at +x
-            p = p[::-1, ::-1]
-            x0 = -(x0 + (p.shape[1] - 1) * sample.dx)
-            y0 = -(y0 + (p.shape[0] - 1) * sample.dy)
+            p, x0, y0 = turned_grid(p, x0, y0, sample.dx, sample.dy)
             phi = -phi
         kernel = self._kernel  # type: ignore[attr-defined]
         if kernel is not None:  # the kernel solve_arrays calls, without its wrapping
@@ -335,10 +340,12 @@ class CreepModel:
                 kernel_law = self._kernel_law(self.friction(mu_s) if law is None else law)
             fx, fy, k, dfx, dfy = kernel(p, x0, y0, sample.dx, sample.dy, sample.xi,
                                          sample.eta, phi, kernel_law, abs(sample.speed), slope)
-            kappa, dkappa = self.knee_factor(sample, mu_s)
+            # the factor of the patch as turned above, not turned again
+            kappa, dkappa = self._knee_as_solved(p, x0, y0, sample.dx, sample.dy, sample.xi,
+                                                 sample.eta, phi, mu_s)
             if slope:  # d(kappa F)/dmu_s = kappa dF/dmu_s + F dkappa/dmu_s
                 fx, fy = kappa * dfx + dkappa * fx, kappa * dfy + dkappa * fy
-            elif kappa != 1.0:
+            else:
                 fx, fy = kappa * fx, kappa * fy
         else:
             law = self.friction(mu_s) if law is None else law
@@ -346,7 +353,8 @@ class CreepModel:
                                          sample.eta, phi,
                                          bound=self.bound,  # type: ignore[arg-type]
                                          friction=law, speed=abs(sample.speed))
-            kappa = self.knee_factor(sample, mu_s)[0]
+            kappa = self._knee_as_solved(p, x0, y0, sample.dx, sample.dy, sample.xi,
+                                         sample.eta, phi, mu_s)[0]
             fx, fy, k = kappa * f.fx, kappa * f.fy, f.slip_fraction
         return (-fx, -fy, k) if reverse else (fx, fy, k)
 

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 from rclpy.serialization import serialize_message
 
+from fastsim_ros.contact.area import turned_grid
 from fastsim_ros.params import SPECS, ParameterError
 from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig
 from fastsim_ros.profile_pipeline import AnyPipeline, make_pipeline
@@ -568,9 +569,7 @@ def _solve_input(outcome: Any) -> tuple[Any, ...]:
     patch, creep = outcome.patch, outcome.creepage
     p, x0, y0, phi = patch.pressure, patch.x0, patch.y0, creep.phi
     if creep.speed < 0.0:  # turned by 180 degrees, as the pipeline solves it
-        p = p[::-1, ::-1]
-        x0 = -(x0 + (p.shape[1] - 1) * patch.dx)
-        y0 = -(y0 + (p.shape[0] - 1) * patch.dy)
+        p, x0, y0 = turned_grid(p, x0, y0, patch.dx, patch.dy)
         phi = -phi
     return (p[None], np.array([[x0, y0, patch.dx, patch.dy]]),
             np.array([[creep.xi, creep.eta, phi]]), np.ones(1, dtype=np.bool_))
