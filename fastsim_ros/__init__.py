@@ -13,6 +13,7 @@ checkout and the install tree keep separate entries.
 
 import hashlib
 import os
+import sys
 import tempfile
 
 
@@ -68,3 +69,9 @@ if "NUMBA_CACHE_DIR" not in os.environ or (
         _cache = os.path.join(_cache, _sources_digest())
         os.makedirs(_cache, exist_ok=True)
         os.environ["NUMBA_CACHE_DIR"] = os.environ[_CHOSEN] = _cache
+        if "numba.core.config" in sys.modules:
+            # numba read its settings when it was imported (a script that imports numba
+            # before this package): without a reload its cache stayed in __pycache__,
+            # keyed on each file's own time stamp, and a kernel compiled in from another
+            # file (rolling_sweep into transient.py's solves) loaded stale machine code
+            sys.modules["numba.core.config"].reload_config()

@@ -349,3 +349,33 @@ def test_the_kernel_cache_is_keyed_on_every_compiled_source():
                     assert module.resolve() in keyed, (f, module)
                 elif name.isupper():  # a constant, frozen into the kernels
                     assert base.with_suffix(".py").resolve() in keyed, (f, pkg, name)
+
+
+def test_the_keyed_cache_holds_when_numba_was_imported_first(tmp_path):
+    """A script that imports numba before the package still caches under the sources' key.
+
+    numba reads ``NUMBA_CACHE_DIR`` when it is imported: a benchmark that
+    imported numba first kept numba's default, ``__pycache__`` keyed on each
+    file's own time stamp, and ``transient.py``'s solves loaded machine code
+    compiled against an older ``kernels.rolling_sweep`` (a doubled force in
+    ``rolling_sweep`` left ``mae_rolling_solve``'s answer as it was).
+    """
+    import os
+    import subprocess
+    import sys
+
+    probe = ("import os, numba, numba.core.config as c, fastsim_ros; "
+             "from fastsim_ros.contact import transient; "
+             "print(c.CACHE_DIR); print(os.environ['NUMBA_CACHE_DIR']); "
+             "print(transient.mae_rolling_solve._cache._cache_path)")
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("NUMBA_CACHE_DIR", "FASTSIM_ROS_NUMBA_CACHE_DIR")}
+    env["XDG_CACHE_HOME"] = str(tmp_path)
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(__file__).resolve().parents[1]),
+                                         env.get("PYTHONPATH", "")])
+    done = subprocess.run([sys.executable, "-c", probe], env=env, cwd=str(tmp_path),
+                          capture_output=True, text=True, timeout=120, check=True)
+    numba_dir, chosen, cache_path = done.stdout.split()
+    assert chosen.startswith(str(tmp_path))
+    assert numba_dir == chosen
+    assert cache_path.startswith(chosen)
