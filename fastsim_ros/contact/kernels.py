@@ -404,29 +404,29 @@ def project(t_x, t_y, p_x, p_y, g, lev, law, prm, speed, step, vs, rigid, w_x, g
 
 
 @njit(cache=True, error_model="numpy", inline="always")
-def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, dx, rolled, nsub, x_rel, rate_x,
-               rate_y0, rate_yx, w_x, g_x, g_y, eta, phi, l1, l2, law, prm, speed, rigid):
+def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, rolled, nsub, s, v_sub, ahead,
+               per, x_rel, d_x, d_y, d_yx, w_x, g_x, g_y, eta, phi, l1, l2, law, prm, speed,
+               rigid):
     """March a particle of strip ``j`` from ``x + rolled`` to one step before cell ``i``.
 
     :func:`rolling_sweep`'s path of a transient step: ``nsub - 1`` steps of
     ``rolled / nsub`` (m), each projected with :func:`project` on the bound
     of the cell the particle reaches (zero traction where it is off the
     contact); ``(t_x, t_y)`` (Pa) and ``lev`` (its friction ratio) where it
-    starts; the strip's rates as :func:`strip_rates`, ``g_x``, ``g_y`` the
-    far field's shift per step (m).  Return the traction and ratio before
-    the last step (the cell's own, :func:`rolling_sweep`'s).  Inlined: as a
-    call per cell it cost a 30 x 30 step of two cells 26.8 -> 34.4 us (the
-    paper's MAE) and 34.3 -> 46.1 us (the calibrated one), same run; the
-    steady march never enters it.
+    starts; ``s = rolled / nsub`` (m), ``v_sub = speed / s`` (1/s), the
+    cell reached after step ``m`` is ``i + int(ahead - (m + 1) per)``
+    (``ahead = rolled / dx + 0.5``, ``per = s / dx``); the step's constant
+    parts of the strip (Pa, Pa/m): ``d_x = rate_x s + g_x / l1``, ``d_y =
+    rate_y0 s + g_y / l2``, ``d_yx = rate_yx s`` (the rates of
+    :func:`strip_rates`, ``g_x``, ``g_y`` the far field's shift per step, m).
+    All of them are the same for every cell of a sweep or of a strip:
+    :func:`rolling_sweep` computes them once (nine divisions a cell cost a
+    two-cell step of the 30 x 30 semi-ellipses some 4 us).  Return the
+    traction and ratio before the last step (the cell's own,
+    :func:`rolling_sweep`'s).  Inlined: as a call per cell it cost a 30 x
+    30 step of two cells 26.8 -> 34.4 us (the paper's MAE) and 34.3 -> 46.1
+    us (the calibrated one), same run; the steady march never enters it.
     """
-    s = rolled / nsub
-    v_sub = speed / s
-    # the steps' constant parts (Pa) and the cell reached, in cells from cell i
-    d_x = rate_x * s + g_x / l1
-    d_y = rate_y0 * s + g_y / l2
-    d_yx = rate_yx * s
-    ahead = rolled / dx + 0.5
-    per = s / dx
     for m in range(nsub - 1):
         ic = min(i + int(ahead - (m + 1) * per), nx - 1)
         g_m = outer * (shape[j, ic] * inner)
@@ -569,6 +569,38 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     # path's start reads it)
     kinetic = law != LAW_CONSTANT and rolled > dx and rolled < math.inf
     kin = np.ones((ny, nx) if kinetic else (1, 1))
+    # the weights of the previous state at x + rolled (the same for every cell)
+    f = rolled / dx if rolled < math.inf else 0.0
+    k0 = int(f)
+    u = f - k0
+    c0 = -u * (u - 1.0) * (u - 2.0) / 6.0
+    c1 = (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0
+    c2 = -(u + 1.0) * u * (u - 2.0) / 2.0
+    c3 = (u + 1.0) * u * (u - 1.0) / 6.0
+    w1 = u
+    w0 = 1.0 - (rolled - k0 * dx) / half
+    # a step longer than a cell: the paths' sub-steps (march_path) and their constants, the
+    # same for every cell (sweep) or strip (d_*, each cell's shift per L: one division a strip)
+    marched = rolled > dx and rolled < math.inf
+    nsub = int(math.ceil(rolled / dx - 1e-9)) if marched else 1
+    s_sub = rolled / nsub
+    v_sub = speed / s_sub
+    ahead = rolled / dx + 0.5
+    per = s_sub / dx
+    gx_sub = shift_x / nsub
+    gy_sub = shift_y / nsub
+    # per strip: the far field's shift over a memory cell's own step divided by L1, L2 (Pa),
+    # and the sub-steps' constant parts d_x, d_y, d_yx (march_path)
+    memory = rolled < math.inf
+    strip = np.empty((5, ny if memory else 1))
+    gl_x, gl_y, d_x, d_y, d_yx = strip[0], strip[1], strip[2], strip[3], strip[4]
+    if memory:
+        for j in range(ny):
+            gl_x[j] = gx_sub / flex[0, j]
+            gl_y[j] = gy_sub / flex[1, j]
+            d_x[j] = rate_x[j] * s_sub + gl_x[j]
+            d_y[j] = rate_y0[j] * s_sub + gl_y[j]
+            d_yx[j] = rate_yx[j] * s_sub
     for i in range(nx - 1, -1, -1):
         x = x0 + dx * i
         x_rel = x - x_c
@@ -593,52 +625,47 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
             cont[j] = i - 1
             g_x = 0.0
             g_y = 0.0
+            # the far field's shift over the cell's own step divided by L1, L2 (Pa)
+            glx = 0.0
+            gly = 0.0
             lev = level[j]
             if far and dist[j] <= rolled:
                 # entered during the step: the far field's increment over this cell's march
                 n = int((dist[j] - half) / dx + 0.5)
                 g_x = shift_x * (share[0, n + 1] - share[0, n])
                 g_y = shift_y * (share[1, n + 1] - share[1, n])
+                glx = g_x / flex[0, j]
+                gly = g_y / flex[1, j]
             elif dist[j] > rolled:
-                g_x = shift_x
-                g_y = shift_y
+                g_x = gx_sub
+                g_y = gy_sub
+                glx = gl_x[j]
+                gly = gl_y[j]
                 # in the contact before the step: from the previous state at x + rolled
                 s = rolled
-                f = rolled / dx
-                k0 = int(f)
                 iu = i + k0
                 if iu + 2 <= first[j] and iu >= 1 and shape[j, iu - 1] > 0.0:
                     # cubic Lagrange through the cells iu - 1 .. iu + 2 (exact for the
                     # quadratic traction of spin in adhesion: no smearing over the steps)
-                    u = f - k0
-                    c0 = -u * (u - 1.0) * (u - 2.0) / 6.0
-                    c1 = (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0
-                    c2 = -(u + 1.0) * u * (u - 2.0) / 2.0
-                    c3 = (u + 1.0) * u * (u - 1.0) / 6.0
                     t_x = (c0 * prev_x[j, iu - 1] + c1 * prev_x[j, iu] + c2 * prev_x[j, iu + 1]
                            + c3 * prev_x[j, iu + 2])
                     t_y = (c0 * prev_y[j, iu - 1] + c1 * prev_y[j, iu] + c2 * prev_y[j, iu + 1]
                            + c3 * prev_y[j, iu + 2])
                 elif iu < first[j]:
-                    w1 = f - k0
                     t_x = (1.0 - w1) * prev_x[j, iu] + w1 * prev_x[j, iu + 1]
                     t_y = (1.0 - w1) * prev_y[j, iu] + w1 * prev_y[j, iu + 1]
                 else:
                     # between the first cell's centre and the front face (zero traction there)
-                    w0 = 1.0 - (rolled - k0 * dx) / half
                     t_x = w0 * prev_x[j, iu]
                     t_y = w0 * prev_y[j, iu]
-                if rolled > dx:
+                if marched:
                     # the particle's path from x + h, marched in steps of at most a cell, each
                     # projected on the bound where the particle is, as the steady march does
                     # (the slip's direction follows the local rigid slip, which spin turns
                     # along the path; one projection over a long step took the path's mean):
                     # with h a whole number of cells the steady state is then a fixed point
                     # of the steps exactly; the last step is the cell's own
-                    nsub = int(math.ceil(rolled / dx - 1e-9))
-                    s = rolled / nsub
-                    g_x = g_x / nsub
-                    g_y = g_y / nsub
+                    s = s_sub
                     lev = 1.0
                     if kinetic:
                         # the particle's friction ratio where it starts, this sweep's there
@@ -646,17 +673,17 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                         if start <= first[j]:
                             lev = kin[j, start]
                     t_x, t_y, lev = march_path(
-                        t_x, t_y, lev, shape, outer, inner, j, i, nx, dx, rolled, nsub, x_rel,
-                        rate_x[j], rate_y0[j], rate_yx[j], w_x[j], g_x, g_y, eta, phi,
-                        flex[0, j], flex[1, j], law, prm, speed, rigid)
+                        t_x, t_y, lev, shape, outer, inner, j, i, nx, rolled, nsub, s_sub,
+                        v_sub, ahead, per, x_rel, d_x[j], d_y[j], d_yx[j], w_x[j], g_x, g_y,
+                        eta, phi, flex[0, j], flex[1, j], law, prm, speed, rigid)
             # the cell's own step: project()'s projection written out (a call costs the
             # steady march 20-30 %, measured; the fixed-point test of whole-cell transient
             # steps holds the two to the same answer)
             x_mid = x_rel + 0.5 * s
             p_x = t_x
             p_y = t_y
-            t_x = t_x - rate_x[j] * s - g_x / flex[0, j]
-            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s - g_y / flex[1, j]
+            t_x = t_x - rate_x[j] * s - glx
+            t_y = t_y - (rate_y0[j] + rate_yx[j] * x_mid) * s - gly
             over = False
             m2 = t_x * t_x + t_y * t_y
             if law == LAW_CONSTANT:
