@@ -21,6 +21,10 @@ each call, after a warm-up; the three compiled calls interleaved in blocks):
 - ``TransientSolver.step`` on the calibrated MAE (transient rolling: the
   traction carried from the last step, which rolled two cells; the issue's
   target is at most 1.5x the steady ``CalibratedMaeSolver.solve``),
+- the same step on the 30 x 30 patches at several distances rolled ``V
+  dt`` (half a cell to 4.3 cells), with the creepages unchanged and with
+  a rig's noise on them (the far field's fixed point then follows a change
+  of force every step), over the steady ``solve_arrays``,
 
 then the batched throughput (patch solves per second, one core) of
 ``solve_batch`` on distinct patches and on one patch under many creepages.
@@ -145,6 +149,63 @@ def throughput(fn: Callable[[], Any], size: int) -> float:
     return size / float(np.median(runs))
 
 
+#: the distances rolled a step of the transient table, in cells
+TRANSIENT_STEPS = (0.5, 1.0, 1.3, 2.0, 4.3)
+#: the creepages' relative noise of its second column (a measured rig's kinematics)
+TRANSIENT_NOISE = 1e-3
+
+
+def transient_table(calls: int, cells: int = 30) -> None:
+    """Print a transient step's cost over the steady solve at several ``V dt``, one run.
+
+    ``TransientSolver(CalibratedMaeSolver).step`` on the 30 x 30 patches,
+    from the state its own steps settled in, with the bench's creepages
+    unchanged (a whole number of cells is then the steady state's fixed
+    point: one sweep) and with each creepage times ``1 + 1e-3 n`` (``n``
+    standard normal, fresh every call: a rig's measured kinematics, whose
+    change of force the far field's fixed point follows), interleaved with
+    the steady ``CalibratedMaeSolver.solve_arrays`` of the same patch.
+    """
+    calibrated = CalibratedMaeSolver(NU, G)
+    transient = TransientSolver(calibrated)
+    xi, eta, phi = CREEP
+    rng = np.random.default_rng(0)
+    print(f"transient rolling: TransientSolver(CalibratedMaeSolver).step over the steady "
+          f"solve_arrays,\n{cells}x{cells} patches, V dt in cells; constant: the creepages "
+          f"unchanged; noise: each times 1 + {TRANSIENT_NOISE:g} n (n standard normal)\n")
+    head = (f"{'patch':<14}{'V dt':>6}  {'steady':>13}  {'constant':>13}{'ratio':>7}"
+            f"  {'noise':>13}{'ratio':>7}")
+    print(head)
+    print("-" * len(head))
+    for name, make in (("semi-ellipses", semi_ellipses), ("ellipse", ellipse)):
+        ar = make(cells)
+        p = np.array(ar.pressure)
+        grid = (ar.x0, ar.y0, ar.dx, ar.dy)
+        for steps in TRANSIENT_STEPS:
+            rolled = steps * ar.dx
+            settled = transient.step(None, p, *grid, xi, eta, phi, math.inf, MU)[1]
+            for _ in range(100):
+                settled = transient.step(settled, p, *grid, xi, eta, phi, rolled, MU)[1]
+            state = [settled, settled]
+
+            def constant() -> None:
+                state[0] = transient.step(state[0], p, *grid, xi, eta, phi, rolled, MU)[1]
+
+            def noise() -> None:
+                k = 1.0 + TRANSIENT_NOISE * rng.standard_normal(3)
+                state[1] = transient.step(state[1], p, *grid, k[0] * xi, k[1] * eta,
+                                          k[2] * phi, rolled, MU)[1]
+            t = per_call({"steady": lambda: calibrated.solve_arrays(p, *grid, xi, eta, phi, MU),
+                          "constant": constant, "noise": noise}, calls)
+            base = t["steady"][0]
+            print(f"{name:<14}{steps:>6g}  {t['steady'][0]:>6.1f} /{t['steady'][1]:>5.1f}  "
+                  f"{t['constant'][0]:>6.1f} /{t['constant'][1]:>5.1f}"
+                  f"{t['constant'][0] / base:>7.2f}  {t['noise'][0]:>6.1f} /{t['noise'][1]:>5.1f}"
+                  f"{t['noise'][0] / base:>7.2f}")
+    print("\ntimes in us, median / p99; ratio: the median over the steady median "
+          "(the issue's target: 1.5).\n")
+
+
 def main() -> None:
     """Run the benchmark and print its tables."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -246,6 +307,7 @@ def main() -> None:
           "tr/cal its median over CalibratedMaeSolver.solve's;\nlocal: the same without the "
           "far field (Kalker's local model); stepping: the far field\nwith a creepage step "
           "every call (its secant every time).\n")
+    transient_table(args.calls)
     print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
     head = (f"{'patch':<14}{'grid':>6}  {'MAE distinct':>13}{'MAE 1 patch':>13}"
             f"{'eq distinct':>13}{'eq 1 patch':>13}{'cal distinct':>13}{'cal 1 patch':>13}")

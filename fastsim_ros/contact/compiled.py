@@ -36,8 +36,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from fastsim_ros.contact import kernels as k
 from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.checks import (Bound, SplitRule, check_bound, check_shear_modulus,
-                                        check_split_rule)
+from fastsim_ros.contact.checks import (Bound, SplitRule, check_bound, check_friction,
+                                        check_shear_modulus, check_split_rule)
 from fastsim_ros.contact.equivalent import EquivalentEllipse
 from fastsim_ros.contact.errors import (ContactError, EmptyContactError, InvalidInputError,
                                         OutOfTableError)
@@ -151,6 +151,10 @@ def _per_item(value: ArrayLike, size: int, name: str) -> FloatArray:
 def _law(mu: float | None, friction: FrictionLaw | None,
          speed: float | None) -> tuple[int, FloatArray, float, float]:
     """Return the kernels' ``(law code, params, mu_s, speed)`` of a solve."""
+    if friction is None and mu is not None:
+        # constant friction, the common case: ConstantFriction's check without building one
+        # (0.65 us of a transient step's 7 us in Python)
+        return k.LAW_CONSTANT, _NO_PARAMS, check_friction(float(mu)), 0.0
     law = resolve(mu, friction)
     if law.slip_dependent:
         return law.code, law.params, law.mu_s, check_speed(speed)
