@@ -31,6 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "test"))
 
+import numpy as np  # noqa: E402
 from bench_fastsim import machine, per_call  # noqa: E402
 from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from ros_messages import cdr, cloud_msg, rolling_twist  # noqa: E402
@@ -61,15 +62,20 @@ def stamped(raw: bytes, stamp_ns: int) -> bytearray:
 
 
 def rig_cycle(pipe: Pipeline, *, xi: float = 4e-3, speed: float = 20.0,
-              measured: bool = False, cycles: int = 100_000) -> Callable[[], None]:
+              measured: bool = False, cycles: int = 100_000,
+              noise: float = 0.0) -> Callable[[], None]:
     """Return a function that runs the next 1 kHz rig cycle through ``pipe``.
 
-    The wheelset twist (creepage ``xi`` at ``speed`` m/s), with ``measured``
+    The wheelset twist (creepage ``xi`` at ``speed`` m/s; with ``noise``
+    the creepage times ``1 + noise n``, ``n`` standard normal, from a pool
+    of 97 twists in turn: a measured rig's kinematics), with ``measured``
     a measured wrench, and both contacts' 30-cell flange-root patches, as
     CDR bytes with the cycle's stamp (``bytes``, as the node gets them: the
     patch topics' header parsed once); at most ``cycles`` cycles with ``measured``.
     """
     area = samples.flange_root_patch(cells=30)
+    noisy = [cdr(rolling_twist(xi * (1.0 + noise * n), speed=speed))
+             for n in np.random.default_rng(0).standard_normal(97)] if noise else []
     twist = cdr(rolling_twist(xi, speed=speed))
     left = cdr(cloud_msg(area, origin=LEFT, dtype="<f8"))
     right = cdr(cloud_msg(area, origin=RIGHT, dtype="<f8"))
@@ -84,7 +90,7 @@ def rig_cycle(pipe: Pipeline, *, xi: float = 4e-3, speed: float = 20.0,
         stamp[0] += PERIOD_NS
         t = stamp[0]
         # bytes, as rclpy hands a raw subscription's message to the node
-        pipe.on_wheel_twist(bytes(stamped(twist, t)))
+        pipe.on_wheel_twist(bytes(stamped(noisy[t // PERIOD_NS % 97] if noise else twist, t)))
         if measured:
             pipe.on_measured_wrench(next(forces))
         pipe.on_patch("left", bytes(stamped(left, t)))

@@ -858,7 +858,8 @@ class Pipeline:
             previous, dt_ns = carried
             # in the order of pipeline_kernels.MEM_*
             mem = np.array((1.0, *previous.grid, dt_ns, memory.direction, *previous.force,
-                            float(memory.solver.far_field), memory.solver.solver.nu))
+                            float(memory.solver.far_field), memory.solver.solver.nu,
+                            *previous.far_slope))
             state_arrays = (previous.tau_x, previous.tau_y, np.empty((ny, nx)),
                             np.empty((ny, nx)), np.empty((ny, nx), dtype=np.bool_),
                             np.empty(contact_kernels.GEO_SIZE))
@@ -885,12 +886,14 @@ class Pipeline:
         if memory is not None:  # ContactMemory.solve's state, kept unless the patch jumped
             _, _, tau_x, tau_y, _, geo = state_arrays
             sign = -1.0 if result[fast.SPEED] < 0.0 else 1.0  # the forces of the turned patch
+            j_xx, j_xy, j_yx, j_yy = mem[fast.MEM_FAR_SLOPE:fast.MEM_FAR_SLOPE + 4].tolist()
             new = TractionState(tau_x, tau_y, previous.grid, float(geo[contact_kernels.G_AREA]),
                                 (float(geo[contact_kernels.G_XC]),
                                  float(geo[contact_kernels.G_YC])),
                                 float(geo[contact_kernels.G_ELLIPSE + 2]),
                                 force=(sign * float(result[fast.FX]),
-                                       sign * float(result[fast.FY])))
+                                       sign * float(result[fast.FY])),
+                                far_slope=(j_xx, j_xy, j_yx, j_yy))
             (o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2) = frame_out[
                 patch_kernels.ORIGIN:patch_kernels.E_Y + 3].tolist()
             if not memory.take(cloud.stamp_ns, float(result[fast.SPEED]), new,

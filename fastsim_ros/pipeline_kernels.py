@@ -37,10 +37,11 @@ RESULT_SIZE = 25
 #: the indices of :func:`solve_cloud`'s ``memory`` (transient rolling's carried state):
 #: on (1) or steady (0), the state's grid (turned as the patch is when rolling towards -x),
 #: the time since the last solved patch (ns), the last rolling direction (+-1), the last
-#: force (N, turned), the far field on (1) or off (0), the Poisson ratio
-(MEM_ON, MEM_GRID, MEM_DT_NS, MEM_DIRECTION, MEM_FORCE, MEM_FAR_FIELD, MEM_NU) = (
-    0, 1, 5, 6, 7, 9, 10)
-MEMORY_SIZE = 11
+#: force (N, turned), the far field on (1) or off (0), the Poisson ratio, the far field's
+#: Jacobian (N/m, 2 x 2 by rows, in and out: the new state's, written back)
+(MEM_ON, MEM_GRID, MEM_DT_NS, MEM_DIRECTION, MEM_FORCE, MEM_FAR_FIELD, MEM_NU,
+ MEM_FAR_SLOPE) = (0, 1, 5, 6, 7, 9, 10, 11)
+MEMORY_SIZE = 15
 
 
 @njit(cache=True, inline="always")
@@ -165,11 +166,13 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
         rolled = abs(speed) * memory[MEM_DT_NS] * 1e-9
         v = abs(speed) if slip_dependent else 0.0
         far = memory[MEM_FAR_FIELD] != 0.0
+        far_slope = memory[MEM_FAR_SLOPE:MEM_FAR_SLOPE + 4].copy()
         r = transient.mae_rolling_solve(
             p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule, parabolic, shear_modulus,
             knots, polys, law, prm, v, out_x, out_y, slip, calibrated, pair_knots, pair_values,
             prev_x, prev_y, rolled, geo, memory[MEM_NU], far, memory[MEM_FORCE],
-            memory[MEM_FORCE + 1])
+            memory[MEM_FORCE + 1], far_slope)
+        memory[MEM_FAR_SLOPE:MEM_FAR_SLOPE + 4] = far_slope
     elif slope:
         q = contact.mae_solve_mu_slope(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule,
                                        parabolic, shear_modulus, knots, polys, law, prm,

@@ -236,18 +236,26 @@ FAR_FIELD_STEPS = 4
 def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
                   yp, law, prm, speed, out_x, out_y, slip, rigid, prev_x, prev_y, rolled,
                   m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total,
-                  fade=1.0):
+                  slope, fade=1.0):
     """One time step with the far field: :func:`kernels.rolling_sweep` at its fixed point.
 
     The patch's shift over the step is ``s = M (F - F_old)`` (m per
     direction, :func:`far_field`), ``F`` the step's own force: ``g(s) = s -
     M (F(s) - F_old) = 0`` is solved by secant steps from ``s = 0`` (``F`` is
     monotone in ``s``: memory cells in stick lose ``s / L`` each, those in
-    slip stay on the bound), the second point the root if every cell were a
-    memory cell in stick (stiffness ``K``).  In the steady state ``F =
-    F_old``: one sweep, ``s = 0``.  A cell that entered during the step saw
-    the shift since it entered (:func:`kernels.rolling_sweep`): a lag of
-    length ``l (1 - h / length)``, so that a step ``h`` of the patch's
+    slip stay on the bound) by Broyden's method in ``(s_x, s_y)``: the
+    second point the root of the plane ``F = F0 - J s``, ``J`` (N/m, 2 x
+    2: ``dF_x/ds_x, dF_x/ds_y, dF_y/ds_x, dF_y/ds_y``, negated) in ``slope``
+    (4 floats, in and out: the last Broyden estimate, carried from step to
+    step with the contact's state; unknown (NaN) or out of range: ``K``,
+    diagonal, as if every memory cell stuck).  Slipping cells turn with the
+    shift too, and the directions couple: on the bench's patch (88% slip)
+    ``J`` is a third of ``K`` with cross terms of 15%, so a first point
+    from ``K`` was 0.6 of the root, per direction, a sweep or two more a
+    step.  In the steady state ``F = F_old``: one sweep, ``s = 0``.  A
+    cell that entered during the step saw the shift since it entered
+    (:func:`kernels.rolling_sweep`): a lag of length ``l (1 - h /
+    length)``, so that a step ``h`` of the patch's
     ``length`` or more is the steady state (no material saw the old force);
     ``fade`` (1) scales that lag further (:func:`elastic_steps`' sub-steps).
     Returns as :func:`kernels.rolling_sweep`; the last
@@ -271,8 +279,17 @@ def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     s0y = 0.0
     g0x = -m_x * (fx - f_old_x)
     g0y = -m_y * (fy - f_old_y)
-    s1x = m_x * (fx - f_old_x) / (1.0 + m_x * k_x)
-    s1y = m_y * (fy - f_old_y) / (1.0 + m_y * k_y)
+    # g's Jacobian A = I + M J (F ~ F0 - J s): from the carried J, else every memory cell in
+    # stick (J = K, diagonal); Broyden's updates from the points swept
+    j_xx, j_xy, j_yx, j_yy = slope[0], slope[1], slope[2], slope[3]
+    if not (j_xx >= 0.0 and j_xx <= k_x and j_yy >= 0.0 and j_yy <= k_y
+            and abs(j_xy) <= k_x and abs(j_yx) <= k_y):
+        j_xx, j_xy, j_yx, j_yy = k_x, 0.0, 0.0, k_y
+    a11 = 1.0 + m_x * j_xx
+    a12 = m_x * j_xy
+    a21 = m_y * j_yx
+    a22 = 1.0 + m_y * j_yy
+    s1x, s1y = _newton(a11, a12, a21, a22, s0x, s0y, g0x, g0y)
     for _ in range(FAR_FIELD_STEPS):
         fx, fy, mz, nslip, ncontact = k.rolling_sweep(
             shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
@@ -280,17 +297,41 @@ def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
             s1y, r_x, r_y)
         g1x = s1x - m_x * (fx - f_old_x)
         g1y = s1y - m_y * (fy - f_old_y)
+        # Broyden: A += (dg - A ds) ds^T / |ds|^2
+        d_x = s1x - s0x
+        d_y = s1y - s0y
+        nd = d_x * d_x + d_y * d_y
+        if nd > 0.0:
+            r_1 = (g1x - g0x) - (a11 * d_x + a12 * d_y)
+            r_2 = (g1y - g0y) - (a21 * d_x + a22 * d_y)
+            a11 += r_1 * d_x / nd
+            a12 += r_1 * d_y / nd
+            a21 += r_2 * d_x / nd
+            a22 += r_2 * d_y / nd
+            # the next step's first guess, J = M^-1 (A - I), where the far field acts
+            if m_x > 0.0:
+                slope[0] = (a11 - 1.0) / m_x
+                slope[1] = a12 / m_x
+            if m_y > 0.0:
+                slope[2] = a21 / m_y
+                slope[3] = (a22 - 1.0) / m_y
         if abs(g1x) * k_x <= tol and abs(g1y) * k_y <= tol:
             break
-        s2x = s1x
-        s2y = s1y
-        if g1x != g0x:
-            s2x = s1x - g1x * (s1x - s0x) / (g1x - g0x)
-        if g1y != g0y:
-            s2y = s1y - g1y * (s1y - s0y) / (g1y - g0y)
         s0x, s0y, g0x, g0y = s1x, s1y, g1x, g1y
-        s1x, s1y = s2x, s2y
+        s1x, s1y = _newton(a11, a12, a21, a22, s1x, s1y, g1x, g1y)
     return fx, fy, mz, nslip, ncontact
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def _newton(a11, a12, a21, a22, s_x, s_y, g_x, g_y):
+    """Return ``s - A^-1 g``: the root of the line through ``(s, g)`` with Jacobian ``A``.
+
+    A singular ``A`` (a degenerate Broyden update) takes its diagonal alone.
+    """
+    det = a11 * a22 - a12 * a21
+    if abs(det) > 1e-6 * abs(a11 * a22) and det != 0.0:
+        return (s_x - (a22 * g_x - a12 * g_y) / det, s_y - (a11 * g_y - a21 * g_x) / det)
+    return s_x - (g_x / a11 if a11 != 0.0 else 0.0), s_y - (g_y / a22 if a22 != 0.0 else 0.0)
 
 
 #: with the far field, a step longer than this share of the patch's length is taken in equal
@@ -308,7 +349,7 @@ FADE_START = 0.5
 @njit(cache=True, error_model="numpy")
 def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
                   yp, law, prm, speed, out_x, out_y, slip, rigid, prev_x, prev_y, rolled,
-                  m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total):
+                  m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total, slope):
     """Roll ``rolled`` (m) as :func:`elastic_sweep` does, in sub-steps where it is long.
 
     The far field's force is taken to change as a first-order lag within a
@@ -335,12 +376,15 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
       :data:`SUBSTEP_CHANGE` the answer (forces and tractions) goes linearly
       from the whole step's to the sub-steps'.
 
-    Arguments and return as :func:`elastic_sweep`.
+    Arguments and return as :func:`elastic_sweep`; the sub-steps start from
+    the Jacobian ``slope`` came with (the whole step's sweeps are discarded
+    with it), so that a step of ``h`` is two of ``h/2`` to the bit.
     """
+    j_xx, j_xy, j_yx, j_yy = slope[0], slope[1], slope[2], slope[3]
     fx, fy, mz, nslip, ncontact = elastic_sweep(
         shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
         law, prm, speed, out_x, out_y, slip, rigid, prev_x, prev_y, rolled, m_x, m_y, k_x,
-        k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total)
+        k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total, slope)
     if (m_x == 0.0 and m_y == 0.0) or not rolled < length:
         return fx, fy, mz, nslip, ncontact
     nsub = max(1, int(math.ceil(rolled / (SUBSTEP * length) - 1e-9)))
@@ -349,6 +393,7 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     if nsub == 1 or not change > limit:
         return fx, fy, mz, nslip, ncontact
     # the force changes over a long step: again from the start, in sub-steps
+    slope[0], slope[1], slope[2], slope[3] = j_xx, j_xy, j_yx, j_yy
     weight = min(1.0, (change - limit) / limit)
     whole_x = out_x.copy()
     whole_y = out_y.copy()
@@ -367,7 +412,7 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
         fx, fy, mz, nslip, ncontact = elastic_sweep(
             shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
             law, prm, speed, out_x, out_y, slip, rigid, state_x, state_y, h, m_x * fade,
-            m_y * fade, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total, fade)
+            m_y * fade, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, bound_total, slope, fade)
         f_old_x = fx
         f_old_y = fy
     if weight < 1.0:
@@ -391,7 +436,7 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
 def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                       shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
                       calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo, nu,
-                      with_far_field, f_old_x, f_old_y):
+                      with_far_field, f_old_x, f_old_y, slope):
     """One time step of MAE + FastSim, rolling ``rolled`` (m) from the state ``prev_x, prev_y``.
 
     As :func:`fastsim_ros.contact.kernels.mae_solve` (same arguments and
@@ -400,7 +445,8 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
     ``geo`` receives the MAE geometry (:data:`~kernels.GEO_SIZE`).  With
     ``with_far_field`` the patch's shift (:func:`far_field`, Mindlin's on the
     equivalent ellipse, Poisson ratio ``nu``) from the previous force
-    ``f_old_x``, ``f_old_y`` (N).
+    ``f_old_x``, ``f_old_y`` (N); ``slope`` (4 floats, N/m, in and out): the
+    far field's Jacobian carried with the state (:func:`elastic_sweep`).
     """
     status = k.check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != k.OK:
@@ -435,7 +481,7 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
     fx, fy, mz, nslip, _ = elastic_steps(
         shape, outer, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
         law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled,
-        m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, mu * geo[k.G_LOAD])
+        m_x, m_y, k_x, k_y, l_x, l_y, length, f_old_x, f_old_y, mu * geo[k.G_LOAD], slope)
     return k.OK, 0.0, fx, fy, mz, geo[k.G_LOAD], nslip, int(geo[k.G_NCONTACT])
 
 
@@ -455,7 +501,8 @@ def longest_segment(p, dx):
 @njit(cache=True, error_model="numpy")
 def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
                           shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
-                          prev_x, prev_y, rolled, ell, nu, with_far_field, f_old_x, f_old_y):
+                          prev_x, prev_y, rolled, ell, nu, with_far_field, f_old_x, f_old_y,
+                          slope):
     """One time step of FastSim on the patch's equivalent ellipse (``n`` x ``n`` cells).
 
     As :func:`fastsim_ros.contact.kernels.equivalent_solve` with the state
@@ -500,7 +547,7 @@ def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic
     fx, fy, mz, nslip, ncontact = elastic_steps(
         shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi, flex, x_c, y_c, xp, yp,
         law, prm, speed, out_x, out_y, slip, False, prev_x, prev_y, rolled, m_x, m_y, k_x,
-        k_y, l_x, l_y, length, f_old_x, f_old_y, mu * ell[k.ELL_LOAD])
+        k_y, l_x, l_y, length, f_old_x, f_old_y, mu * ell[k.ELL_LOAD], slope)
     return k.OK, 0.0, fx, fy, mz, ell[k.ELL_LOAD], nslip, ncontact
 
 
@@ -511,7 +558,9 @@ class TractionState:
     ``load``: the patch's normal load (N), ``area``: its cells in contact
     times the cell area (m^2), ``centroid``: its pressure centroid (m) and
     ``half_length``: half its extent along ``x`` (m), for the jump rule;
-    ``force``: its total ``(Fx, Fy)`` (N), the far field's previous force.
+    ``force``: its total ``(Fx, Fy)`` (N), the far field's previous force;
+    ``far_slope``: the far field's Jacobian ``-dF/ds`` (N/m, 2 x 2 by rows,
+    NaN: none yet), the next step's first guess (:func:`elastic_sweep`).
     """
 
     tau_x: FloatArray
@@ -521,6 +570,7 @@ class TractionState:
     centroid: tuple[float, float]
     half_length: float
     force: tuple[float, float] = (0.0, 0.0)
+    far_slope: tuple[float, float, float, float] = (math.nan,) * 4
 
     def resampled(self, grid: tuple[float, float, float, float],
                   shape: tuple[int, int]) -> tuple[FloatArray, FloatArray]:
@@ -590,6 +640,7 @@ class TransientSolver:
         parabolic = check_bound(bound)
         xp, yp = float(reference[0]), float(reference[1])
         f_old = state.force if state is not None else (0.0, 0.0)
+        slope = np.array(state.far_slope if state is not None else (math.nan,) * 4)
         if isinstance(s, MaeSolver):
             grid = (float(x0), float(y0), float(dx), float(dy))
             shape = p.shape
@@ -601,7 +652,7 @@ class TransientSolver:
                 float(mu_s), xp, yp, s._rule, parabolic, s.shear_modulus, s._knots, s._polys,
                 code, prm, v, out[0], out[1], out[2], s._calibrated, s._pair_knots,
                 s._pair_values, prev[0], prev[1], float(rolled), geo, s.nu, self.far_field,
-                f_old[0], f_old[1])
+                f_old[0], f_old[1], slope)
             # the patch's area, centroid and half length, for ContactMemory's jump rule
             measures = (float(geo[k.G_AREA]), (float(geo[k.G_XC]), float(geo[k.G_YC])),
                         float(geo[k.G_ELLIPSE + 2]))
@@ -620,13 +671,15 @@ class TransientSolver:
                 p, float(x0), float(y0), float(dx), float(dy), float(xi), float(eta),
                 float(phi), float(mu_s), xp, yp, parabolic, n, s.shear_modulus, s._knots,
                 s._polys, code, prm, v, out[0], out[1], out[2], prev[0], prev[1],
-                float(rolled), ell, s.nu, self.far_field, f_old[0], f_old[1])
+                float(rolled), ell, s.nu, self.far_field, f_old[0], f_old[1], slope)
             # the equivalent ellipse has the patch's area and centroid
             measures = (math.pi * float(ell[k.ELL_A] * ell[k.ELL_B]),
                         (float(ell[k.ELL_XC]), float(ell[k.ELL_YC])), float(ell[k.ELL_A]))
         forces = s._forces(result, grid, out, True)
         return forces, TractionState(out[0], out[1], grid, *measures,
-                                     force=(float(result[2]), float(result[3])))
+                                     force=(float(result[2]), float(result[3])),
+                                     far_slope=(float(slope[0]), float(slope[1]),
+                                                float(slope[2]), float(slope[3])))
 
     def _previous(self, state: TractionState | None, grid: tuple[float, float, float, float],
                   shape: tuple[int, ...]) -> tuple[FloatArray, FloatArray]:
