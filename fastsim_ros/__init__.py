@@ -15,6 +15,7 @@ import hashlib
 import os
 import sys
 import tempfile
+from typing import Any
 
 
 def _numba_cache_dir() -> str:
@@ -34,9 +35,12 @@ def _numba_cache_dir() -> str:
 #: stamp of the file a kernel is defined in, not of what it compiles in from
 #: elsewhere (``rules.py`` into ``kernels.py``, ``transient.py`` into
 #: ``pipeline_kernels.py``, ``msg_adapters/patch.py``'s constants), so the cache
-#: directory is keyed on their contents and a changed formula can never load a
-#: stale kernel (``test_pipeline_kernels`` checks the list against the sources:
-#: every module with compiled functions, and what they import, is here)
+#: directory this package chooses is keyed on their contents and a changed formula
+#: can never load a stale kernel from it (``test_pipeline_kernels`` checks the list
+#: against the sources: every module with compiled functions, and what they import,
+#: is here).  A ``NUMBA_CACHE_DIR`` the user set is kept as it is: there numba's
+#: per-file time stamps are the only key, and a kernel changed in one file and
+#: compiled into another's can load stale (clear that directory after editing)
 _KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/knee.py",
                    "contact/transient.py",
                    "pipeline_kernels.py", "replay/kernels.py",
@@ -71,7 +75,10 @@ if "NUMBA_CACHE_DIR" not in os.environ or (
         os.environ["NUMBA_CACHE_DIR"] = os.environ[_CHOSEN] = _cache
         if "numba.core.config" in sys.modules:
             # numba read its settings when it was imported (a script that imports numba
-            # before this package): without a reload its cache stayed in __pycache__,
-            # keyed on each file's own time stamp, and a kernel compiled in from another
-            # file (rolling_sweep into transient.py's solves) loaded stale machine code
-            sys.modules["numba.core.config"].reload_config()
+            # before this package): its cache stayed in __pycache__, keyed on each file's
+            # own time stamp, and a kernel compiled in from another file (rolling_sweep
+            # into transient.py's solves) loaded stale machine code.  Only the cache's
+            # directory is set: reload_config() would also reset what the script set in
+            # code (numba.config.DISABLE_JIT for a coverage run)
+            _config: Any = sys.modules["numba.core.config"]
+            _config.CACHE_DIR = _cache

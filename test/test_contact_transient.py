@@ -433,14 +433,14 @@ def test_the_carried_far_field_jacobian_changes_the_path_not_the_answer(solver_c
     rolled = 2.3 * patch.dx
     _, state = _step(t, None, patch, creep, math.inf, mu=MU)
     rng = np.random.default_rng(5)
-    for _ in range(12):
+    for _ in range(6):
         _, state = _step(t, state, patch, creep * (1 + 1e-2 * rng.standard_normal(3)),
                          rolled, mu=MU)
     assert all(math.isfinite(v) for v in state.far_slope)
     j_xx, j_xy, j_yx, j_yy = state.far_slope
     assert j_xx > 0.0 and j_yy > 0.0
     bound = MU * 4e4
-    for _ in range(6):
+    for _ in range(3):
         step_creep = creep * (1 + 1e-2 * rng.standard_normal(3))
         carried, new = _step(t, state, patch, step_creep, rolled, mu=MU)
         forgotten, _ = _step(t, dataclasses.replace(state, far_slope=(math.nan,) * 4), patch,

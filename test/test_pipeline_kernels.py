@@ -269,6 +269,8 @@ def test_transient_rolling_equals_the_python_path_cycle_for_cycle(settings):
             assert (m.state.grid, m.state.area, m.state.centroid, m.state.half_length,
                     m.state.force) == (n.state.grid, n.state.area, n.state.centroid,
                                        n.state.half_length, n.state.force)
+            # the far field's Jacobian, carried too (NaN: none yet)
+            assert np.array_equal(m.state.far_slope, n.state.far_slope, equal_nan=True)
             assert (m.stamp_ns, m.direction, m.lost) == (n.stamp_ns, n.direction, n.lost)
     counts = fast._memories["left"].counts
     assert counts["start"] == 1 and counts["stamp_gap"] == 1 and counts["reversed"] == 1
@@ -358,7 +360,8 @@ def test_the_keyed_cache_holds_when_numba_was_imported_first(tmp_path):
     imported numba first kept numba's default, ``__pycache__`` keyed on each
     file's own time stamp, and ``transient.py``'s solves loaded machine code
     compiled against an older ``kernels.rolling_sweep`` (a doubled force in
-    ``rolling_sweep`` left ``mae_rolling_solve``'s answer as it was).
+    ``rolling_sweep`` left ``mae_rolling_solve``'s answer as it was).  Only
+    the cache's directory is set: what the script set in code stays.
     """
     import os
     import subprocess
@@ -379,3 +382,10 @@ def test_the_keyed_cache_holds_when_numba_was_imported_first(tmp_path):
     assert chosen.startswith(str(tmp_path))
     assert numba_dir == chosen
     assert cache_path.startswith(chosen)
+    # and what the script set in code stays set (a reload of numba's settings reset it)
+    probe = ("import numba; numba.config.DISABLE_JIT = True; import fastsim_ros; "
+             "from fastsim_ros.contact import transient; "
+             "print(numba.config.DISABLE_JIT, type(transient.elastic_sweep).__name__)")
+    done = subprocess.run([sys.executable, "-c", probe], env=env, cwd=str(tmp_path),
+                          capture_output=True, text=True, timeout=120, check=True)
+    assert done.stdout.split() == ["True", "function"]

@@ -308,13 +308,10 @@ def elastic_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
             a12 += r_1 * d_y / nd
             a21 += r_2 * d_x / nd
             a22 += r_2 * d_y / nd
-            # the next step's first guess, J = M^-1 (A - I), where the far field acts
-            if m_x > 0.0:
-                slope[0] = (a11 - 1.0) / m_x
-                slope[1] = a12 / m_x
-            if m_y > 0.0:
-                slope[2] = a21 / m_y
-                slope[3] = (a22 - 1.0) / m_y
+            # the next step's first guess, J = M^-1 (A - I), where the far field acts (a
+            # direction without it keeps K's row: a NaN there would void the whole guess)
+            slope[0], slope[1] = ((a11 - 1.0) / m_x, a12 / m_x) if m_x > 0.0 else (k_x, 0.0)
+            slope[2], slope[3] = (a21 / m_y, (a22 - 1.0) / m_y) if m_y > 0.0 else (0.0, k_y)
         if abs(g1x) * k_x <= tol and abs(g1y) * k_y <= tol:
             break
         s0x, s0y, g0x, g0y = s1x, s1y, g1x, g1y
@@ -378,7 +375,8 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
 
     Arguments and return as :func:`elastic_sweep`; the sub-steps start from
     the Jacobian ``slope`` came with (the whole step's sweeps are discarded
-    with it), so that a step of ``h`` is two of ``h/2`` to the bit.
+    with it), so that a step of ``h`` taken in full sub-steps is two of
+    ``h/2`` so taken to the bit.
     """
     j_xx, j_xy, j_yx, j_yy = slope[0], slope[1], slope[2], slope[3]
     fx, fy, mz, nslip, ncontact = elastic_sweep(
