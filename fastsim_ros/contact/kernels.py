@@ -420,8 +420,9 @@ def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, rolled, nsub, s, v_
     rate_y0 s + g_y / l2``, ``d_yx = rate_yx s`` (the rates of
     :func:`strip_rates`, ``g_x``, ``g_y`` the far field's shift per step, m).
     All of them are the same for every cell of a sweep or of a strip:
-    :func:`rolling_sweep` computes them once (nine divisions a cell cost a
-    two-cell step of the 30 x 30 semi-ellipses some 4 us).  Return the
+    :func:`rolling_sweep` computes them once (with the rest of its per-cell
+    constants: a two-cell step of the 60 x 60 semi-ellipses 66.7-68.8 ->
+    62.7-63.2 us, the paper's MAE, alternating runs).  Return the
     traction and ratio before the last step (the cell's own,
     :func:`rolling_sweep`'s).  Inlined: as a call per cell it cost a 30 x
     30 step of two cells 26.8 -> 34.4 us (the paper's MAE) and 34.3 -> 46.1
@@ -567,9 +568,11 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     v_half = speed / half
     # slip-dependent laws over marched paths: each cell's friction ratio in this sweep (a
     # path's start reads it)
-    kinetic = law != LAW_CONSTANT and rolled > dx and rolled < math.inf
+    marched = rolled > dx and rolled < math.inf
+    kinetic = law != LAW_CONSTANT and marched
     kin = np.ones((ny, nx) if kinetic else (1, 1))
-    # the weights of the previous state at x + rolled (the same for every cell)
+    # the weights of the previous state at x + rolled, the same for every cell: cubic c0 .. c3,
+    # linear u, w0 next to the front face
     f = rolled / dx if rolled < math.inf else 0.0
     k0 = int(f)
     u = f - k0
@@ -577,11 +580,10 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     c1 = (u + 1.0) * (u - 1.0) * (u - 2.0) / 2.0
     c2 = -(u + 1.0) * u * (u - 2.0) / 2.0
     c3 = (u + 1.0) * u * (u - 1.0) / 6.0
-    w1 = u
     w0 = 1.0 - (rolled - k0 * dx) / half
-    # a step longer than a cell: the paths' sub-steps (march_path) and their constants, the
-    # same for every cell (sweep) or strip (d_*, each cell's shift per L: one division a strip)
-    marched = rolled > dx and rolled < math.inf
+    # a step longer than a cell (marched): the paths' sub-steps (march_path) and their
+    # constants, the same for every cell (sweep) or strip (d_*, each cell's shift per L: one
+    # division a strip)
     nsub = int(math.ceil(rolled / dx - 1e-9)) if marched else 1
     s_sub = rolled / nsub
     v_sub = speed / s_sub
@@ -652,8 +654,8 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                     t_y = (c0 * prev_y[j, iu - 1] + c1 * prev_y[j, iu] + c2 * prev_y[j, iu + 1]
                            + c3 * prev_y[j, iu + 2])
                 elif iu < first[j]:
-                    t_x = (1.0 - w1) * prev_x[j, iu] + w1 * prev_x[j, iu + 1]
-                    t_y = (1.0 - w1) * prev_y[j, iu] + w1 * prev_y[j, iu + 1]
+                    t_x = (1.0 - u) * prev_x[j, iu] + u * prev_x[j, iu + 1]
+                    t_y = (1.0 - u) * prev_y[j, iu] + u * prev_y[j, iu + 1]
                 else:
                     # between the first cell's centre and the front face (zero traction there)
                     t_x = w0 * prev_x[j, iu]

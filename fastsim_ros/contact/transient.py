@@ -27,7 +27,8 @@ the exact transient solver (``docs/validation_transient.md``):
   step built up twice as fast as the exact one.  With ``u = L tau + M F``
   (``F`` the patch's total force, ``M`` making a uniform shift Mindlin's) the
   patch shifts as its force changes; steady rolling does not see it (``F``
-  constant).  The step's own ``F`` is a fixed point, solved by secant steps
+  constant).  The step's own ``F`` is a fixed point, solved by Broyden's
+  secant method with its Jacobian carried from step to step in the state
   (:func:`elastic_sweep`; one sweep in the steady state).  Assumed: the far
   field is uniform over the patch (its first moment only: no torsion term),
   and the force changes over a step as a first-order lag of the relaxation
