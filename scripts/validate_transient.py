@@ -89,6 +89,38 @@ def exact_reference(a: float, b: float, creep: tuple[float, float, float], key: 
     return extrapolated, fine_at_coarse, 2.0 * fine_steady - coarse_steady, fine_steady
 
 
+#: the creepage's share at which the steady methods' error is taken, up to the step's own:
+#: the levels of force a step response passes through on its way to the steady state
+LEVELS = tuple(np.linspace(0.05, 1.0, 20))
+
+
+def steady_envelope(a: float, b: float, creep: tuple[float, float, float], key: str,
+                    names: tuple[str, ...]) -> dict[str, float]:
+    """Return each method's largest steady error (F/(mu N)) at the creepages up to ``creep``.
+
+    A step response from zero traction passes through every level of force
+    from zero to the steady one, and on its way its partial-slip states are
+    those of smaller steady creepages: FastSim's steady error there (up to
+    5 % of the force in early partial slip, ``fastsim_ros/contact/knee.py``)
+    is the steady method's own error at those levels.  So beside the error
+    at the step's creepage the report takes the largest one at the
+    creepages ``f creep``, ``f`` in :data:`LEVELS` (the exact steady force
+    converged in the cell as :func:`exact_reference`'s).
+    """
+    scale = MU * N
+    fine = areas.ellipse(a, b, nx=CELLS, ny=CELLS, load=N)
+    coarse = areas.ellipse(a, b, nx=CELLS // 2, ny=CELLS // 2, load=N)
+    worst = dict.fromkeys(names, 0.0)
+    for f in LEVELS:
+        c = (f * creep[0], f * creep[1], f * creep[2])
+        exact = (2.0 * getattr(coulomb(fine, *c, mu=MU, nu=NU, shear_modulus=G), key)
+                 - getattr(coulomb(coarse, *c, mu=MU, nu=NU, shear_modulus=G), key)) / scale
+        for name in names:
+            fast = getattr(METHODS[name](NU, G).solve(fine, *c, mu=MU), key) / scale
+            worst[name] = max(worst[name], abs(fast - exact))
+    return worst
+
+
 def sampled(history: list[float], cells_per_step: int, n: int) -> list[float]:
     """Return ``history`` (at steps of two cells of ``CELLS``) at the fast methods' ``n`` steps.
 
@@ -113,15 +145,21 @@ def sampled(history: list[float], cells_per_step: int, n: int) -> list[float]:
     return out
 
 
-def other_shapes() -> list[tuple[str, str, float, str, float, float, bool] | tuple[str, str]]:
-    """Return the step responses on ellipses a/b = 2 and 0.5 (gap, steady error, ok).
+Shaped = tuple[str, str, float, str, float, float, bool, float, bool]
+
+
+def other_shapes() -> list[Shaped | tuple[str, str]]:
+    """Return the step responses on ellipses a/b = 2 and 0.5.
+
+    Each as ``(shape, step, V dt / a, method, gap, steady error, ok, steady
+    error over the levels, ok over the levels)`` (:func:`steady_envelope`).
 
     As the circle's, with a = 6 mm or 3 mm along the rolling direction, at
     V dt / a = 0.1, 0.3 and 1; a step whose exact response does not
     converge is reported as such.
     """
     from fastsim_ros.contact.errors import ConvergenceError
-    out: list[tuple[str, str, float, str, float, float, bool] | tuple[str, str]] = []
+    out: list[Shaped | tuple[str, str]] = []
     scale = MU * N
     for a, b in ((A, A / 2), (A / 2, A)):
         shape = f"a/b = {a / b:g}"
@@ -135,6 +173,7 @@ def other_shapes() -> list[tuple[str, str, float, str, float, float, bool] | tup
                 out.append((shape, f"{kind}: the exact transient solver did not converge "
                                    f"({e})"))
                 continue
+            levels = steady_envelope(a, b, creep, key, ("mae_calibrated", "fastsim_ellipse"))
             for m in OTHER_STEPS:
                 n = math.ceil(3 * CELLS / m)
                 exact = np.array(sampled(ref, m, n))
@@ -149,7 +188,9 @@ def other_shapes() -> list[tuple[str, str, float, str, float, float, bool] | tup
                                            *creep, m * ar.dx, MU)
                         fast.append(getattr(f, key) / scale)
                     gap = float(np.max(np.abs(np.array(fast) - exact)))
-                    out.append((shape, kind, m * ar.dx / a, name, gap, err, gap <= err + 0.02))
+                    worst = max(levels[name], err)
+                    out.append((shape, kind, m * ar.dx / a, name, gap, err, gap <= err + 0.02,
+                                worst, gap <= worst + 0.02))
     return out
 
 
@@ -231,6 +272,7 @@ def main() -> None:
         ax.plot(dist, ref, "k-", lw=2, label="exact (converged in the cell)")
         ax.plot(dist, raw, color="0.5", lw=1, label=f"exact on {CELLS} x {CELLS} cells")
         ax.axhline(ex_steady, color="k", lw=0.8, ls=":")
+        levels = steady_envelope(A, A, creep, key, tuple(METHODS))
         for m in CELLS_PER_STEP:
             n = max(1, math.ceil(ROLLED / (m * ar.dx)))
             exact = sampled(ref, m, n)
@@ -259,8 +301,10 @@ def main() -> None:
                             label=f"local model (Kalker), V dt/a = {m * ar.dx / A:g}")
                 gap = float(np.max(np.abs(np.array(fast) - np.array(exact))))
                 err = abs(steady - ex_steady)
+                worst = max(levels[name], err)
                 rows.append((kind, m * ar.dx / A, name, exact[0], exact[-1], fast[0],
-                             fast[-1], gap, err, gap <= err + 0.02))
+                             fast[-1], gap, err, gap <= err + 0.02, worst,
+                             gap <= worst + 0.02))
         ax.set_title(f"step in {kind}")
         ax.set_xlabel("distance rolled / contact length 2a")
         ax.set_ylabel(f"{'Fx' if key == 'fx' else 'Fy'} / (mu N)")
@@ -283,39 +327,51 @@ def main() -> None:
              "catt_to_cart, `test/test_contact_exact_transient.py`); fast: "
              "`fastsim_ros/contact/transient.py` on each method's patch. Forces as F/(mu N) "
              "(Fx for the xi step, Fy for eta and phi). gap: the largest |fast - exact| "
-             "over the steps; steady error: |fast steady - exact steady|; ok: gap <= steady "
-             "error + 0.02 (issue 29).", "",
+             "over the steps; steady error: |fast steady - exact steady| at the step's "
+             "creepage; ok: gap <= steady error + 0.02 (issue 29). levels: the largest "
+             "steady error at the creepages the response passes through on its way (the "
+             f"step's creepage times {LEVELS[0]:g} to 1 in steps of {LEVELS[1] - LEVELS[0]:g}"
+             ", and the step's own), the steady method's own error over the levels of "
+             "force and the partial-slip states the build-up visits (FastSim's steady force "
+             "is up to 5 % too high in early partial slip, `fastsim_ros/contact/knee.py`); "
+             "ok (levels): gap <= that + 0.02.", "",
              f"![step responses](figures/{FIGURE.name})", "",
              "The figure: the exact response (black; its steady limit dotted), the "
              "calibrated MAE with the far field (solid) and Kalker's local model (dashed), "
              "in steps of a tenth and of one semi-axis.", "",
              "| step | V dt / a | method | exact 1st | exact last | fast 1st | fast last | "
-             "gap | steady error | ok |",
-             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
+             "gap | steady error | ok | steady error (levels) | ok (levels) |",
+             "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in rows:
         lines.append(f"| {r[0]} | {r[1]:g} | {r[2]} | {r[3]:.4f} | {r[4]:.4f} | "
                      f"{r[5]:.4f} | {r[6]:.4f} | {r[7]:.4f} | {r[8]:.4f} | "
-                     f"{'yes' if r[9] else 'no'} |")
+                     f"{'yes' if r[9] else 'no'} | {r[10]:.4f} | "
+                     f"{'yes' if r[11] else 'no'} |")
     ok = sum(r[9] for r in rows)
-    lines += ["", f"{ok} of {len(rows)} step responses within the criterion.", ""]
+    ok_levels = sum(r[11] for r in rows)
+    lines += ["", f"{ok} of {len(rows)} step responses within the criterion at the step's "
+              f"creepage, {ok_levels} of {len(rows)} over the levels.", ""]
     shapes = other_shapes()
-    measured = [r for r in shapes if len(r) == 7]
+    measured = [r for r in shapes if len(r) == 9]
     lines += ["## Other shapes", "",
               "Ellipses with a/b = 2 and 0.5 (a along the rolling direction, 6 or 3 mm, "
               f"{CELLS} x {CELLS} cells, the same load, material and steps):", "",
-              "| shape | step | V dt / a | method | gap | steady error | ok |",
-              "| --- | --- | --- | --- | --- | --- | --- |"]
+              "| shape | step | V dt / a | method | gap | steady error | ok | "
+              "steady error (levels) | ok (levels) |",
+              "| --- | --- | --- | --- | --- | --- | --- | --- | --- |"]
     for r in measured:
         lines.append(f"| {r[0]} | {r[1]} | {r[2]:g} | {r[3]} | {r[4]:.4f} | {r[5]:.4f} | "
-                     f"{'yes' if r[6] else 'no'} |")
+                     f"{'yes' if r[6] else 'no'} | {r[7]:.4f} | {'yes' if r[8] else 'no'} |")
     lines += ["", f"{sum(bool(r[6]) for r in measured)} of {len(measured)} within the "
-              "criterion."]
+              f"criterion at the step's creepage, {sum(bool(r[8]) for r in measured)} of "
+              f"{len(measured)} over the levels."]
     lines += [f"- {r[0]}, {r[1]}" for r in shapes if len(r) == 2]
-    misses = [r for r in rows if not r[9]] + [r for r in measured if not r[6]]
-    if misses:
-        excess = max((r[7] - r[8]) if len(r) == 10 else (r[4] - r[5]) for r in misses)
-        lines += ["", f"{len(misses)} misses; the largest excess over the criterion is "
-                  f"{excess - 0.02:.4f} of mu N."]
+    for label, circle, other in (("at the step's creepage", 9, 6), ("over the levels", 11, 8)):
+        misses = ([r[7] - r[circle - 1] for r in rows if not r[circle]]
+                  + [r[4] - r[other - 1] for r in measured if not r[other]])
+        if misses:
+            lines += ["", f"{label}: {len(misses)} misses; the largest excess over the "
+                      f"criterion is {max(misses) - 0.02:.4f} of mu N."]
     lines += convergence_section()
     lines += ["", "## The model", "",
               "The fast methods step with Kalker's non-steady FASTSIM and two additions "
@@ -349,7 +405,8 @@ def main() -> None:
               "elastic field outside the patch keeps a memory that decays about 7 % a cell "
               "rolled, `test_rolling_reaches_the_steady_state`).", ""]
     OUT.write_text("\n".join(lines))
-    print(f"wrote {OUT}: {ok} of {len(rows)} within the criterion")
+    print(f"wrote {OUT}: {ok} of {len(rows)} within the criterion at the step's creepage, "
+          f"{ok_levels} over the levels")
 
 
 if __name__ == "__main__":
