@@ -452,3 +452,29 @@ def test_the_carried_far_field_jacobian_changes_the_path_not_the_answer(solver_c
         assert abs(carried.fx - forgotten.fx) <= 2 * tol
         assert abs(carried.fy - forgotten.fy) <= 2 * tol
         state = new
+
+
+@pytest.mark.parametrize("solver_cls", SOLVERS)
+def test_a_steps_state_is_the_dataclass_it_names(solver_cls, patch) -> None:
+    """The state a step returns (made without the dataclass's ``__init__``) is one, frozen.
+
+    Every field is set, equal to the one the step computed and to a state
+    built field by field the usual way; it cannot be assigned to.
+    """
+    t = TransientSolver(solver_cls(NU, G))
+    _, state = _step(t, None, patch, (1e-3, 5e-4, 0.5), 1.5 * patch.dx, mu=MU)
+    names = [f.name for f in dataclasses.fields(state)]
+    assert sorted(vars(state)) == sorted(names)
+    built = type(state)(**{name: getattr(state, name) for name in names})
+    for name in names:
+        mine, theirs = getattr(state, name), getattr(built, name)
+        if isinstance(mine, np.ndarray):
+            assert mine is theirs
+        else:
+            assert mine == theirs and type(mine) is type(theirs), name
+    assert all(type(v) is float for v in (*state.grid, state.area, *state.centroid,
+                                          state.half_length, *state.force, *state.far_slope))
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        state.force = (0.0, 0.0)  # type: ignore[misc]
+    replaced = dataclasses.replace(state, force=(1.0, 2.0))
+    assert replaced.force == (1.0, 2.0) and replaced.grid == state.grid
