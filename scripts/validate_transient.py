@@ -100,9 +100,10 @@ def steady_envelope(a: float, b: float, creep: tuple[float, float, float], key: 
 
     A step response from zero traction passes through every level of force
     from zero to the steady one, and on its way its partial-slip states are
-    those of smaller steady creepages: FastSim's steady error there (up to
-    5 % of the force in early partial slip, ``fastsim_ros/contact/knee.py``)
-    is the steady method's own error at those levels.  So beside the error
+    those of smaller steady creepages: FastSim's steady error there (its
+    force is too high before the knee, ``fastsim_ros/contact/knee.py``; on
+    the circle here by up to 0.036 of mu N, at half the step's eta) is the
+    steady method's own error at those levels.  So beside the error
     at the step's creepage the report takes the largest one at the
     creepages ``f creep``, ``f`` in :data:`LEVELS` (the exact steady force
     converged in the cell as :func:`exact_reference`'s).
@@ -333,8 +334,8 @@ def main() -> None:
              f"step's creepage times {LEVELS[0]:g} to 1 in steps of {LEVELS[1] - LEVELS[0]:g}"
              ", and the step's own), the steady method's own error over the levels of "
              "force and the partial-slip states the build-up visits (FastSim's steady force "
-             "is up to 5 % too high in early partial slip, `fastsim_ros/contact/knee.py`); "
-             "ok (levels): gap <= that + 0.02.", "",
+             "is too high before the knee, `fastsim_ros/contact/knee.py`: the column says by "
+             "how much here); ok (levels): gap <= that + 0.02.", "",
              f"![step responses](figures/{FIGURE.name})", "",
              "The figure: the exact response (black; its steady limit dotted), the "
              "calibrated MAE with the far field (solid) and Kalker's local model (dashed), "
