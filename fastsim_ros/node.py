@@ -26,7 +26,7 @@ import math
 import signal
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 import fastsim_ros.numba_quietly  # noqa: F401  (first: numba without its coverage hook)
@@ -438,15 +438,34 @@ class _FrontEnd:
         return SetParametersResult(successful=True)
 
 
+@contextlib.contextmanager
+def _destroyed_on_failure(node: Node) -> Iterator[None]:
+    """Destroy ``node`` when its construction fails (a refused start), then re-raise.
+
+    The constructor that raises never returns the node to :func:`_run`,
+    which destroys only what it was given: the half-built node's entities
+    (its rcl node, parameter services, publishers) were left to the garbage
+    collector, after the context's shutdown or at the interpreter's exit,
+    while the middleware's threads wound down.
+    """
+    try:
+        yield
+    except BaseException:
+        with contextlib.suppress(Exception):
+            node.destroy_node()
+        raise
+
+
 class FastsimNode(_FrontEnd, Node):
     """Creep forces for every contact patch received (INTERFACE.md)."""
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
-        self._declare()
-        self._configure(log=self.get_logger().info)
-        self._open()
-        self.add_on_set_parameters_callback(self._set_running)
+        with _destroyed_on_failure(self):
+            self._declare()
+            self._configure(log=self.get_logger().info)
+            self._open()
+            self.add_on_set_parameters_callback(self._set_running)
 
 
 class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
@@ -472,8 +491,9 @@ class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
         self._active = False
         self._configured = False
         self._subs, self._pubs, self._wanted = {}, {}, set()
-        self._declare(start_only_read_only=False)
-        self.add_on_set_parameters_callback(self._on_set_parameters)
+        with _destroyed_on_failure(self):
+            self._declare(start_only_read_only=False)
+            self.add_on_set_parameters_callback(self._on_set_parameters)
 
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Check the parameters and build the pipeline (profiles, contact table)."""
@@ -514,6 +534,19 @@ class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
         """Release everything after an error in a transition; back to ``unconfigured``."""
         self._release()
         return TransitionCallbackReturn.SUCCESS
+
+    def destroy_node(self) -> None:
+        """Destroy the node and its lifecycle state machine, which holds the rcl node.
+
+        rclpy 7.1's ``LifecycleNode.destroy_node`` leaves the state machine
+        to the garbage collector, and the rcl node (in the graph, its
+        middleware entities) with it: measured, the node stayed in its
+        context's graph after ``destroy_node`` until the state machine went.
+        """
+        super().destroy_node()
+        machine = getattr(self, "_state_machine", None)
+        if machine is not None:
+            machine.destroy_when_not_in_use()
 
     def _release(self) -> None:
         self._active = False

@@ -176,3 +176,77 @@ def test_a_signal_while_the_node_is_importing_ends_it_with_exit_0(signum):
     out, _ = proc.communicate(timeout=HANG_SECONDS)
     assert proc.returncode == 0, out
     assert not any(w in out for w in ("Traceback", "Error", "error", "Fatal")), out
+
+
+@pytest.mark.parametrize("managed", [False, True], ids=["node", "lifecycle"])
+def test_a_refused_construction_destroys_its_half_built_node(managed):
+    """A constructor that refuses its parameters destroys the node it had made.
+
+    ``_run`` destroys only a node it was given; the refused one never
+    reached it, so its entities lived as long as the exception's traceback
+    or a reference cycle did, up to the garbage collector's pass after the
+    context's shutdown.  With the collector held off and the exception
+    held, the refused node is no longer in its context's graph as soon as
+    the constructor raised.  The lifecycle node's own ``destroy_node``
+    releases its state machine too (rclpy's left it, and the rcl node it
+    holds, to the collector: measured, the old code fails here).
+    """
+    import gc
+
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.signals import SignalHandlerOptions
+
+    from fastsim_ros.node import FastsimLifecycleNode, FastsimNode, StartupError
+
+    context = Context()
+    rclpy.init(args=["--ros-args", "-p", "wheelset_frame:=[1, 2]", "-p",
+                     "executor:=threads"], context=context,
+               domain_id=int(time.time()) % 100 + 110,
+               signal_handler_options=SignalHandlerOptions.NO)
+    probe = None
+    gc.disable()
+    try:
+        with pytest.raises(StartupError, match="wheelset_frame") as refused:
+            (FastsimLifecycleNode if managed else FastsimNode)(context=context)
+        probe = rclpy.create_node("fastsim_test_probe", context=context)
+        assert probe.get_node_names() == ["fastsim_test_probe"]
+        assert refused.tb is not None  # the traceback (and its frames) still held
+    finally:
+        gc.enable()
+        if probe is not None:
+            probe.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
+def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
+    """``destroy_node`` of the managed node takes its rcl node out of the graph then and there.
+
+    ``_run`` destroys the node, then shuts the context down: with rclpy's
+    ``LifecycleNode.destroy_node`` alone the rcl node, held by the state
+    machine, outlived the context's shutdown until the collector came.
+    """
+    import gc
+
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.signals import SignalHandlerOptions
+
+    from fastsim_ros.node import FastsimLifecycleNode
+
+    context = Context()
+    rclpy.init(args=[], context=context, domain_id=int(time.time()) % 100 + 110,
+               signal_handler_options=SignalHandlerOptions.NO)
+    probe = None
+    gc.disable()
+    try:
+        node = FastsimLifecycleNode(context=context)
+        probe = rclpy.create_node("fastsim_test_probe", context=context)
+        assert sorted(probe.get_node_names()) == ["fastsim", "fastsim_test_probe"]
+        node.destroy_node()
+        assert probe.get_node_names() == ["fastsim_test_probe"]
+    finally:
+        gc.enable()
+        if probe is not None:
+            probe.destroy_node()
+        rclpy.try_shutdown(context=context)
