@@ -72,8 +72,9 @@ def traction_cloud_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
                        grid: tuple[float, float, float, float]) -> bytes:
     """Return the solved traction as a serialized organised ``PointCloud2`` in the wheelset frame.
 
-    One point per cell of the solve's grid (``grid = (x0, y0, dx, dy)`` in
-    the contact plane), placed at ``origin + x e_x + y e_y``; ``tau_x``,
+    One point per cell of ``grid = (x0, y0, dx, dy)`` in the contact plane
+    (the patch's cells: the pipeline moves the equivalent ellipse's traction
+    there from its own grid), placed at ``origin + x e_x + y e_y``; ``tau_x``,
     ``tau_y``: traction of the rail on the wheel along the contact frame's
     axes (Pa); ``slip``: 1 where the cell is on the traction bound.
     Fields ``x y z tau_x tau_y`` float32 and ``slip`` uint8 (TRACTION_DTYPE).

@@ -271,6 +271,11 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
                             f"{max_cells}")
     if ny * nx == 0:
         _layout(cloud)
+        if len(cloud.data):
+            # a grid of no cells that carries points is malformed, not a lifted wheel: a
+            # width of 0 over a whole patch's data was published as a zero wrench
+            raise RejectedInput("irregular_grid", f"{len(cloud.data)} bytes of data for a "
+                                f"grid of {ny} x {nx} points")
         return None
     words, row, step, cols = _words(cloud)
     pressure = np.empty((ny, nx))

@@ -120,6 +120,21 @@ def test_empty_patch_is_no_contact():
     assert patch_from_cloud(cdr.read_cloud(to_cdr(empty)), max_cells=MAX) is None
 
 
+@pytest.mark.parametrize("emptied", ["width", "height"])
+def test_a_grid_of_no_points_over_a_patchs_data_is_irregular_not_empty(emptied):
+    """A zero width (or height) with the points still there is malformed, not a lifted wheel.
+
+    Before, the grid's size alone made it an empty patch: a zero wrench
+    published for a message that carried a whole loaded patch.
+    """
+    msg = cloud_msg(egg(), dtype="<f8")
+    setattr(msg, emptied, 0)
+    if emptied == "width":
+        msg.row_step = 0
+    error = rejected(msg, "irregular_grid")
+    assert f"{len(bytes(msg.data))} bytes" in str(error)
+
+
 def rejected(msg, reason, max_cells=MAX):
     with pytest.raises(RejectedInput) as info:
         convert(msg, max_cells)

@@ -17,6 +17,7 @@ import gzip
 import io
 import json
 import math
+import re
 import shutil
 import signal
 import subprocess
@@ -701,6 +702,32 @@ def test_bad_inputs_exit_2_and_leave_nothing_while_a_good_one_completes(tmp_path
     assert sorted(p.name for p in out.iterdir()) == ["hertz_ramp", "hertz_ramp.csv",
                                                      "hertz_ramp.png"]
     assert "hertz_ramp: 1600 messages in" in stdout
+
+
+def test_a_topic_without_a_usable_definition_is_one_line_naming_the_bag(tmp_path, capsys):
+    """A custom type whose definition the bag garbles: exit 2, the bag's path on its line.
+
+    The problem is found at a topic, below the file's level; before, its line
+    named the topic and the type but not the bag, so among several inputs
+    nobody could tell which one failed.
+    """
+    bag = tmp_path / "custom"
+    with Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as w:
+        c = w.add_connection("/weird", "my_pkg/msg/Foo", msgdef="this is not a definition",
+                             rihs01="RIHS01_" + "0" * 64)
+        w.write(c, 1, bytes(8))
+    # as a writer that knows no hash leaves it: the definition is then all there is
+    meta = bag / "metadata.yaml"
+    meta.write_text(re.sub(r"type_description_hash:\s*RIHS01_0+", 'type_description_hash: ""',
+                           meta.read_text()))
+    out = tmp_path / "out"
+    status, stdout, err = run([bag, BAGS / "hertz_ramp", "-o", out], capsys)
+    assert status == 2
+    line = err.strip().splitlines()[-1]
+    assert line.startswith(f"fastsim_replay: {bag}: topic /weird: no usable definition of "
+                           "type my_pkg/msg/Foo"), line
+    assert "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir()) == ["hertz_ramp"]
 
 
 def test_truncated_bag_from_the_console_script(tmp_path):

@@ -146,6 +146,57 @@ def turned_grid(pressure: FloatArray, x0: float, y0: float, dx: float,
     return (p, -(x0 + (p.shape[1] - 1) * dx), -(y0 + (p.shape[0] - 1) * dy))
 
 
+def regridded(values: FloatArray, grid: tuple[float, float, float, float],
+              new_grid: tuple[float, float, float, float],
+              shape: tuple[int, int]) -> FloatArray:
+    """Return ``values`` on ``grid`` ``(x0, y0, dx, dy)`` (m) at the cell centres of another.
+
+    Bilinear between the four cells around each new centre, zero outside the
+    old grid (the values taken to fall to zero over half a cell beyond its
+    edge cells); ``shape``: the new grid's ``(ny, nx)``.
+    """
+    x0, y0, dx, dy = new_grid
+    ny, nx = shape
+    ox, oy, odx, ody = grid
+    ony, onx = values.shape
+    # fractional indices of the new cell centres in the old grid
+    fi = (x0 + dx * np.arange(nx) - ox) / odx
+    fj = (y0 + dy * np.arange(ny) - oy) / ody
+    # pad by one zero cell on each side: zero outside the old grid
+    padded = np.zeros((ony + 2, onx + 2))
+    padded[1:-1, 1:-1] = values
+    i = np.clip(fi + 1.0, 0.0, onx + 1.0 - 1e-9)
+    j = np.clip(fj + 1.0, 0.0, ony + 1.0 - 1e-9)
+    i0 = np.minimum(np.floor(i).astype(np.int64), onx)
+    j0 = np.minimum(np.floor(j).astype(np.int64), ony)
+    wi = (i - i0)[None, :]
+    wj = (j - j0)[:, None]
+    a = padded[np.ix_(j0, i0)]
+    b = padded[np.ix_(j0, i0 + 1)]
+    c = padded[np.ix_(j0 + 1, i0)]
+    d = padded[np.ix_(j0 + 1, i0 + 1)]
+    out: FloatArray = (1 - wj) * ((1 - wi) * a + wi * b) + wj * ((1 - wi) * c + wi * d)
+    return out
+
+
+def nearest_cells(values: NDArray[np.bool_], grid: tuple[float, float, float, float],
+                  new_grid: tuple[float, float, float, float],
+                  shape: tuple[int, int]) -> NDArray[np.bool_]:
+    """Return flags on ``grid`` at another grid's cell centres: the nearest cell's, False outside.
+
+    As :func:`regridded` for values that do not interpolate (a cell's slip).
+    """
+    x0, y0, dx, dy = new_grid
+    ny, nx = shape
+    ox, oy, odx, ody = grid
+    ony, onx = values.shape
+    i = np.rint((x0 + dx * np.arange(nx) - ox) / odx).astype(np.int64)
+    j = np.rint((y0 + dy * np.arange(ny) - oy) / ody).astype(np.int64)
+    inside = ((j >= 0) & (j < ony))[:, None] & ((i >= 0) & (i < onx))[None, :]
+    out: NDArray[np.bool_] = values[np.ix_(np.clip(j, 0, ony - 1), np.clip(i, 0, onx - 1))]
+    return out & inside
+
+
 def ellipse(a: float, b: float, *, nx: int, ny: int | None = None,
             load: float | None = None, pressure: str = "hertz") -> GridArea:
     """Make an ellipse with semi-axes ``a`` (along x) and ``b`` (m) on ``nx`` x ``ny`` cells.

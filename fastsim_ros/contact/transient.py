@@ -86,6 +86,7 @@ from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from fastsim_ros.contact import kernels as k
+from fastsim_ros.contact.area import regridded
 from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (ContactForces, EquivalentEllipseSolver, MaeSolver,
                                           _law, _pressure, _raise, warm_up_case)
@@ -596,30 +597,8 @@ class TractionState:
     def resampled(self, grid: tuple[float, float, float, float],
                   shape: tuple[int, int]) -> tuple[FloatArray, FloatArray]:
         """Return the tractions interpolated bilinearly on another grid (zero outside this one)."""
-        x0, y0, dx, dy = grid
-        ny, nx = shape
-        ox, oy, odx, ody = self.grid
-        ony, onx = self.tau_x.shape
-        # fractional indices of the new cell centres in the old grid
-        fi = (x0 + dx * np.arange(nx) - ox) / odx
-        fj = (y0 + dy * np.arange(ny) - oy) / ody
-        out = []
-        for tau in (self.tau_x, self.tau_y):
-            # pad by one zero cell on each side: zero traction outside the old grid
-            padded = np.zeros((ony + 2, onx + 2))
-            padded[1:-1, 1:-1] = tau
-            i = np.clip(fi + 1.0, 0.0, onx + 1.0 - 1e-9)
-            j = np.clip(fj + 1.0, 0.0, ony + 1.0 - 1e-9)
-            i0 = np.minimum(np.floor(i).astype(np.int64), onx)
-            j0 = np.minimum(np.floor(j).astype(np.int64), ony)
-            wi = (i - i0)[None, :]
-            wj = (j - j0)[:, None]
-            a = padded[np.ix_(j0, i0)]
-            b = padded[np.ix_(j0, i0 + 1)]
-            c = padded[np.ix_(j0 + 1, i0)]
-            d = padded[np.ix_(j0 + 1, i0 + 1)]
-            out.append((1 - wj) * ((1 - wi) * a + wi * b) + wj * ((1 - wi) * c + wi * d))
-        return out[0], out[1]
+        return (regridded(self.tau_x, self.grid, grid, shape),
+                regridded(self.tau_y, self.grid, grid, shape))
 
 
 _new_object = object.__new__

@@ -243,7 +243,11 @@ def _run_local(task: Task, profile: bool) -> Result:
         if task.retry:
             faults.pause("committed")
     except BadInput as e:
-        result.status, result.error = 2, str(e)
+        # one line naming the file (INTERFACE.md): a problem found below the file's level
+        # (a topic's definition) names only what it saw
+        error = str(e)
+        result.status = 2
+        result.error = error if error.startswith(str(source)) else f"{source}: {error}"
     except OutputError as e:
         result.status, result.error = 1, str(e)
     except OSError as e:
