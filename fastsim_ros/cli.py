@@ -31,6 +31,7 @@ import argparse
 import csv
 import json
 import math
+import os
 import re
 import sys
 import warnings
@@ -52,6 +53,9 @@ from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, 
 #: flexibilities make FastSim give its zones' coefficients on any grid (Kalker's
 #: on an ellipse, to rounding): the grid enters through the zones' geometry
 #: only, as for ``mae``, hence the same 100 cells.
+#: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
+#: fewer than twice this is solved on its grid alone
+EXACT_COARSEST = 8
 DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
                  "dlm": 100, "asm": 100,
                  "exact_forces": 60, "mae_forces": 60, "mae_calibrated_forces": 60,
@@ -352,6 +356,9 @@ def _patch_alone(args: argparse.Namespace) -> None:
     if given:
         raise UsageError(f"give either --patch or the shape's flags ({', '.join(given)}), "
                          "not both")
+    if getattr(args, "cells", None) is not None:
+        # it was ignored without a word: a patch file's grid is its own
+        raise UsageError("--cells sets a shape's grid; a --patch file keeps its own cells")
 
 
 def _shape_maker(args: argparse.Namespace) -> tuple[Callable[[int], areas.GridArea], str]:
@@ -458,12 +465,28 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
                       speed=args.speed)
     creepages = (args.xi, args.eta, args.phi)
     speed = None if args.speed is None else abs(args.speed)
+    cells = [patch.nx, patch.ny]
     if args.method == "exact":
         from fastsim_ros.contact import exact
         _check_exact_grid(patch, forces=True)
         sol = exact.coulomb(patch, *creepages, nu=args.nu, shear_modulus=args.shear_modulus,
                             friction=law, speed=speed)
-        result.update(Fx=sol.fx, Fy=sol.fy, Mz=sol.mz, slip_fraction=float(
+        fx, fy, mz = sol.fx, sol.fy, sol.mz
+        n = patch.nx
+        if args.patch is None and n >= 2 * EXACT_COARSEST:
+            # the exact forces converge in the cell at first order (the rigid slip taken at
+            # a cell's end, the upstream difference: METHOD.md 5): on 60 cells an ellipse's
+            # Fy under spin is 1.7% off its limit, so a shape's forces are extrapolated
+            # from n/2 and n cells, F = (n F_n - m F_m) / (n - m)
+            m = n // 2
+            coarse = exact.coulomb(areas.ellipse(args.a, args.b, nx=m, ny=m, load=args.load),
+                                   *creepages, nu=args.nu, shear_modulus=args.shear_modulus,
+                                   friction=law, speed=speed)
+            fx, fy, mz = ((n * f - m * c) / (n - m) for f, c in
+                          ((sol.fx, coarse.fx), (sol.fy, coarse.fy), (sol.mz, coarse.mz)))
+            cells = [m, n]
+            result.update(extrapolated=True)
+        result.update(Fx=fx, Fy=fy, Mz=mz, slip_fraction=float(
             np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
     elif args.method in ("mae", "mae_calibrated"):
         from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
@@ -501,7 +524,7 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
                       ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
     _finite_result(result, FORCE_KEYS)
-    result["cells"] = [patch.nx, patch.ny]
+    result["cells"] = cells
     return result
 
 
@@ -555,6 +578,9 @@ def _force_area(args: argparse.Namespace) -> areas.GridArea:
         return patch.with_load(args.load)
     if args.shape != "ellipse" or args.a is None or args.b is None:
         raise UsageError("forces need --shape ellipse --a A --b B (with --load) or --patch FILE")
+    if getattr(args, "a_over_b", None) is not None:
+        # it was dropped without a word: the semi-axes give the ratio
+        raise UsageError("--a-over-b is for coefficients: forces take the semi-axes --a and --b")
     if args.load is None:
         raise UsageError("--load is required with --shape ellipse --a A --b B")
     _in_range("--a", args.a, "length", " m")
@@ -569,7 +595,9 @@ def _check_load(load: float, unit: areas.GridArea) -> None:
     lo, hi = LIMITS["pressure"]
     peak = float(unit.pressure.max()) * (load / unit.load)  # floats: inf, not an error
     if not lo <= peak <= hi:
-        raise InvalidInputError(f"--load {load:g} N gives a largest pressure of {peak:.3g} Pa; "
+        # an overflowing peak is told as above the limit (no non-finite number printed)
+        told = f"of {peak:.3g} Pa" if math.isfinite(peak) else f"above {hi:g} Pa"
+        raise InvalidInputError(f"--load {load:g} N gives a largest pressure {told}; "
                                 f"pressures must lie in [{lo:g}, {hi:g}] Pa")
 
 
@@ -643,8 +671,22 @@ def main(argv: Sequence[str] | None = None) -> int:
             _print_table(args.command, result)
         sys.stdout.flush()
     except BrokenPipeError:  # e.g. piped into head
+        _quiet_stdout()
         return 0
+    except OSError as e:  # a full disk, a closed descriptor: one line, not a traceback
+        _quiet_stdout()
+        print(f"fastsim_contact: error: cannot write the answer: {e.strerror or e}",
+              file=sys.stderr)
+        return 1
     return 0
+
+
+def _quiet_stdout() -> None:
+    """Point stdout at the null device: the interpreter's last flush at exit fails again."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":

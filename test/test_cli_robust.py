@@ -445,3 +445,89 @@ def test_a_shapes_flags_beside_a_patch_are_refused(tmp_path, capsys, command, ex
 def test_estimate_names_its_measured_file_in_read_errors(tmp_path, capsys):
     rc, out, err = run(capsys, "estimate", *ELLIPSE, "--measured", tmp_path / "none.csv")
     assert_refused(rc, out, err, f"cannot read measured file {tmp_path / 'none.csv'}")
+
+
+# ------------------------------------------------------ from an audit of the contract (stop 41)
+
+@pytest.mark.parametrize("cells", ["4", "5"])
+def test_an_extrapolation_of_one_grid_is_refused(capsys, cells):
+    """Exact coefficients on 4 or 5 cells have one grid to fit: refused (a fit gave half C11)."""
+    assert_refused(*run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "1",
+                        "--cells", cells), "an extrapolation needs two grids at least")
+
+
+@pytest.mark.parametrize("cells, grids", [("6", [4, 6]), ("7", [4, 6]), ("9", [4, 6, 8])])
+def test_an_extrapolation_solves_no_grid_finer_than_asked(capsys, cells, grids):
+    res = assert_answered(*run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "1",
+                               "--cells", cells, "--json"))
+    assert res["cells"] == grids and res["extrapolated"]
+    assert res["C11"] == pytest.approx(4.12, rel=0.1)  # Kalker's, a/b = 1, nu = 0.25
+
+
+@pytest.mark.parametrize("command", ["coefficients", "forces"])
+@pytest.mark.parametrize("rows", [["0,0,1e9", "0.001,0,0", "0,0.001,0"],
+                                  ["0,0,1e9", "0,0.001,1e9", "0,0.002,1e9", "0.001,0,0"]],
+                         ids=["one-cell", "one-column"])
+def test_dlm_on_a_patch_too_thin_to_level_is_bad_input(capsys, tmp_path, command, rows):
+    """DLM's levelling needs a patch of some width: one line, exit 2 (was exit 1, a nan)."""
+    patch = tmp_path / "thin.csv"
+    patch.write_text("x,y,pressure\n" + "\n".join(rows) + "\n")
+    argv = [command, "--patch", patch, "--method", "dlm"]
+    if command == "forces":
+        argv += CREEP
+    rc, out, err = run(capsys, *argv)
+    assert_refused(rc, out, err, "too thin")
+    assert "nan" not in err
+
+
+def test_cells_beside_a_patch_and_a_over_b_beside_forces_are_refused(capsys):
+    """Flags dropped without a word before: each is named."""
+    assert_refused(*run(capsys, "coefficients", "--patch", EXAMPLE, "--cells", "20",
+                        "--method", "mae"), "--cells sets a shape's grid")
+    assert_refused(*run(capsys, "forces", *ELLIPSE, "--a-over-b", "2", *CREEP),
+                   "--a-over-b is for coefficients")
+
+
+def test_coordinates_whose_gaps_underflow_name_no_nan(capsys, tmp_path):
+    patch = tmp_path / "tiny.csv"
+    patch.write_text("x,y,pressure\n" + "\n".join(
+        f"{x!r},{y!r},1e9" for x in (0.0, 1e-303, 2e-303) for y in (0.0, 1e-303, 2e-303)))
+    rc, out, err = run(capsys, "coefficients", "--patch", patch)
+    assert_refused(rc, out, err, "no cell size along x can be found")
+    assert "nan" not in err and "inf" not in err
+
+
+def test_an_overflowing_load_is_told_without_inf(capsys):
+    argv = dict(zip(ELLIPSE[::2], ELLIPSE[1::2]), **{"--load": "1e308"})
+    rc, out, err = run(capsys, "forces", *[v for kv in argv.items() for v in kv], *CREEP)
+    assert_refused(rc, out, err, "gives a largest pressure above 1e+13 Pa")
+    assert "inf" not in err
+
+
+def test_an_answer_that_cannot_be_written_is_one_line(tmp_path):
+    """stdout on a full device: one line on stderr, no traceback (was an OSError's)."""
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "fastsim_ros.cli", "coefficients",
+                               "--shape", "ellipse", "--a-over-b", "1", "--method", "mae",
+                               "--cells", "10", "--json"], stdout=full, stderr=subprocess.PIPE,
+                              text=True, cwd=Path(__file__).resolve().parents[1], timeout=120)
+    assert proc.returncode == 1
+    assert proc.stderr.strip().splitlines() == [
+        "fastsim_contact: error: cannot write the answer: No space left on device"]
+
+
+def test_exact_forces_on_a_shape_are_extrapolated_within_one_percent(capsys):
+    """INTERFACE.md: exact's default grid converged within 1%; on 60 cells alone Fy was 1.7% off.
+
+    An ellipse under spin (the audit's case): the default answer, extrapolated
+    from 30 and 60 cells, against the extrapolation from 60 and 120.
+    """
+    argv = ["forces", "--shape", "ellipse", "--a", "0.006", "--b", "0.004", "--load", "1e5",
+            "--xi", "1e-5", "--eta", "0", "--phi", "5", "--mu", "0.3", "--method", "exact",
+            "--json"]
+    default = assert_answered(*run(capsys, *argv))
+    fine = assert_answered(*run(capsys, *argv, "--cells", "120"))
+    assert default["cells"] == [30, 60] and default["extrapolated"]
+    assert fine["cells"] == [60, 120]
+    for key in ("Fy", "Mz"):
+        assert default[key] == pytest.approx(fine[key], rel=0.01), key

@@ -277,6 +277,11 @@ def from_cells(x: FloatArray, y: FloatArray, pressure: FloatArray, *,
         raise InvalidInputError("negative pressure")
     ux, dx = _spacing(x, "x", rtol)
     uy, dy = _spacing(y, "y", rtol)
+    for name, h, u in (("x", dx, ux), ("y", dy, uy)):
+        if not (math.isfinite(h) and h > 0.0):
+            # coordinates so close that their gaps underflow (1e-303 m apart): no grid
+            raise IrregularGridError(f"no cell size along {name} can be found: the {name} "
+                                     f"coordinates span {float(u[-1] - u[0]):.3g} m")
     # the grid's size from the spacing alone: no index array yet, nothing allocated
     nx = _span_cells(ux, dx)
     ny = _span_cells(uy, dy)

@@ -48,6 +48,7 @@ from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.asm import (CalibratedFlexibility, FlexibilityMethod, centroid,
                                      strip_runs)
 from fastsim_ros.contact.checks import check_material
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.fastsim import sweep_integrals
 from fastsim_ros.contact.influence import influence_kernel
 
@@ -196,7 +197,10 @@ def dlm_flexibility(area: GridArea, *, nu: float, shear_modulus: float,
     x_c, y_c = centroid(area)
     for l_k in (it.l1[-1], it.l2[-1], it.l3[-1]):
         if not (math.isfinite(l_k) and l_k > 0.0):
-            raise ValueError(f"the levelling gave no positive flexibility ({l_k:g} m/Pa)")
+            # a patch too thin to level (one loaded cell, a single column or row): the
+            # area's fault, told as such (a plain ValueError was the CLI's internal error)
+            raise InvalidInputError("DLM's levelling gave no positive flexibility: the patch "
+                                    "is too thin for it (one cell or one line of cells)")
     return CalibratedFlexibility(it.l1[-1], it.l2[-1], it.l3[-1], x_c, y_c)
 
 

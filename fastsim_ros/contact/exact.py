@@ -440,8 +440,15 @@ EXTRAPOLATION_GRIDS = (0.4, 0.6, 0.8, 1.0)
 
 
 def extrapolation_grids(finest: int) -> list[int]:
-    """Return the even cell counts of an extrapolation up to ``finest`` cells across."""
-    return sorted({max(4, 2 * round(f * finest / 2)) for f in EXTRAPOLATION_GRIDS})
+    """Return the even cell counts of an extrapolation up to ``finest`` cells across.
+
+    None above ``finest`` (an odd count rounded up to the next even one
+    before, ``--cells 7`` solved on 8); fewer than two for ``finest`` below
+    6, where no line can be fitted: :func:`extrapolated_coefficients` then
+    refuses.
+    """
+    top = finest - finest % 2
+    return sorted({min(top, max(4, 2 * round(f * finest / 2))) for f in EXTRAPOLATION_GRIDS})
 
 
 def extrapolated_coefficients(shape: ShapeName, ratios: tuple[float, ...], *, nu: float,
@@ -478,6 +485,10 @@ def _extrapolated(shape: str, ratios: tuple[float, ...], nu: float,
         raise InvalidInputError(f"unknown shape {shape!r} with a/b {ratios}: an ellipse takes "
                                 "one ratio, semi-ellipses two")
     grids = extrapolation_grids(finest)
+    if len(grids) < 2:
+        # one grid fits no line: numpy's rank-deficient fit gave half the coefficients
+        raise InvalidInputError(f"an extrapolation needs two grids at least: {finest} cells "
+                                "across give one (6 or more do)")
     per = [creep_coefficients(make(n), nu=nu) for n in grids]
     h = np.array([1.0 / n for n in grids])
     fit = {key: float(np.polyfit(h, [getattr(c, key) for c in per], 1)[1])
