@@ -166,6 +166,25 @@ class _FrontEnd:
     _diagnostics: Publisher | None = None
     _timer: Any = None
 
+    def _apply_descriptor(self, parameter: Parameter, descriptor: Any = None,
+                          check_read_only: bool = True) -> SetParametersResult:
+        """Check a value against its descriptor as rclpy does, completing a wrong type's reason.
+
+        rclpy refuses a value of another type before any callback of ours
+        runs, with "Wrong parameter type, expected ... got ..." alone;
+        INTERFACE.md wants every refusal to name the parameter and its range.
+        The reason keeps rclpy's words first (rclpy maps them to its type
+        exception) and adds the parameter's name and what it takes.
+        """
+        result: SetParametersResult = super()._apply_descriptor(  # type: ignore[misc]
+            parameter, descriptor, check_read_only)
+        spec = parameters.SPECS.get(parameter.name)
+        if (not result.successful and spec is not None
+                and result.reason.startswith("Wrong parameter type")):
+            result.reason = (f"{result.reason} for parameter {parameter.name!r}: it must be "
+                             f"{spec.allowed()}")
+        return result
+
     # --- the three steps --------------------------------------------------------------
     def _declare(self, *, start_only_read_only: bool = True) -> None:
         """Declare every parameter; ``contacts`` defaults to the profiles' four in that mode.

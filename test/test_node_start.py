@@ -250,3 +250,39 @@ def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
         if probe is not None:
             probe.destroy_node()
         rclpy.try_shutdown(context=context)
+
+
+def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range():
+    """INTERFACE.md: a bad value is refused naming the parameter and the allowed range.
+
+    rclpy refuses a value of another type before the node's callbacks see
+    it, with "Wrong parameter type ..." alone; the reason now goes on with
+    the parameter's name and what it takes (rclpy's words first: it maps them
+    to its type exception).  An out-of-range value names both already.
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.parameter import Parameter
+    from rclpy.signals import SignalHandlerOptions
+
+    from fastsim_ros.node import FastsimLifecycleNode
+
+    context = Context()
+    rclpy.init(args=[], context=context, domain_id=int(time.time()) % 100 + 110,
+               signal_handler_options=SignalHandlerOptions.NO)
+    node = None
+    try:
+        node = FastsimLifecycleNode(context=context)
+        for name, value in (("friction_coefficient", "abc"), ("method", 3),
+                            ("publish_traction", 1.5)):
+            result, = node.set_parameters([Parameter(name, value=value)])
+            assert not result.successful
+            assert result.reason.startswith("Wrong parameter type"), result.reason
+            assert f"for parameter {name!r}: it must be " in result.reason, result.reason
+        result, = node.set_parameters([Parameter("friction_coefficient", value="abc")])
+        assert result.reason.endswith("in [0.001, 5]")
+        assert node.get_parameter("friction_coefficient").value == 0.3
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown(context=context)
