@@ -351,12 +351,22 @@ class _FrontEnd:
         return out
 
     def _matched(self, topic: str) -> Callable[[Any], None]:
-        """Return the matched-event callback of an output topic's publisher."""
+        """Return the matched-event callback of an output topic's publisher.
+
+        A contact's frame topic that gains a subscriber has the frame
+        published at the contact's next solve, moved or not (a viewer
+        started after the node on a steady rig got none).
+        """
+        frame_of = next((c for c in self.pipeline.config.contacts
+                         if topic == f"contact/{c}/frame"), None)
+
         def matched(status: Any) -> None:
             if status.current_count > 0:
                 self._wanted.add(topic)
             else:
                 self._wanted.discard(topic)
+            if frame_of is not None and status.current_count_change > 0:
+                self.pipeline.republish_frame(frame_of)
         return matched
 
     def _input_callback(self, spec: InputTopic) -> Callable[[bytes], None]:

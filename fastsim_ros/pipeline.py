@@ -1179,6 +1179,16 @@ class Pipeline:
         """Return a copy of the contact's cumulative counts by status."""
         return dict(self._contacts[contact].stats.counts)
 
+    def republish_frame(self, contact: str) -> None:
+        """Have the contact's next solve publish its frame, moved or not.
+
+        The frame is published when it changes (INTERFACE.md), to whoever
+        subscribes then: on a steady rig a subscriber that joins later (a
+        viewer started after the node) never got one.  The node calls this
+        when the frame's topic gains a subscriber.
+        """
+        self._contacts[contact].last_frame = None
+
     def report(self, contact: str) -> ContactReport:
         """Return the contact's diagnostics and start a new rate window."""
         stats = self._contacts[contact].stats

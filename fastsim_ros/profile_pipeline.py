@@ -264,6 +264,10 @@ class ProfilePipeline:
         """Return a contact's cumulative counts by status."""
         return self.pipeline.counts(contact)
 
+    def republish_frame(self, contact: str) -> None:
+        """Have the contact's next solve publish its frame (:meth:`Pipeline.republish_frame`)."""
+        self.pipeline.republish_frame(contact)
+
     def solve_time_percentiles(self, contact: str) -> tuple[float, float]:
         """Return a contact's solve-time p50 and p99 (us)."""
         return self.pipeline.solve_time_percentiles(contact)

@@ -12,6 +12,7 @@ import subprocess
 
 import numpy as np
 import pytest
+from geometry_msgs.msg import PoseStamped
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import samples
@@ -117,6 +118,28 @@ def test_wrenches_equal_the_library_for_every_method(run_node, contacts):
     assert client.wheelset[-1].header.frame_id == "wheelset"
     assert client.wheelset[-1].wrench.force.z == pytest.approx(
         sum(w[-1].wrench.force.z for w in client.wrenches.values()), rel=1e-12)
+
+
+def test_a_frame_subscriber_that_joins_late_gets_the_frame_at_the_next_solve(run_node):
+    """The frame is published when it changes: a viewer that joins a steady rig later got none.
+
+    A subscription to ``contact/left/frame`` made after the first solves
+    receives the (unmoved) frame at the next solve, and once only.
+    """
+    proc, client = run_node("-p", 'contacts:=["left"]', contacts=("left",))
+    send_twist(client, rolling_twist(1e-3, stamp_ns=T0))
+    for k in range(2):
+        assert len(exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 + (k + 1) * MS,
+                                                      dtype="<f8"))) == 1
+    frames = client.subscribe(PoseStamped, "contact/left/frame")
+    client.wait_connected(proc)
+    for k in range(2, 5):
+        assert len(exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 + (k + 1) * MS,
+                                                      dtype="<f8"))) == 1
+    assert client.wait_for(lambda: len(frames) >= 1)
+    client.spin(0.2)
+    assert [stamp_ns(f) for f in frames] == [T0 + 3 * MS]
+    assert frames[0].header.frame_id == "wheelset"
 
 
 def test_roller_rig_config(run_node):

@@ -310,6 +310,19 @@ def test_messages_of_a_solve():
     assert "contact/left/frame" not in dict(pipe.messages(again))
 
 
+def test_a_frame_asked_for_again_is_published_at_the_next_solve_once():
+    # the node asks when the frame's topic gains a subscriber (a viewer joining late)
+    pipe = make()
+    pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0)))
+    published = []
+    for k in range(5):
+        if k == 3:
+            pipe.republish_frame("left")
+        out = solve(pipe, egg(), stamp=T0 + (k + 1) * MS)
+        published.append("contact/left/frame" in dict(pipe.messages(out)))
+    assert published == [True, False, False, True, False]
+
+
 def test_messages_only_for_the_topics_wanted():
     # the node encodes only what somebody subscribes to; without a choice, everything
     pipe = make(contacts=["left", "right"])
