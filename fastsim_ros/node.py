@@ -365,7 +365,9 @@ class _FrontEnd:
                 self._wanted.add(topic)
             else:
                 self._wanted.discard(topic)
-            if frame_of is not None and status.current_count_change > 0:
+            # (a managed node between cleanup and configure has no pipeline)
+            if (frame_of is not None and status.current_count_change > 0
+                    and hasattr(self, "pipeline")):
                 self.pipeline.republish_frame(frame_of)
         return matched
 
