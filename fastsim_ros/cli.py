@@ -53,14 +53,14 @@ from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, 
 #: flexibilities make FastSim give its zones' coefficients on any grid (Kalker's
 #: on an ellipse, to rounding): the grid enters through the zones' geometry
 #: only, as for ``mae``, hence the same 100 cells.
-#: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
-#: fewer than twice this is solved on its grid alone
-EXACT_COARSEST = 8
 DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
                  "dlm": 100, "asm": 100,
                  "exact_forces": 60, "mae_forces": 60, "mae_calibrated_forces": 60,
                  "fastsim_ellipse_forces": 60, "fastrip_forces": 60, "dlm_forces": 60,
                  "asm_forces": 60}
+#: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
+#: fewer than twice this is solved on its grid alone
+EXACT_COARSEST = 8
 #: the methods of ``coefficients`` and of ``forces`` (the first: ``forces``' default)
 COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
 FORCE_METHODS = ("mae", "mae_calibrated", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
