@@ -146,6 +146,16 @@ def turned_grid(pressure: FloatArray, x0: float, y0: float, dx: float,
     return (p, -(x0 + (p.shape[1] - 1) * dx), -(y0 + (p.shape[0] - 1) * dy))
 
 
+def _centres_in(grid: tuple[float, float, float, float],
+                new_grid: tuple[float, float, float, float],
+                shape: tuple[int, int]) -> tuple[NDArray[np.floating], NDArray[np.floating]]:
+    """Return the new grid's cell centres as fractional ``(column, row)`` indices of ``grid``."""
+    x0, y0, dx, dy = new_grid
+    ny, nx = shape
+    ox, oy, odx, ody = grid
+    return (x0 + dx * np.arange(nx) - ox) / odx, (y0 + dy * np.arange(ny) - oy) / ody
+
+
 def regridded(values: FloatArray, grid: tuple[float, float, float, float],
               new_grid: tuple[float, float, float, float],
               shape: tuple[int, int]) -> FloatArray:
@@ -155,13 +165,8 @@ def regridded(values: FloatArray, grid: tuple[float, float, float, float],
     old grid (the values taken to fall to zero over half a cell beyond its
     edge cells); ``shape``: the new grid's ``(ny, nx)``.
     """
-    x0, y0, dx, dy = new_grid
-    ny, nx = shape
-    ox, oy, odx, ody = grid
     ony, onx = values.shape
-    # fractional indices of the new cell centres in the old grid
-    fi = (x0 + dx * np.arange(nx) - ox) / odx
-    fj = (y0 + dy * np.arange(ny) - oy) / ody
+    fi, fj = _centres_in(grid, new_grid, shape)
     # pad by one zero cell on each side: zero outside the old grid
     padded = np.zeros((ony + 2, onx + 2))
     padded[1:-1, 1:-1] = values
@@ -186,12 +191,10 @@ def nearest_cells(values: NDArray[np.bool_], grid: tuple[float, float, float, fl
 
     As :func:`regridded` for values that do not interpolate (a cell's slip).
     """
-    x0, y0, dx, dy = new_grid
-    ny, nx = shape
-    ox, oy, odx, ody = grid
     ony, onx = values.shape
-    i = np.rint((x0 + dx * np.arange(nx) - ox) / odx).astype(np.int64)
-    j = np.rint((y0 + dy * np.arange(ny) - oy) / ody).astype(np.int64)
+    fi, fj = _centres_in(grid, new_grid, shape)
+    i = np.rint(fi).astype(np.int64)
+    j = np.rint(fj).astype(np.int64)
     inside = ((j >= 0) & (j < ony))[:, None] & ((i >= 0) & (i < onx))[None, :]
     out: NDArray[np.bool_] = values[np.ix_(np.clip(j, 0, ony - 1), np.clip(i, 0, onx - 1))]
     return out & inside
