@@ -44,8 +44,8 @@ from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
 from fastsim_ros.estimation.model import model_error
 from fastsim_ros.contact import kernels as contact_kernels
-from fastsim_ros.contact.transient import (RESET_REASONS, ContactMemory, TractionState,
-                                           TransientSolver)
+from fastsim_ros.contact.transient import (RESET_REASONS, ContactMemory, TransientSolver,
+                                           mae_state)
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
 from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist, stamped_doubles,
@@ -911,13 +911,9 @@ class Pipeline:
             _, _, tau_x, tau_y, _, geo = state_arrays
             sign = -1.0 if result[fast.SPEED] < 0.0 else 1.0  # the forces of the turned patch
             j_xx, j_xy, j_yx, j_yy = mem[fast.MEM_FAR_SLOPE:fast.MEM_FAR_SLOPE + 4].tolist()
-            new = TractionState(tau_x, tau_y, previous.grid, float(geo[contact_kernels.G_AREA]),
-                                (float(geo[contact_kernels.G_XC]),
-                                 float(geo[contact_kernels.G_YC])),
-                                float(geo[contact_kernels.G_ELLIPSE + 2]),
-                                force=(sign * float(result[fast.FX]),
-                                       sign * float(result[fast.FY])),
-                                far_slope=(j_xx, j_xy, j_yx, j_yy))
+            new = mae_state(tau_x, tau_y, previous.grid, geo,
+                            (sign * float(result[fast.FX]), sign * float(result[fast.FY])),
+                            (j_xx, j_xy, j_yx, j_yy))
             (o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2) = frame_out[
                 patch_kernels.ORIGIN:patch_kernels.E_Y + 3].tolist()
             if not memory.take(cloud.stamp_ns, float(result[fast.SPEED]), new,

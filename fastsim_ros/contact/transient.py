@@ -628,6 +628,27 @@ def _made(tau_x: FloatArray, tau_y: FloatArray, grid: tuple[float, float, float,
     return state
 
 
+def mae_state(tau_x: FloatArray, tau_y: FloatArray, grid: tuple[float, float, float, float],
+              geo: FloatArray, force: tuple[float, float],
+              far_slope: tuple[float, float, float, float]) -> TractionState:
+    """Return the state a MAE step leaves: its tractions, with the measures of the jump rule.
+
+    ``geo``: the step's MAE geometry (:data:`~kernels.GEO_SIZE`): the
+    patch's area, centroid and half length (its equivalent ellipse's ``a``)
+    for :class:`ContactMemory`; ``force`` (N) and ``far_slope`` as
+    :class:`TractionState`'s: the pipeline's compiled path
+    (``pipeline.Pipeline``) builds its state here, as
+    :meth:`TransientSolver.step` does from :func:`_mae_measures`.
+    """
+    return _made(tau_x, tau_y, grid, *_mae_measures(geo), force, far_slope)
+
+
+def _mae_measures(geo: FloatArray) -> tuple[float, tuple[float, float], float]:
+    """Return the patch's area, centroid and half length (m^2, m, m) from a MAE geometry."""
+    g = geo.tolist()
+    return g[k.G_AREA], (g[k.G_XC], g[k.G_YC]), g[k.G_ELLIPSE + 2]
+
+
 class TransientSolver:
     """Non-steady FastSim on a compiled solver's patches (MAE, calibrated MAE, ellipse).
 
@@ -680,9 +701,7 @@ class TransientSolver:
                 code, prm, v, out[0], out[1], out[2], s._calibrated, s._pair_knots,
                 s._pair_values, prev[0], prev[1], float(rolled), geo, s.nu, self.far_field,
                 f_old[0], f_old[1], slope)
-            # the patch's area, centroid and half length, for ContactMemory's jump rule
-            g = geo.tolist()
-            measures = (g[k.G_AREA], (g[k.G_XC], g[k.G_YC]), g[k.G_ELLIPSE + 2])
+            measures = _mae_measures(geo)
         else:
             n = s.cells or k.ellipse_cells(int(np.count_nonzero(p > 0.0)))
             ell = np.empty(k.ELL_SIZE)
@@ -703,10 +722,9 @@ class TransientSolver:
             measures = (math.pi * float(ell[k.ELL_A] * ell[k.ELL_B]),
                         (float(ell[k.ELL_XC]), float(ell[k.ELL_YC])), float(ell[k.ELL_A]))
         forces = s._forces(result, grid, out, True)
-        far_slope = slope.tolist()
-        return forces, _made(out[0], out[1], grid, measures[0], measures[1], measures[2],
-                             (float(result[2]), float(result[3])),
-                             (far_slope[0], far_slope[1], far_slope[2], far_slope[3]))
+        j = slope.tolist()
+        return forces, _made(out[0], out[1], grid, *measures,
+                             (float(result[2]), float(result[3])), (j[0], j[1], j[2], j[3]))
 
     def _previous(self, state: TractionState | None, grid: tuple[float, float, float, float],
                   shape: tuple[int, ...]) -> tuple[FloatArray, FloatArray]:
