@@ -12,6 +12,8 @@ own: about half a second to the refusal), once for the whole module.
 
 from __future__ import annotations
 
+import contextlib
+import gc
 import signal
 import subprocess
 import time
@@ -178,6 +180,35 @@ def test_a_signal_while_the_node_is_importing_ends_it_with_exit_0(signum):
     assert not any(w in out for w in ("Traceback", "Error", "error", "Fatal")), out
 
 
+@contextlib.contextmanager
+def in_process(*ros_args: str, collector: bool = True):
+    """Yield ``(context, nodes)``: an rclpy context of this process's own, shut down after.
+
+    In a DDS domain of its own, without rclpy's signal handlers (pytest keeps
+    its own); ``ros_args``: the nodes' ROS arguments; every node put in
+    ``nodes`` is destroyed at the end; ``collector=False`` holds the garbage
+    collector off meanwhile (a node that lingers then stays where it is).
+    """
+    import rclpy
+    from rclpy.context import Context
+    from rclpy.signals import SignalHandlerOptions
+
+    context = Context()
+    rclpy.init(args=["--ros-args", *ros_args] if ros_args else [], context=context,
+               domain_id=int(time.time()) % 100 + 110,
+               signal_handler_options=SignalHandlerOptions.NO)
+    nodes: list = []
+    if not collector:
+        gc.disable()
+    try:
+        yield context, nodes
+    finally:
+        gc.enable()
+        for node in nodes:
+            node.destroy_node()
+        rclpy.try_shutdown(context=context)
+
+
 @pytest.mark.parametrize("managed", [False, True], ids=["node", "lifecycle"])
 def test_a_refused_construction_destroys_its_half_built_node(managed):
     """A constructor that refuses its parameters destroys the node it had made.
@@ -191,32 +222,18 @@ def test_a_refused_construction_destroys_its_half_built_node(managed):
     releases its state machine too (rclpy's left it, and the rcl node it
     holds, to the collector: measured, the old code fails here).
     """
-    import gc
-
     import rclpy
-    from rclpy.context import Context
-    from rclpy.signals import SignalHandlerOptions
 
     from fastsim_ros.node import FastsimLifecycleNode, FastsimNode, StartupError
 
-    context = Context()
-    rclpy.init(args=["--ros-args", "-p", "wheelset_frame:=[1, 2]", "-p",
-                     "executor:=threads"], context=context,
-               domain_id=int(time.time()) % 100 + 110,
-               signal_handler_options=SignalHandlerOptions.NO)
-    probe = None
-    gc.disable()
-    try:
+    with in_process("-p", "wheelset_frame:=[1, 2]", "-p", "executor:=threads",
+                    collector=False) as (context, nodes):
         with pytest.raises(StartupError, match="wheelset_frame") as refused:
             (FastsimLifecycleNode if managed else FastsimNode)(context=context)
         probe = rclpy.create_node("fastsim_test_probe", context=context)
+        nodes.append(probe)
         assert probe.get_node_names() == ["fastsim_test_probe"]
         assert refused.tb is not None  # the traceback (and its frames) still held
-    finally:
-        gc.enable()
-        if probe is not None:
-            probe.destroy_node()
-        rclpy.try_shutdown(context=context)
 
 
 def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
@@ -226,30 +243,17 @@ def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
     ``LifecycleNode.destroy_node`` alone the rcl node, held by the state
     machine, outlived the context's shutdown until the collector came.
     """
-    import gc
-
     import rclpy
-    from rclpy.context import Context
-    from rclpy.signals import SignalHandlerOptions
 
     from fastsim_ros.node import FastsimLifecycleNode
 
-    context = Context()
-    rclpy.init(args=[], context=context, domain_id=int(time.time()) % 100 + 110,
-               signal_handler_options=SignalHandlerOptions.NO)
-    probe = None
-    gc.disable()
-    try:
+    with in_process(collector=False) as (context, nodes):
         node = FastsimLifecycleNode(context=context)
         probe = rclpy.create_node("fastsim_test_probe", context=context)
+        nodes.append(probe)
         assert sorted(probe.get_node_names()) == ["fastsim", "fastsim_test_probe"]
         node.destroy_node()
         assert probe.get_node_names() == ["fastsim_test_probe"]
-    finally:
-        gc.enable()
-        if probe is not None:
-            probe.destroy_node()
-        rclpy.try_shutdown(context=context)
 
 
 def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range():
@@ -260,19 +264,13 @@ def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range
     the parameter's name and what it takes (rclpy's words first: it maps them
     to its type exception).  An out-of-range value names both already.
     """
-    import rclpy
-    from rclpy.context import Context
     from rclpy.parameter import Parameter
-    from rclpy.signals import SignalHandlerOptions
 
     from fastsim_ros.node import FastsimLifecycleNode
 
-    context = Context()
-    rclpy.init(args=[], context=context, domain_id=int(time.time()) % 100 + 110,
-               signal_handler_options=SignalHandlerOptions.NO)
-    node = None
-    try:
+    with in_process() as (context, nodes):
         node = FastsimLifecycleNode(context=context)
+        nodes.append(node)
         for name, value in (("friction_coefficient", "abc"), ("method", 3),
                             ("publish_traction", 1.5)):
             result, = node.set_parameters([Parameter(name, value=value)])
@@ -282,7 +280,3 @@ def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range
         result, = node.set_parameters([Parameter("friction_coefficient", value="abc")])
         assert result.reason.endswith("in [0.001, 5]")
         assert node.get_parameter("friction_coefficient").value == 0.3
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown(context=context)
