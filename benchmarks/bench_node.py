@@ -293,8 +293,17 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
         # a cold kernel cache compiles for a minute or more before the first topic opens
         # (measured: a fresh clone whose cache was filled elsewhere gave up at 30 s)
         if time.monotonic() - start > START_TIMEOUT or proc.poll() is not None:
+            status = proc.poll()
+            # stop it before giving up: a target left running kept its DDS domain busy
+            # (a test run that drew the same domain later saw its /diagnostics publisher)
+            proc.terminate()
+            try:
+                proc.wait(10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
             raise SystemExit(f"the {target} did not come up within {START_TIMEOUT:g} s "
-                             f"(exit status {proc.poll()}); a cold kernel cache compiles "
+                             f"(exit status {status}); a cold kernel cache compiles "
                              "first: scripts/setup_env.sh fills it")
     for _ in range(50):
         ex.spin_once(timeout_sec=0.01)
