@@ -13,7 +13,7 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver, warm_up
 from fastsim_ros.contact.errors import OutOfTableError
 from fastsim_ros.contact.fastsim import traction_bound
 from fastsim_ros.contact.friction import ExponentialFriction
-from fastsim_ros.contact.mae import mae_coefficients, mae_geometry, mirror_geometries, row_extents
+from fastsim_ros.contact.mae import mae_coefficients, mae_geometry, row_extents, split_geometries
 from fastsim_ros.contact.mae_calibrated import (_paired_coefficients, calibrated_flexibilities,
                                                 mae_calibrated_coefficients,
                                                 mae_calibrated_fastsim, sweep_integrals,
@@ -137,16 +137,17 @@ def test_rigid_slip_return_declines_inside_the_bound():
 def _zone_sums(ar, table, pairs):
     """Return the method's zone coefficients summed as MAE's eq. 7: C~11, C~22, C~23 about S.
 
-    In a tie of the split (an odd number of strips on a shape symmetric in
-    ``y``), the mean over its two faces (the method averages their strips'
-    stiffness).
+    With the split between two faces (a tie: an odd number of strips on a
+    shape symmetric in ``y``), the weighted mean over them (the method
+    weighs their strips' stiffness).
     """
     sums = []
-    for geo in mirror_geometries(ar):
+    for geo, weight in split_geometries(ar):
         (w1, w2), (c1, c2) = geo.weights, zone_coefficients(ar, geo, table, pairs)
-        sums.append((w1 * c1["c11"] + w2 * c2["c11"], w1 * c1["c22"] + w2 * c2["c22"],
-                     w1**1.5 * c1["c23"] + w2**1.5 * c2["c23"]))
-    return tuple(sum(v) / len(sums) for v in zip(*sums))
+        sums.append((weight * (w1 * c1["c11"] + w2 * c2["c11"]),
+                     weight * (w1 * c1["c22"] + w2 * c2["c22"]),
+                     weight * (w1**1.5 * c1["c23"] + w2**1.5 * c2["c23"])))
+    return tuple(sum(v) for v in zip(*sums))
 
 
 @pytest.mark.parametrize("cells", [12, 20, 41])

@@ -46,8 +46,6 @@ I_H11, I_H13, I_H22, I_H23 = 4, 6, 8, 9
 
 #: split rules of :func:`fastsim_ros.contact.mae.split_face`
 RULE_WIDEST_STRIP, RULE_CENTROID, RULE_AUTO = 0, 1, 2
-#: :data:`fastsim_ros.contact.rules.MIN_ZONE_SHARE` (a global: frozen into the kernels)
-MIN_ZONE_SHARE = rules.MIN_ZONE_SHARE
 
 #: status codes of the kernels (``E_*``; the result slots below have other prefixes)
 OK = 0
@@ -282,6 +280,8 @@ LAW_EXPONENTIAL = rules.LAW_EXPONENTIAL
 rigid_slip_return = njit(cache=True, error_model="numpy")(rules.rigid_slip_return)
 pair_factor = njit(cache=True, error_model="numpy")(rules.pair_factor)
 chord_bend_offset = njit(cache=True, error_model="numpy")(rules.chord_bend_offset)
+widest_position = njit(cache=True, error_model="numpy")(rules.widest_position)
+face_blend = njit(cache=True, error_model="numpy")(rules.face_blend)
 
 
 @njit(cache=True, error_model="numpy")
@@ -1031,18 +1031,25 @@ def split_face(count, rule):
     """Index ``f`` of the cell face the MAE split runs along, from the strips' counts.
 
     ``count[j]``: cells in contact in strip ``j``.  The three rules of
-    :func:`fastsim_ros.contact.mae.split_face`, branch for branch.
+    :func:`fastsim_ros.contact.mae.split_face`, branch for branch: the lower
+    face of :func:`split_blend`'s pair.
     """
-    return split_rule(count, rule)[0]
+    return split_blend(count, rule)[0]
 
 
 @njit(cache=True, error_model="numpy")
-def split_rule(count, rule):
-    """Return ``(f, tie)``: :func:`split_face`, and :func:`fastsim_ros.contact.mae.split_tie`.
+def split_blend(count, rule):
+    """Return ``(f, t)``: the split as faces ``f`` and ``f + 1`` weighted ``1 - t``, ``t``.
 
-    ``tie``: the rule's split line runs through the middle of strip ``f``
-    (both its faces alike: :func:`mae_flexibility` averages the two).
+    :func:`fastsim_ros.contact.mae.split_blend`: ``auto`` at the weighted
+    centre of the near-longest strips (:func:`~fastsim_ros.contact.rules.widest_position`),
+    ``centroid`` at the centroid, both continuous
+    (:func:`~fastsim_ros.contact.rules.face_blend`); ``widest_strip`` on one
+    face, or a tie's two alike (``t = 1/2``).  :func:`mae_flexibility` blends
+    the two faces' strip stiffnesses.
     """
+    if rule == RULE_AUTO:
+        return face_blend(count, widest_position(count))
     ny = count.shape[0]
     total = 0
     moment = 0
@@ -1051,16 +1058,9 @@ def split_rule(count, rule):
         moment += count[j] * j
     yc = moment / total
     if rule == RULE_CENTROID:
-        return _centroid_face(count, yc, moment, total)
+        return face_blend(count, yc + 0.5)
     f, tie = _widest_strip_face(count, yc, moment, total)
-    if rule == RULE_AUTO:
-        below = 0
-        for j in range(f):
-            below += count[j]
-        share = below / total
-        if min(share, 1.0 - share) < MIN_ZONE_SHARE:
-            return _centroid_face(count, yc, moment, total)
-    return f, tie
+    return f, 0.5 if tie else 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -1235,7 +1235,8 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, 
     ``pair_knots``; unread otherwise).  Return ``(status, info)``; ``info`` is
     the offending ``a/b`` of a zone outside the table (the geometry is
     complete then, the flexibilities are not).  ``shift``: the split that
-    many faces above the rule's (1: a tie's other face).
+    many faces above the rule's lower face (1: the upper face of
+    :func:`split_blend`'s pair).
     """
     status = check_grid(x0, y0, dx, dy)
     if status != OK:
@@ -1440,19 +1441,22 @@ def mae_flexibility(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, e
                     calibrated, pair_knots, pair_values, flex):
     """:func:`mae_prepare`, then each strip's ``L1 .. L4`` into ``flex``; return its status.
 
-    Where the rule's split is a tie (:func:`split_rule`: the line through
-    the middle of a strip, as on a patch symmetric in ``y`` with an odd
-    number of strips) the two faces' strip stiffnesses ``1/L`` are averaged and
-    ``geo``'s sweep line ``y_s`` is their mean, the middle of that strip
-    (:func:`fastsim_ros.contact.mae.mirror_geometries`): either face alone
-    gave an ellipse ``C~13`` of -0.03 and a yaw moment from nothing.
+    Where the rule's split lies between two faces (:func:`split_blend`:
+    ``t > 0``; a tie, the line through the middle of a strip, is ``t =
+    1/2``) the two faces' strip stiffnesses ``1/L`` are weighted ``1 - t``
+    and ``t`` and ``geo``'s sweep line ``y_s`` is their weighted mean
+    (:func:`fastsim_ros.contact.mae.split_geometries`): the force then
+    moves continuously with the split, and a patch symmetric in ``y`` has no
+    yaw moment from nothing (either face alone gave an ellipse ``C~13`` of
+    -0.03).
     """
     status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
                                strips, calibrated, pair_knots, pair_values)
     if status != OK:
         return status, info
     mae_strip_flexibility(geo, flex)
-    if not split_rule(strips[0], rule)[1]:
+    t = split_blend(strips[0], rule)[1]
+    if t == 0.0:
         return OK, 0.0
     other = np.empty(GEO_SIZE)
     other_env = np.empty_like(env)
@@ -1462,12 +1466,13 @@ def mae_flexibility(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, e
         return status, info
     upper = np.empty_like(flex)
     mae_strip_flexibility(other, upper)
-    # the strips' stiffness 1/L averaged (mae.averaged_flexibility): the full-adhesion
-    # coefficients, linear in it, the two splits' mean
+    # the strips' stiffness 1/L weighted (mae.blended_flexibility): the full-adhesion
+    # coefficients, linear in it, move linearly from one face's to the other's
+    s = 1.0 - t
     for k in range(4):
         for j in range(flex.shape[1]):
-            flex[k, j] = 2.0 / (1.0 / flex[k, j] + 1.0 / upper[k, j])
-    geo[G_YS] = 0.5 * (geo[G_YS] + other[G_YS])
+            flex[k, j] = 1.0 / (s / flex[k, j] + t / upper[k, j])
+    geo[G_YS] = s * geo[G_YS] + t * other[G_YS]
     return OK, 0.0
 
 

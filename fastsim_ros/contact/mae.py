@@ -28,7 +28,7 @@ from fastsim_ros.contact.checks import SplitRule, check_split_rule
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
 from fastsim_ros.contact.friction import FrictionLaw
-from fastsim_ros.contact.rules import MIN_ZONE_SHARE
+from fastsim_ros.contact.rules import face_blend, widest_position
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
 
@@ -90,55 +90,60 @@ def row_extents(mask: NDArray[np.bool_]) -> tuple[NDArray[np.int_], NDArray[np.i
 def split_face(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> int:
     """Index ``f`` of the cell face ``y = y0 + (f - 1/2) dy`` the split runs along.
 
-    ``auto`` (the default): ``widest_strip``, unless that leaves a zone with
-    less than :data:`MIN_ZONE_SHARE` of the area, then ``centroid``.  A
-    longest chord on (or next to) the area's edge means a truncated shape,
-    not two semi-ellipses joined along their widest chord: on an ellipse cut
-    near its centre line the ``widest_strip`` zones come out empty and MAE's
-    coefficients 30% low, the centroid split's within 4% (docs/validation.md).
-    ``centroid``: the face nearest the centroid (the paper's text).
-    ``widest_strip``: through the band of strips with the longest chord (of
-    several bands apart, the widest, then the one nearest the centroid, so
-    that the mirror image of an area in ``y`` splits at the mirrored face;
-    two alike at one distance: the centroid's face): its middle face (on an
-    ellipse with an even number of strips, the centre line), unless the
-    chord drops by over a cell at each end more on one side of the band
-    than on the other (a jump: the join line of two semi-ellipses), where
-    the split takes the band's face on that side.
+    The lower face of :func:`split_blend`'s pair (the whole split where its
+    ``t`` is 0).
     """
-    return _split(row_extents(area.mask)[0], rule)[0]
+    return split_blend(area, rule)[0]
+
+
+def split_blend(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> tuple[int, float]:
+    """Return ``(f, t)``: the rule's split as faces ``f``, ``f + 1`` weighted ``1 - t``, ``t``.
+
+    ``auto`` (the default): the weighted centre of the strips with a chord
+    near the longest (:func:`~fastsim_ros.contact.rules.widest_position`):
+    the paper's widest strip, made a continuous function of the patch (an
+    argmax over a staircase jumps between strips millimetres apart as a row
+    of cells comes or goes, and a threshold between two rules jumps where
+    it is crossed: docs/validation_split.md).  ``centroid``: the centroid
+    (the paper's text).  Both lie between two faces in general
+    (:func:`~fastsim_ros.contact.rules.face_blend`), and the MAE methods
+    blend those two splits (:func:`split_geometries`).  ``widest_strip``:
+    the seed's discrete rule, kept for the paper's Table 5 (it finds the
+    join line of two semi-ellipses exactly), not continuous: through the
+    band of strips with the longest chord (of several bands apart, the
+    widest, then the one nearest the centroid, so that the mirror image of
+    an area in ``y`` splits at the mirrored face; two alike at one
+    distance: the centroid's), its middle face, unless the chord drops by
+    over a cell at each end more on one side of the band than on the other
+    (a jump: the join line of two semi-ellipses), where the split takes
+    the band's face on that side; a line through the middle of a strip is
+    a tie, ``t = 1/2``.
+    """
+    return _split(row_extents(area.mask)[0], rule)
 
 
 def split_tie(area: GridArea, rule: SplitRule = DEFAULT_SPLIT) -> bool:
-    """Tell whether the rule's split line runs through the middle of a strip.
+    """Tell whether the rule's split line runs through the middle of a strip (``t = 1/2``).
 
     Then the faces on either side of that strip serve alike (a patch
     symmetric in ``y`` with an odd number of strips: its centre line is no
-    cell face), :func:`split_face` gives the lower one, and the MAE methods
-    take both splits' strip stiffnesses ``1/L``, averaged (:func:`mirror_geometries`):
-    one of them alone gave an ellipse ``C~13`` of -0.03 and a yaw moment from
-    nothing on a centred wheelset.
+    cell face), and the MAE methods weigh both splits alike: one of them
+    alone gave an ellipse ``C~13`` of -0.03 and a yaw moment from nothing on
+    a centred wheelset.
     """
-    return _split(row_extents(area.mask)[0], rule)[1]
+    return split_blend(area, rule)[1] == 0.5
 
 
-def _split(count: NDArray[np.int_], rule: SplitRule) -> tuple[int, bool]:
-    """Return the split face of :func:`split_face` and whether it is :func:`split_tie`'s tie."""
+def _split(count: NDArray[np.int_], rule: SplitRule) -> tuple[int, float]:
+    """Return :func:`split_blend`'s ``(f, t)`` from the strips' counts."""
+    if rule == "auto":
+        return face_blend(count, widest_position(count))
     ny = count.size
     total = int(count.sum())
     moment = int((count * np.arange(ny)).sum())
     yc = moment / total
-    if rule == "auto":
-        f, tie = _split(count, "widest_strip")
-        share = float(count[:f].sum()) / float(total)
-        if min(share, 1.0 - share) < MIN_ZONE_SHARE:
-            return _split(count, "centroid")
-        return f, tie
     if rule == "centroid":
-        rows = np.flatnonzero(count)
-        if moment % total == 0:   # the centroid at a strip's centre: its two faces alike
-            return moment // total, True
-        return int(np.clip(round(yc + 0.5), rows[0], rows[-1] + 1)), False
+        return face_blend(count, yc + 0.5)
     check_split_rule(rule)
     # the band of strips sharing the longest chord (a staircase ellipse has several); of
     # several such bands apart, the widest, then the one nearest the centroid (a mirror
@@ -158,18 +163,18 @@ def _split(count: NDArray[np.int_], rule: SplitRule) -> tuple[int, bool]:
     # chords of centred shapes change by two cells at a time (one at each end)
     drop_below, drop_above = count[j0] - below, count[j0] - above
     if drop_below > drop_above + 2:
-        return j0, False
+        return j0, 0.0
     if drop_above > drop_below + 2:
-        return j1 + 1, False
+        return j1 + 1, 0.0
     width = j1 - j0 + 1
     if width % 2 == 0:
-        return j0 + width // 2, False
+        return j0 + width // 2, 0.0
     middle = j0 + width // 2
     # an odd band: the face of its middle strip nearer the centroid; the centroid at the
     # strip's centre: both faces alike (the lower one given)
     if moment == middle * total:
-        return middle, True
-    return (middle + 1 if yc > middle else middle), False
+        return middle, 0.5
+    return (middle + 1 if yc > middle else middle), 0.0
 
 
 def _zone(area: GridArea, rows: NDArray[np.bool_], x_c: float, y_s: float,
@@ -219,37 +224,36 @@ def _geometry_at(area: GridArea, rule: SplitRule, f: int) -> MaeGeometry:
                        _zone(area, ~rows, x_c, y_s, False), area.area)
 
 
-def mirror_geometries(area: GridArea,
-                      rule: SplitRule = DEFAULT_SPLIT) -> tuple[MaeGeometry, ...]:
-    """Return the geometry of the rule's split, and of the other face where it is a tie.
+def split_geometries(area: GridArea,
+                     rule: SplitRule = DEFAULT_SPLIT) -> tuple[tuple[MaeGeometry, float], ...]:
+    """Return the geometries of the rule's split faces with their weights (:func:`split_blend`).
 
-    (:func:`split_tie`): the MAE methods then average the two splits' strip
-    stiffnesses (:func:`averaged_flexibility`) and sweep from the middle
-    of the strip between them.
+    One face (weight 1), or two (``1 - t`` and ``t``): the MAE methods then
+    weigh the two splits' strip stiffnesses (:func:`blended_flexibility`)
+    and sweep from the weighted mean of their split lines.
     """
-    f, tie = _split(row_extents(area.mask)[0], rule)
-    if not tie:
-        return (_geometry_at(area, rule, f),)
-    return _geometry_at(area, rule, f), _geometry_at(area, rule, f + 1)
+    f, t = _split(row_extents(area.mask)[0], rule)
+    if t == 0.0:
+        return ((_geometry_at(area, rule, f), 1.0),)
+    return (_geometry_at(area, rule, f), 1.0 - t), (_geometry_at(area, rule, f + 1), t)
 
 
-def averaged_flexibility(flexibilities: list[StripFlexibility]) -> StripFlexibility:
-    """Return the strips' flexibilities (m/Pa) over the splits of a tie: stiffness averaged.
+def blended_flexibility(flexibilities: list[tuple[StripFlexibility, float]]) -> StripFlexibility:
+    """Return the strips' flexibilities (m/Pa) over weighted splits: stiffness ``1/L`` weighted.
 
-    A strip's traction in adhesion is its rigid slip over ``L``: averaging
+    A strip's traction in adhesion is its rigid slip over ``L``: weighting
     ``1/L`` makes the full-adhesion coefficients ``C~11``, ``C~22``,
-    ``C~23`` the mean of the two splits' exactly.
+    ``C~23`` the splits' weighted mean exactly.
     """
     if len(flexibilities) == 1:
-        return flexibilities[0]
-    n = len(flexibilities)
-    return StripFlexibility(*(n / sum(1.0 / getattr(f, name) for f in flexibilities)
+        return flexibilities[0][0]
+    return StripFlexibility(*(1.0 / sum(w / getattr(f, name) for f, w in flexibilities)
                               for name in ("l1", "l2", "l3", "spin")))
 
 
-def sweep_point(geometries: tuple[MaeGeometry, ...]) -> tuple[float, float]:
-    """Return the sweep point ``S = (x_c, y_s)`` (m): the splits' mean ``y_s`` in a tie."""
-    return (geometries[0].x_c, sum(g.y_s for g in geometries) / len(geometries))
+def sweep_point(geometries: tuple[tuple[MaeGeometry, float], ...]) -> tuple[float, float]:
+    """Return the sweep point ``S = (x_c, y_s)`` (m): the splits' weighted mean ``y_s``."""
+    return (geometries[0][0].x_c, sum(w * g.y_s for g, w in geometries))
 
 
 def mae_area_coefficients(area: GridArea, table: CoefficientTable, *,
@@ -257,15 +261,17 @@ def mae_area_coefficients(area: GridArea, table: CoefficientTable, *,
                           rule: SplitRule = DEFAULT_SPLIT) -> CreepCoefficients:
     """Return MAE's coefficients of an area (:func:`mae_coefficients` of its split).
 
-    In a tie (:func:`split_tie`) the two splits' coefficients, averaged: a
-    patch symmetric in ``y`` then has ``C~13 = 0`` on any grid.
+    Where the split lies between two faces (:func:`split_blend`) the two
+    splits' coefficients, weighted: continuous in the patch, and on a patch
+    symmetric in ``y`` (a tie) ``C~13 = 0`` on any grid.
     """
-    each = [mae_coefficients(g, table, reference) for g in mirror_geometries(area, rule)]
+    each = [(mae_coefficients(g, table, reference), w) for g, w in split_geometries(area, rule)]
     if len(each) == 1:
-        return each[0]
-    mean = {name: sum(getattr(c, name) for c in each) / len(each)
+        return each[0][0]
+    mean = {name: sum(w * getattr(c, name) for c, w in each)
             for name in ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33")}
-    return CreepCoefficients(**mean, area=each[0].area, reference=each[0].reference)
+    first = each[0][0]
+    return CreepCoefficients(**mean, area=first.area, reference=first.reference)
 
 
 def mae_coefficients(geometry: MaeGeometry, table: CoefficientTable,
@@ -377,14 +383,14 @@ def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: Flo
     ``speed``: rolling speed ``|V|`` (m/s) for such a law; ``shear_modulus``:
     combined ``G`` (Pa); ``table``: coefficients at the material's ``nu``.
     """
-    geometries = mirror_geometries(area, rule)
-    pairs = [zone_flexibilities(g, table, shear_modulus) for g in geometries]
+    geometries = split_geometries(area, rule)
+    pairs = [zone_flexibilities(g, table, shear_modulus) for g, _ in geometries]
     res = fastsim(area, xi, eta, phi, bound=bound,
-                  flexibility=averaged_flexibility([strip_flexibility(area, g, z)
-                                                    for g, z in zip(geometries, pairs)]),
+                  flexibility=blended_flexibility([(strip_flexibility(area, g, z), w)
+                                                   for (g, w), z in zip(geometries, pairs)]),
                   sweep_point=sweep_point(geometries), reference=reference,
                   friction=friction, speed=speed)
-    return MaeResult(res.fx, res.fy, res.mz, res, geometries[0], pairs[0])
+    return MaeResult(res.fx, res.fy, res.mz, res, geometries[0][0], pairs[0])
 
 
 def mae_fastsim_coefficients(area: GridArea, table: CoefficientTable, *,

@@ -66,8 +66,8 @@ from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone,
-                                     ZoneFlexibility, ZonePair, averaged_flexibility,
-                                     mirror_geometries, row_extents,
+                                     ZoneFlexibility, ZonePair, blended_flexibility,
+                                     row_extents, split_geometries,
                                      strip_flexibility, sweep_point, zone_flexibility)
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
 from fastsim_ros.contact.rules import chord_bend_offset
@@ -264,16 +264,16 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
     :func:`zone_coefficients`'; ``without``: rules left out (:data:`RULES`;
     ``"rigid_slip"``: FastSim's radial return).
     """
-    geometries = mirror_geometries(area, rule)
+    geometries = split_geometries(area, rule)
     zone_pairs = [calibrated_flexibilities(area, g, table, pairs, shear_modulus, share=share,
-                                           without=without) for g in geometries]
-    flex: StripFlexibility = averaged_flexibility([strip_flexibility(area, g, z)
-                                                   for g, z in zip(geometries, zone_pairs)])
+                                           without=without) for g, _ in geometries]
+    flex: StripFlexibility = blended_flexibility([(strip_flexibility(area, g, z), w)
+                                                  for (g, w), z in zip(geometries, zone_pairs)])
     res = fastsim(area, xi, eta, phi, bound=bound, flexibility=flex,
                   sweep_point=sweep_point(geometries), reference=reference,
                   friction=friction, speed=speed,
                   slip_rule="radial" if "rigid_slip" in without else "rigid_slip")
-    return MaeResult(res.fx, res.fy, res.mz, res, geometries[0], zone_pairs[0])
+    return MaeResult(res.fx, res.fy, res.mz, res, geometries[0][0], zone_pairs[0])
 
 
 def mae_calibrated_coefficients(area: GridArea, table: CoefficientTable, pairs: PairFactors, *,

@@ -19,9 +19,12 @@ from typing import Any
 LAW_CONSTANT = 0
 LAW_EXPONENTIAL = 1
 
-#: the smallest share of the area a ``widest_strip`` zone may have under the
-#: ``auto`` split rule (:func:`fastsim_ros.contact.mae.split_face`)
-MIN_ZONE_SHARE = 0.15
+#: the ``auto`` split's band of near-longest strips (:func:`widest_position`): the strips
+#: whose chord is within this share of the longest, or within WIDEST_BAND_CELLS cells
+WIDEST_BAND_SHARE = 0.05
+WIDEST_BAND_CELLS = 2.0
+#: a split within this fraction of a cell of a face (or of a strip's middle) is taken there
+SPLIT_SNAP = 1e-9
 
 
 def ellipse_cells(cells_in_contact: float) -> int:
@@ -197,3 +200,66 @@ def chord_bend_offset(count: Any, first: Any, last: Any, j_lo: int, j_hi: int,
         return 0.0
     kappa = (s_uu * s_qm - s_uq * s_um) / det
     return kappa * (s_l2 / n - s_l3 / s_l)
+
+
+def widest_position(count: Any) -> float:
+    """Return the ``auto`` rule's split line in face units ``u`` (``y = y0 + (u - 1/2) dy``).
+
+    ``count[j]``: strip ``j``'s cells in contact.  MAE's split runs along the
+    widest strip (the join line of two semi-ellipses, the centre line of an
+    ellipse); on a grid the longest chord is a staircase, and a flat-topped
+    chord profile (a conformal tread patch) has its longest strip anywhere
+    along the top, so an argmax jumps as a row of cells comes or goes.  Here
+    every strip whose chord reaches into the band ``[longest - w, longest]``
+    (``w`` the larger of :data:`WIDEST_BAND_SHARE` of the longest chord and
+    :data:`WIDEST_BAND_CELLS` cells) weighs in by how far it reaches, and the
+    split is their weighted centre: a continuous function of the chords, at
+    the band's middle on a patch symmetric in ``y`` (``C~13 = 0``), near the
+    join line where one half is wider than the other, and inside the patch
+    where its longest chord is a cut edge (an ellipse cut near its centre
+    line: the zones then stay the two halves' shapes, not one empty zone).
+    """
+    n = len(count)
+    longest = 0
+    for j in range(n):
+        longest = max(longest, count[j])
+    floor = longest - max(WIDEST_BAND_CELLS, WIDEST_BAND_SHARE * longest)
+    weight = 0.0
+    moment = 0.0
+    for j in range(n):
+        w = count[j] - floor
+        if w > 0.0:
+            weight += w
+            moment += w * (j + 0.5)
+    return moment / weight
+
+
+def face_blend(count: Any, u: float) -> tuple[int, float]:
+    """Return ``(f, t)``: a split at ``u`` as faces ``f``, ``f + 1`` weighted ``1 - t``, ``t``.
+
+    A split between two cell faces has no zones of whole strips; the MAE
+    methods solve it as the two faces' splits with their strips' stiffness
+    ``1/L`` weighted ``1 - t`` and ``t`` (the full-adhesion coefficients,
+    linear in ``1/L``, move linearly between the two faces'), so that the
+    force moves continuously with ``u``.  ``u`` is held within the faces of
+    the strips in contact; within :data:`SPLIT_SNAP` of a face it is that
+    face (``t = 0``), of a strip's middle exactly the middle (``t = 1/2``:
+    a patch symmetric in ``y`` then gets both faces alike).
+    """
+    n = len(count)
+    r0 = 0
+    while r0 < n - 1 and count[r0] == 0:
+        r0 += 1
+    r1 = n - 1
+    while r1 > 0 and count[r1] == 0:
+        r1 -= 1
+    u = min(max(u, float(r0)), float(r1 + 1))
+    f = int(math.floor(u))
+    t = u - f
+    if t <= SPLIT_SNAP:
+        return f, 0.0
+    if t >= 1.0 - SPLIT_SNAP:
+        return f + 1, 0.0
+    if abs(t - 0.5) <= SPLIT_SNAP:
+        return f, 0.5
+    return f, t
