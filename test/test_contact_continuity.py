@@ -1,4 +1,4 @@
-"""The MAE methods' forces are continuous in the patch: a row of cells moves them as little as it moves the exact force.
+"""The MAE methods' forces follow the exact theory's row by row: continuous in the patch.
 
 MAE's split line decides each zone's semi-ellipse, so a split that jumps
 between strips as a row of cells comes or goes makes the force jump where
@@ -29,7 +29,7 @@ CREEPAGES = ((4e-4, 0.0, 0.12), (0.0, 8e-4, 0.0))
 
 
 def wide_end_patch(rows_above: int) -> GridArea:
-    """Return a semi-ellipse (a 5 mm, b 8 mm) below the x axis with ``rows_above`` rows of a flatter one above.
+    """Return a semi-ellipse (a 5 mm, b 8 mm) below y = 0, ``rows_above`` rows of a flatter one above.
 
     The longest chord is the join line's; the rows above it (of a
     semi-ellipse of the same ``a`` and ``b`` 2 mm, cells of 0.25 mm) hold a
@@ -139,8 +139,8 @@ def wheelset_patches() -> list[tuple[GridArea, tuple[float, float, float]]]:
 
 
 @pytest.mark.parametrize("method", ["mae", "mae_calibrated"])
-def test_the_tread_force_follows_the_exact_one_across_the_former_jumps(method,
-                                                                      wheelset_patches):
+def test_the_tread_force_follows_the_exact_one_across_the_former_jumps(
+        method, wheelset_patches):
     solver = (MaeSolver if method == "mae" else CalibratedMaeSolver)(NU, G)
     prev = None
     for k, (area, creep) in enumerate(wheelset_patches):
