@@ -623,11 +623,42 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
             if all(v is not None for _, v in values):
                 print("  " + "  ".join(f"{k} = {v:9.4f}" for k, v in values))
     else:
-        print(f"method {result['method']}, N = {result['N']:.6g} N, friction "
-              f"{result['friction_law']}")
-        print(f"  Fx = {result['Fx']:.6g} N\n  Fy = {result['Fy']:.6g} N\n"
-              f"  Mz = {result['Mz']:.6g} N m\n"
-              f"  slip fraction = {result['slip_fraction']:.4g}")
+        print_forces(result)
+
+
+#: units of the ``forces`` result's numbers in the readable table (the rest: none)
+FORCE_UNITS = {"N": "N", "Fx": "N", "Fy": "N", "Mz": "N m", "split_y": "m", "speed": "m/s",
+               "friction_decay": "s/m", "area": "m^2", "a": "m", "b": "m", "x_c": "m",
+               "y_c": "m"}
+
+
+def _text(key: str, value: Any) -> str:
+    """Return one value of a result as the readable table shows it, with its unit."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        unit = FORCE_UNITS.get(key)
+        return f"{value:.6g}" + (f" {unit}" if unit else "")
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_text(k, v)}" for k, v in value.items())
+    if isinstance(value, list):
+        if key == "cells":
+            return " x ".join(str(v) for v in value)
+        return "; ".join(f"[{_text(key, v)}]" for v in value)
+    return str(value)
+
+
+def print_forces(result: dict[str, Any]) -> None:
+    """Print every field of a ``forces`` result, one ``key = value`` line each (JSON's keys)."""
+    first = [k for k in ("method", "N", "Fx", "Fy", "Mz", "slip_fraction") if k in result]
+    for key in first + [k for k in result if k not in first]:
+        text = _text(key, result[key])
+        if key == "cells" and result.get("extrapolated"):
+            # the exact forces on a shape: the two grids of the extrapolation, cells across
+            text = " and ".join(str(n) for n in result[key]) + " across (extrapolated)"
+        print(f"  {key} = {text}")
 
 
 def _run(argv: Sequence[str] | None) -> tuple[argparse.Namespace, dict[str, Any]]:
