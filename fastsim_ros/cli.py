@@ -18,6 +18,11 @@ FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path);
 ``dlm`` and ``asm`` the seed paper's older ways to FastSim's flexibilities
 (:mod:`~fastsim_ros.contact.dlm`, :mod:`~fastsim_ros.contact.asm`, numpy).
 
+Defaults are one set, the node's (:func:`node_default` reads
+:data:`fastsim_ros.params.PARAMETERS`): method (``coefficients``: ``exact``,
+the exact theory's numbers), Poisson ratio, shear modulus, friction law,
+bound; each ``--help`` shows them.
+
 What the command line accepts is bounded (:data:`LIMITS`, :data:`MAX_PATCH_CELLS`,
 :data:`MAX_STRIP_CELLS`, :data:`MAX_EXACT_FORCE_CELLS`): every real contact lies
 far inside, and inside them no intermediate quantity can overflow or underflow,
@@ -46,6 +51,18 @@ from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
                                         check_poisson_ratio)
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, FrictionLaw
+from fastsim_ros.params import SPECS
+
+
+def node_default(parameter: str) -> Any:
+    """Return the node's default of ``parameter``: every tool's default (one set, the node's).
+
+    The command line's material, friction, method, bound and grid defaults
+    are the node's parameters' (:data:`fastsim_ros.params.PARAMETERS`), read
+    from there, so that the same question gets the same numbers from every tool.
+    """
+    return SPECS[parameter].default
+
 
 #: cells across the bounding box of a shape, per method: exact coefficients are
 #: extrapolated from grids up to this; FastSim's discretisation error at 60
@@ -61,9 +78,10 @@ DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
 #: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
 #: fewer than twice this is solved on its grid alone
 EXACT_COARSEST = 8
-#: the methods of ``coefficients`` and of ``forces`` (the first: ``forces``' default)
+#: the methods of ``coefficients`` (default ``exact``: the coefficients are the exact
+#: theory's numbers) and of ``forces`` (default the node's ``method``)
 COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
-FORCE_METHODS = ("mae", "mae_calibrated", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
+FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -142,9 +160,33 @@ def _add_area(p: argparse.ArgumentParser, *, forces: bool) -> None:
         g.add_argument("--a", type=_finite, help="semi-axis along x (m)")
         g.add_argument("--b", type=_finite, help="semi-axis along y (m)")
     g.add_argument("--patch", type=Path, help="CSV with header x,y,pressure (m, m, Pa)")
+    if forces:
+        cells = (f"default {DEFAULT_CELLS['mae_calibrated_forces']} for every method (exact on "
+                 "a shape: extrapolated from N/2 and N cells)")
+    else:
+        by_count: dict[int, list[str]] = {}
+        for method in COEFFICIENT_METHODS:
+            by_count.setdefault(DEFAULT_CELLS[method], []).append(method)
+        cells = "default " + ", ".join(f"{n} ({', '.join(ms)})" for n, ms in by_count.items())
+        cells += "; exact on a shape: the finest grid of its extrapolation"
     p.add_argument("--cells", type=_cells,
-                   help="cells along each axis of a shape's bounding box (a patch keeps its grid)")
+                   help="cells along each axis of a shape's bounding box (a patch keeps its "
+                   f"grid); {cells}")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def add_material(p: Any, finite: Callable[[str], float]) -> None:
+    """Add ``--shear-modulus`` and ``--nu`` with the node's defaults, shown in the help."""
+    p.add_argument("--shear-modulus", type=finite, default=node_default("shear_modulus"),
+                   help="combined shear modulus G (Pa; default %(default)g, the node's)")
+    add_poisson_ratio(p, finite)
+
+
+def add_poisson_ratio(p: Any, finite: Callable[[str], float]) -> None:
+    """Add ``--nu`` with the node's default (steel), shown in the help."""
+    p.add_argument("--nu", type=finite, default=node_default("poisson_ratio"),
+                   help="Poisson ratio (default %(default)g, steel, the node's; Kalker's "
+                   "published tables are at 0.25: ask for it)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -155,10 +197,11 @@ def build_parser() -> argparse.ArgumentParser:
     co = sub.add_parser("coefficients", help="generalised creepage coefficients C~ij")
     _add_area(co, forces=False)
     co.add_argument("--method", choices=COEFFICIENT_METHODS, default="exact",
-                    help="exact solver (default), MAE's coefficients, the calibrated MAE's "
+                    help="exact solver (default: the coefficients are the exact theory's "
+                    "numbers), MAE's coefficients, the calibrated MAE's "
                     "(its FastSim in full adhesion), MAE + FastSim in full adhesion, or the "
                     "seed's DLM or ASM (FastSim with their flexibilities, full adhesion)")
-    co.add_argument("--nu", type=_finite, default=0.25, help="Poisson ratio (default 0.25)")
+    add_poisson_ratio(co, _finite)
     fo = sub.add_parser("forces", help="creep forces at given creepages")
     _add_area(fo, forces=True)
     fo.add_argument("--xi", type=_finite, required=True, help="longitudinal creepage")
@@ -166,9 +209,10 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--phi", type=_finite, required=True, help="spin creepage (1/m)")
     fo.add_argument("--mu", type=_finite, required=True,
                     help="friction coefficient (the static mu_s of a slip-dependent law)")
-    fo.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
+    fo.add_argument("--friction-law", choices=("constant", "exponential"),
+                    default=node_default("friction_law"),
                     help="constant (Coulomb) or exponential: mu(v) = mu_s ((1 - A) exp(-B v) "
-                    "+ A), v the local slip velocity (m/s)")
+                    "+ A), v the local slip velocity (m/s); default %(default)s, the node's")
     fo.add_argument("--friction-limit-ratio", type=_finite, metavar="A",
                     help="A in (0, 1] of the exponential law")
     fo.add_argument("--friction-decay", type=_finite, metavar="B",
@@ -176,16 +220,14 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--speed", type=_finite, metavar="V",
                     help="rolling speed V (m/s; its magnitude is used)")
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
-    fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
-    fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
-    # INTERFACE.md fixes the paper's MAE as this command's default (scripts depend on it);
-    # the node's `method` defaults to the calibrated MAE, which --method mae_calibrated gives
-    fo.add_argument("--method", choices=FORCE_METHODS, default="mae",
-                    help="mae (default: the paper's MAE), mae_calibrated (the calibrated MAE, "
-                    "the node's default), fastsim_ellipse, exact, fastrip, dlm or asm")
-    fo.add_argument("--bound", choices=BOUNDS, default="given",
+    add_material(fo, _finite)
+    fo.add_argument("--method", choices=FORCE_METHODS, default=node_default("method"),
+                    help="mae_calibrated (the calibrated MAE), mae (the paper's MAE), "
+                    "fastsim_ellipse, exact, fastrip, dlm or asm; default %(default)s, the "
+                    "node's")
+    fo.add_argument("--bound", choices=BOUNDS, default=node_default("traction_bound"),
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
-                    "(Kalker's on a Hertzian patch)")
+                    "(Kalker's on a Hertzian patch); default %(default)s, the node's")
     from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
     cli_wheelset.add_parser(sub, _finite)
     from fastsim_ros import cli_estimate  # the friction fit too (issue 28)

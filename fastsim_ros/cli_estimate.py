@@ -13,9 +13,11 @@ and ``--friction-decay`` give the starting point.  ``--json`` prints
 ``mu_s``, the law's parameters, their standard deviations (null where the
 data do not determine them) and the fitted curve's worst and rms errors in
 % of ``mu_s N``.  Bad files and flags: one line on stderr, exit status 2
-(the checks and messages of :mod:`fastsim_ros.cli`).
+(the checks and messages of :mod:`fastsim_ros.cli`).  Material, friction and
+bound default to the node's parameters.
 
-The default model is Kalker's exact theory (``--method exact``): an offline
+The default model is Kalker's exact theory (``--method exact``, as for
+``coefficients``: a fitted ``mu_s`` is the exact theory's number): an offline
 fit is where the reference belongs; it recovers ``mu_s``, ``A`` and ``B``
 (seconds for a constant law, tens of seconds for the exponential one on a
 dozen samples at the default 60 x 60 cells).  ``--method mae_calibrated``
@@ -59,22 +61,25 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
                    help="constant (fit mu_s) or exponential (fit mu_s, A, B of mu(v) = "
                    "mu_s ((1 - A) exp(-B v) + A))")
-    p.add_argument("--mu", type=finite, default=0.3, help="starting mu_s (default 0.3)")
+    p.add_argument("--mu", type=finite, default=cli.node_default("friction_coefficient"),
+                   help="starting mu_s (default %(default)g, the node's friction_coefficient)")
+    # the fit's starting point of A and B, not the node's (A = 1 would leave B unseen)
     p.add_argument("--friction-limit-ratio", type=finite, default=0.5, metavar="A",
-                   help="starting A of the exponential law (default 0.5)")
+                   help="starting A of the exponential law (default %(default)g)")
     p.add_argument("--friction-decay", type=finite, default=1.0, metavar="B",
-                   help="starting B (s/m) of the exponential law (default 1)")
+                   help="starting B (s/m) of the exponential law (default %(default)g)")
     p.add_argument("--speed", type=finite, metavar="V",
                    help="rolling speed V (m/s; its magnitude is used), for the exponential law")
     p.add_argument("--load", type=finite, help="normal load N (N)")
-    p.add_argument("--shear-modulus", type=finite, default=8.0e10, help="combined G (Pa)")
-    p.add_argument("--nu", type=finite, default=0.28, help="Poisson ratio (default 0.28)")
+    cli.add_material(p, finite)
     p.add_argument("--method", choices=METHODS, default="exact",
                    help="the measurement model: exact (default: Kalker's exact theory, the "
-                   "reference; seconds to a minute), mae_calibrated (the node's model, "
-                   "fast), mae or fastsim_ellipse")
-    p.add_argument("--bound", choices=BOUNDS, default="given",
-                   help="traction bound: mu p as given, or parabolic")
+                   "reference, as for coefficients; seconds to a minute), mae_calibrated "
+                   "(the node's method times the knee factor, the node's estimator's "
+                   "model; fast), mae or fastsim_ellipse (times the knee factor too)")
+    p.add_argument("--bound", choices=BOUNDS, default=cli.node_default("traction_bound"),
+                   help="traction bound: mu p as given, or parabolic; default %(default)s, "
+                   "the node's")
 
 
 def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
