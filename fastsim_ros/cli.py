@@ -21,7 +21,11 @@ FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path);
 Defaults are one set, the node's (:func:`node_default` reads
 :data:`fastsim_ros.params.PARAMETERS`): method (``coefficients``: ``exact``,
 the exact theory's numbers), Poisson ratio, shear modulus, friction law,
-bound; each ``--help`` shows them.
+bound; each ``--help`` shows them.  Values that are valid but implausible
+for wheel-rail contact in the stated unit (semi-axes, patch extent and
+pressure, load, creepages, friction, shear modulus:
+:data:`fastsim_ros.plausibility.PLAUSIBILITY`) are refused before any solve,
+in one line naming the likely unit mistake, unless ``--allow-implausible``.
 
 What the command line accepts is bounded (:data:`LIMITS`, :data:`MAX_PATCH_CELLS`,
 :data:`MAX_STRIP_CELLS`, :data:`MAX_EXACT_FORCE_CELLS`): every real contact lies
@@ -46,6 +50,7 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from fastsim_ros import plausibility
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
                                         check_poisson_ratio)
@@ -189,6 +194,20 @@ def add_poisson_ratio(p: Any, finite: Callable[[str], float]) -> None:
                    "published tables are at 0.25: ask for it)")
 
 
+def add_allow_implausible(p: Any, quantities: Sequence[str] | None = None) -> None:
+    """Add ``--allow-implausible``: accept values outside :data:`plausibility.PLAUSIBILITY`.
+
+    ``quantities``: the table's names the command checks (its help lists their
+    ranges); None: all.
+    """
+    ranges = "; ".join(f"{q.quantity} {q.expected()}" for q in plausibility.PLAUSIBILITY
+                       if quantities is None or q.name in quantities)
+    p.add_argument(plausibility.OVERRIDE_FLAG, action="store_true",
+                   help="accept a value outside the plausible range of wheel-rail contact "
+                   "(a scaled rig, a full-slip test); without it such a value is refused "
+                   f"as a likely unit mistake. Plausible: {ranges}")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Return the parser of the two commands and their fixed flags."""
     parser = _Parser(prog="fastsim_contact",
@@ -228,6 +247,7 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--bound", choices=BOUNDS, default=node_default("traction_bound"),
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch); default %(default)s, the node's")
+    add_allow_implausible(fo)
     from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
     cli_wheelset.add_parser(sub, _finite)
     from fastsim_ros import cli_estimate  # the friction fit too (issue 28)
@@ -358,6 +378,55 @@ def _check_material(nu: float, shear_modulus: float | None = None) -> None:
         return
     check_material(nu, shear_modulus)
     _in_range("--shear-modulus", shear_modulus, "shear_modulus", " Pa")
+
+
+def contact_extent(area: areas.GridArea) -> tuple[float, float]:
+    """Return the span (m) of the area's cells in contact along x and y, cell size included."""
+    rows, cols = np.nonzero(area.mask)
+    if cols.size == 0:
+        return 0.0, 0.0
+    return (float(np.ptp(cols)) + 1.0) * area.dx, (float(np.ptp(rows)) + 1.0) * area.dy
+
+
+def check_plausible_area(args: argparse.Namespace, area: areas.GridArea) -> None:
+    """Refuse an area or load implausible for wheel-rail contact (:mod:`plausibility`).
+
+    A patch file: its extent, and its largest pressure unless ``--load``
+    rescales them; an ellipse: ``--a`` and ``--b``; then ``--load`` and the
+    largest pressure it gives.  Skipped with ``--allow-implausible``.
+    """
+    allow = args.allow_implausible
+    if allow:
+        return
+    if args.patch is not None:
+        extent_x, extent_y = contact_extent(area)
+        plausibility.check_patch(extent_x, extent_y,
+                                 None if args.load is not None else float(area.pressure.max()),
+                                 what=str(args.patch))
+    else:
+        plausibility.check("semi_axis", args.a, what="--a")
+        plausibility.check("semi_axis", args.b, what="--b")
+    if args.load is not None:
+        plausibility.check("wheel_load", args.load, what="--load")
+        plausibility.check("peak_pressure", float(area.pressure.max()),
+                           what=f"the largest pressure --load {args.load:g} N gives",
+                           mistake="the load and the area's size do not belong together "
+                           "(one of them in another unit)")
+
+
+def check_plausible_material(args: argparse.Namespace) -> None:
+    """Refuse ``--mu`` or ``--shear-modulus`` implausible for wheel-rail contact."""
+    allow = args.allow_implausible
+    plausibility.check("friction_coefficient", args.mu, what="--mu", allow=allow)
+    plausibility.check("shear_modulus", args.shear_modulus, what="--shear-modulus", allow=allow)
+
+
+def check_plausible_creepages(xi: float, eta: float, phi: float, *, allow: bool,
+                              where: str = "") -> None:
+    """Refuse creepages implausible for wheel-rail contact; ``where`` prefixes their names."""
+    for name, quantity, value in (("xi", "creepage", xi), ("eta", "creepage", eta),
+                                  ("phi", "spin", phi)):
+        plausibility.check(quantity, value, what=f"{where}{name}", allow=allow)
 
 
 def _check_exact_grid(area: areas.GridArea, *, forces: bool,
@@ -500,6 +569,11 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     if args.method == "fastrip" and not isinstance(law, ConstantFriction):
         raise UsageError("--method fastrip takes constant friction (--friction-law constant)")
     patch = _force_area(args)
+    # before any solve: a unit mistake is refused, not answered with believable numbers
+    check_plausible_area(args, patch)
+    check_plausible_material(args)
+    check_plausible_creepages(args.xi, args.eta, args.phi, allow=args.allow_implausible,
+                              where="--")
     result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound,
                               "friction_law": law.name}
     if isinstance(law, ExponentialFriction):

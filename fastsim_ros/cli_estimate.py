@@ -13,8 +13,11 @@ and ``--friction-decay`` give the starting point.  ``--json`` prints
 ``mu_s``, the law's parameters, their standard deviations (null where the
 data do not determine them) and the fitted curve's worst and rms errors in
 % of ``mu_s N``.  Bad files and flags: one line on stderr, exit status 2
-(the checks and messages of :mod:`fastsim_ros.cli`).  Material, friction and
-bound default to the node's parameters.
+(the checks and messages of :mod:`fastsim_ros.cli`); so are values
+implausible for wheel-rail contact (:mod:`fastsim_ros.plausibility`: the
+area, ``--load``, ``--mu``, ``--shear-modulus`` and the measured creepages)
+unless ``--allow-implausible``.  Material, friction and bound default to the
+node's parameters.
 
 The default model is Kalker's exact theory (``--method exact``, as for
 ``coefficients``: a fitted ``mu_s`` is the exact theory's number): an offline
@@ -80,16 +83,20 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--bound", choices=BOUNDS, default=cli.node_default("traction_bound"),
                    help="traction bound: mu p as given, or parabolic; default %(default)s, "
                    "the node's")
+    cli.add_allow_implausible(p)
 
 
-def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
+def read_measured(path: Path, *,
+                  allow_implausible: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Read the measured samples: ``(n, 3)`` creepages and ``(n, 1 or 2)`` forces (N).
 
     Refused (:class:`InvalidInputError`, one line naming the file and the
     line): what :func:`fastsim_ros.cli.read_patch` refuses of a text file,
     a header other than :data:`HEADERS`, a row of the wrong length, a value
     that is not a finite number, a creepage beyond the command line's limits,
-    more than :data:`MAX_SAMPLES` rows, no row.
+    more than :data:`MAX_SAMPLES` rows, no row; and, unless
+    ``allow_implausible``, a creepage implausible for wheel-rail contact
+    (:mod:`fastsim_ros.plausibility`: a percentage typed as a fraction).
     """
     rows = cli._rows(path, cli._patch_lines(path, "measured file"))
     first = next(rows, None)
@@ -114,6 +121,8 @@ def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
                                     f"{spin_max:g} 1/m)")
         if max(abs(v) for v in row[3:]) > 1e12:
             raise InvalidInputError(f"{path}, line {line}: a force beyond 1e12 N")
+        cli.check_plausible_creepages(row[0], row[1], row[2], allow=allow_implausible,
+                                      where=f"{path}, line {line}: ")
         values.append(row)
         if len(values) > MAX_SAMPLES:
             raise InvalidInputError(f"{path}: more than {MAX_SAMPLES:,} samples")
@@ -130,6 +139,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
     cli._check_material(args.nu, args.shear_modulus)
     cli._in_range("--mu", args.mu, "mu", open_low=True)
+    cli.check_plausible_material(args)
     if args.load is not None and not args.load > 0.0:
         raise InvalidInputError(f"--load must be positive, got {args.load:g}")
     exponential = args.friction_law == "exponential"
@@ -143,8 +153,10 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         if not 0.0 <= args.friction_decay <= 1e4:
             raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
                                     f"{args.friction_decay:g}")
-    creepages, measured = read_measured(args.measured)
+    creepages, measured = read_measured(args.measured,
+                                        allow_implausible=args.allow_implausible)
     patch = cli._force_area(args)
+    cli.check_plausible_area(args, patch)   # before any solve
     solver: Any
     if args.method == "exact":
         from fastsim_ros.estimation.model import ExactSolver

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from fastsim_ros import cli
+from fastsim_ros import cli, plausibility
 from fastsim_ros.atomic import check_target, write_atomically
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import ContactForces
@@ -115,6 +115,7 @@ def add_parser(sub: Any, finite: Any) -> None:
     m.add_argument("--cell", type=finite, default=cli.node_default("cell_size"),
                    help="cell size of the potential contact grid (m, default %(default)g, "
                    "the node's cell_size)")
+    cli.add_allow_implausible(m, ("wheel_load", "friction_coefficient", "shear_modulus"))
     t = p.add_argument_group("placement (default: the Manchester benchmark, the node's)")
     t.add_argument("--gauge-width", type=finite, default=cli.node_default("gauge_width"),
                    help="track gauge (m, default %(default)g)")
@@ -138,6 +139,19 @@ def add_parser(sub: Any, finite: Any) -> None:
     s.add_argument("-o", "--output", type=Path, help="the sweep's CSV")
     s.add_argument("--plot", type=Path, help="the sweep's figure (PNG)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def check_plausible(args: argparse.Namespace) -> None:
+    """Refuse ``--load``, ``--mu`` or ``--shear-modulus`` implausible for wheel-rail contact.
+
+    Before any pose is solved (:mod:`fastsim_ros.plausibility`); the node's
+    parameter ranges still bound what ``--allow-implausible`` accepts.
+    """
+    if args.load is not None and math.isfinite(args.load) and args.load > 0.0:
+        # a load that is no load at all is refused by its own check, naming its range
+        plausibility.check("wheel_load", args.load, what="--load",
+                           allow=args.allow_implausible)
+    cli.check_plausible_material(args)
 
 
 def _config(args: argparse.Namespace) -> PipelineConfig:
@@ -277,6 +291,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``wheelset``: one pose, or a sweep written to ``-o``."""
     if not (args.cell > 0.0):
         raise InvalidInputError(f"--cell must be positive, got {args.cell}")
+    check_plausible(args)
     if args.sweep_dy is None:
         if args.dy is None or args.yaw is None:
             raise InvalidInputError("give --dy and --yaw (or --sweep-dy)")

@@ -167,8 +167,9 @@ def test_extreme_but_accepted_numbers_give_finite_answers(capsys, method, extra)
     base.update(zip(CREEP[::2], CREEP[1::2]))
     base.update(zip(extra[::2], extra[1::2]))
     argv = [v for kv in base.items() for v in kv]
+    # beyond wheel-rail practice (the hard limits are the point here): marked intended
     f = assert_answered(*run(capsys, "forces", *argv, "--method", method, "--cells", "20",
-                             "--json"))
+                             "--allow-implausible", "--json"))
     mu = float(base["--mu"])
     # the creep force never exceeds mu N (to the solvers' rounding)
     assert math.hypot(f["Fx"], f["Fy"]) <= mu * f["N"] * (1 + 1e-9)
@@ -391,7 +392,8 @@ def strip_patch(path):
 @pytest.mark.parametrize("method", ["mae_calibrated", "mae"])
 def test_outside_the_tables_is_refused_in_one_line(tmp_path, capsys, method):
     path = strip_patch(tmp_path / "strip.csv")
-    for command in (["forces", *CREEP], ["coefficients"]):
+    # a strip 0.4 m long is no wheel-rail patch (forces refuse its extent): marked intended
+    for command in (["forces", *CREEP, "--allow-implausible"], ["coefficients"]):
         assert_refused(*run(capsys, *command, "--patch", path, "--method", method),
                        "outside the tables' range")
     assert_refused(*run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "500",
