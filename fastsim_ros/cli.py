@@ -18,6 +18,15 @@ FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path);
 ``dlm`` and ``asm`` the seed paper's older ways to FastSim's flexibilities
 (:mod:`~fastsim_ros.contact.dlm`, :mod:`~fastsim_ros.contact.asm`, numpy).
 
+Defaults are one set, the node's (:func:`node_default` reads
+:data:`fastsim_ros.params.PARAMETERS`): method (``coefficients``: ``exact``,
+the exact theory's numbers), Poisson ratio, shear modulus, friction law,
+bound; each ``--help`` shows them.  Values that are valid but implausible
+for wheel-rail contact in the stated unit (semi-axes, patch extent and
+pressure, load, creepages, friction, shear modulus:
+:data:`fastsim_ros.plausibility.PLAUSIBILITY`) are refused before any solve,
+in one line naming the likely unit mistake, unless ``--allow-implausible``.
+
 What the command line accepts is bounded (:data:`LIMITS`, :data:`MAX_PATCH_CELLS`,
 :data:`MAX_STRIP_CELLS`, :data:`MAX_EXACT_FORCE_CELLS`): every real contact lies
 far inside, and inside them no intermediate quantity can overflow or underflow,
@@ -41,11 +50,24 @@ from typing import Any, NoReturn
 
 import numpy as np
 
+from fastsim_ros import plausibility
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
                                         check_poisson_ratio)
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, FrictionLaw
+from fastsim_ros.params import SPECS
+
+
+def node_default(parameter: str) -> Any:
+    """Return the node's default of ``parameter``: every tool's default (one set, the node's).
+
+    The command line's material, friction, method, bound and grid defaults
+    are the node's parameters' (:data:`fastsim_ros.params.PARAMETERS`), read
+    from there, so that the same question gets the same numbers from every tool.
+    """
+    return SPECS[parameter].default
+
 
 #: cells across the bounding box of a shape, per method: exact coefficients are
 #: extrapolated from grids up to this; FastSim's discretisation error at 60
@@ -61,9 +83,10 @@ DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
 #: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
 #: fewer than twice this is solved on its grid alone
 EXACT_COARSEST = 8
-#: the methods of ``coefficients`` and of ``forces`` (the first: ``forces``' default)
+#: the methods of ``coefficients`` (default ``exact``: the coefficients are the exact
+#: theory's numbers) and of ``forces`` (default the node's ``method``)
 COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
-FORCE_METHODS = ("mae", "mae_calibrated", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
+FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -142,9 +165,47 @@ def _add_area(p: argparse.ArgumentParser, *, forces: bool) -> None:
         g.add_argument("--a", type=_finite, help="semi-axis along x (m)")
         g.add_argument("--b", type=_finite, help="semi-axis along y (m)")
     g.add_argument("--patch", type=Path, help="CSV with header x,y,pressure (m, m, Pa)")
+    if forces:
+        cells = (f"default {DEFAULT_CELLS['mae_calibrated_forces']} for every method (exact on "
+                 "a shape: extrapolated from N/2 and N cells)")
+    else:
+        by_count: dict[int, list[str]] = {}
+        for method in COEFFICIENT_METHODS:
+            by_count.setdefault(DEFAULT_CELLS[method], []).append(method)
+        cells = "default " + ", ".join(f"{n} ({', '.join(ms)})" for n, ms in by_count.items())
+        cells += "; exact on a shape: the finest grid of its extrapolation"
     p.add_argument("--cells", type=_cells,
-                   help="cells along each axis of a shape's bounding box (a patch keeps its grid)")
+                   help="cells along each axis of a shape's bounding box (a patch keeps its "
+                   f"grid); {cells}")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def add_material(p: Any, finite: Callable[[str], float]) -> None:
+    """Add ``--shear-modulus`` and ``--nu`` with the node's defaults, shown in the help."""
+    p.add_argument("--shear-modulus", type=finite, default=node_default("shear_modulus"),
+                   help="combined shear modulus G (Pa; default %(default)g, the node's)")
+    add_poisson_ratio(p, finite)
+
+
+def add_poisson_ratio(p: Any, finite: Callable[[str], float]) -> None:
+    """Add ``--nu`` with the node's default (steel), shown in the help."""
+    p.add_argument("--nu", type=finite, default=node_default("poisson_ratio"),
+                   help="Poisson ratio (default %(default)g, steel, the node's; Kalker's "
+                   "published tables are at 0.25: ask for it)")
+
+
+def add_allow_implausible(p: Any, quantities: Sequence[str] | None = None) -> None:
+    """Add ``--allow-implausible``: accept values outside :data:`plausibility.PLAUSIBILITY`.
+
+    ``quantities``: the table's names the command checks (its help lists their
+    ranges); None: all.
+    """
+    ranges = "; ".join(f"{q.quantity} {q.expected()}" for q in plausibility.PLAUSIBILITY
+                       if quantities is None or q.name in quantities)
+    p.add_argument(plausibility.OVERRIDE_FLAG, action="store_true",
+                   help="accept a value outside the plausible range of wheel-rail contact "
+                   "(a scaled rig, a full-slip test); without it such a value is refused "
+                   f"as a likely unit mistake. Plausible: {ranges}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -155,10 +216,11 @@ def build_parser() -> argparse.ArgumentParser:
     co = sub.add_parser("coefficients", help="generalised creepage coefficients C~ij")
     _add_area(co, forces=False)
     co.add_argument("--method", choices=COEFFICIENT_METHODS, default="exact",
-                    help="exact solver (default), MAE's coefficients, the calibrated MAE's "
+                    help="exact solver (default: the coefficients are the exact theory's "
+                    "numbers), MAE's coefficients, the calibrated MAE's "
                     "(its FastSim in full adhesion), MAE + FastSim in full adhesion, or the "
                     "seed's DLM or ASM (FastSim with their flexibilities, full adhesion)")
-    co.add_argument("--nu", type=_finite, default=0.25, help="Poisson ratio (default 0.25)")
+    add_poisson_ratio(co, _finite)
     fo = sub.add_parser("forces", help="creep forces at given creepages")
     _add_area(fo, forces=True)
     fo.add_argument("--xi", type=_finite, required=True, help="longitudinal creepage")
@@ -166,9 +228,10 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--phi", type=_finite, required=True, help="spin creepage (1/m)")
     fo.add_argument("--mu", type=_finite, required=True,
                     help="friction coefficient (the static mu_s of a slip-dependent law)")
-    fo.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
+    fo.add_argument("--friction-law", choices=("constant", "exponential"),
+                    default=node_default("friction_law"),
                     help="constant (Coulomb) or exponential: mu(v) = mu_s ((1 - A) exp(-B v) "
-                    "+ A), v the local slip velocity (m/s)")
+                    "+ A), v the local slip velocity (m/s); default %(default)s, the node's")
     fo.add_argument("--friction-limit-ratio", type=_finite, metavar="A",
                     help="A in (0, 1] of the exponential law")
     fo.add_argument("--friction-decay", type=_finite, metavar="B",
@@ -176,16 +239,15 @@ def build_parser() -> argparse.ArgumentParser:
     fo.add_argument("--speed", type=_finite, metavar="V",
                     help="rolling speed V (m/s; its magnitude is used)")
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
-    fo.add_argument("--shear-modulus", type=_finite, default=8.0e10, help="combined G (Pa)")
-    fo.add_argument("--nu", type=_finite, default=0.28, help="Poisson ratio (default 0.28)")
-    # INTERFACE.md fixes the paper's MAE as this command's default (scripts depend on it);
-    # the node's `method` defaults to the calibrated MAE, which --method mae_calibrated gives
-    fo.add_argument("--method", choices=FORCE_METHODS, default="mae",
-                    help="mae (default: the paper's MAE), mae_calibrated (the calibrated MAE, "
-                    "the node's default), fastsim_ellipse, exact, fastrip, dlm or asm")
-    fo.add_argument("--bound", choices=BOUNDS, default="given",
+    add_material(fo, _finite)
+    fo.add_argument("--method", choices=FORCE_METHODS, default=node_default("method"),
+                    help="mae_calibrated (the calibrated MAE), mae (the paper's MAE), "
+                    "fastsim_ellipse, exact, fastrip, dlm or asm; default %(default)s, the "
+                    "node's")
+    fo.add_argument("--bound", choices=BOUNDS, default=node_default("traction_bound"),
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
-                    "(Kalker's on a Hertzian patch)")
+                    "(Kalker's on a Hertzian patch); default %(default)s, the node's")
+    add_allow_implausible(fo)
     from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
     cli_wheelset.add_parser(sub, _finite)
     from fastsim_ros import cli_estimate  # the friction fit too (issue 28)
@@ -316,6 +378,55 @@ def _check_material(nu: float, shear_modulus: float | None = None) -> None:
         return
     check_material(nu, shear_modulus)
     _in_range("--shear-modulus", shear_modulus, "shear_modulus", " Pa")
+
+
+def contact_extent(area: areas.GridArea) -> tuple[float, float]:
+    """Return the span (m) of the area's cells in contact along x and y, cell size included."""
+    rows, cols = np.nonzero(area.mask)
+    if cols.size == 0:
+        return 0.0, 0.0
+    return (float(np.ptp(cols)) + 1.0) * area.dx, (float(np.ptp(rows)) + 1.0) * area.dy
+
+
+def check_plausible_area(args: argparse.Namespace, area: areas.GridArea) -> None:
+    """Refuse an area or load implausible for wheel-rail contact (:mod:`plausibility`).
+
+    A patch file: its extent, and its largest pressure unless ``--load``
+    rescales them; an ellipse: ``--a`` and ``--b``; then ``--load`` and the
+    largest pressure it gives.  Skipped with ``--allow-implausible``.
+    """
+    allow = args.allow_implausible
+    if allow:
+        return
+    if args.patch is not None:
+        extent_x, extent_y = contact_extent(area)
+        plausibility.check_patch(extent_x, extent_y,
+                                 None if args.load is not None else float(area.pressure.max()),
+                                 what=str(args.patch))
+    else:
+        plausibility.check("semi_axis", args.a, what="--a")
+        plausibility.check("semi_axis", args.b, what="--b")
+    if args.load is not None:
+        plausibility.check("wheel_load", args.load, what="--load")
+        plausibility.check("peak_pressure", float(area.pressure.max()),
+                           what=f"the largest pressure --load {args.load:g} N gives",
+                           mistake="the load and the area's size do not belong together "
+                           "(one of them in another unit)")
+
+
+def check_plausible_material(args: argparse.Namespace) -> None:
+    """Refuse ``--mu`` or ``--shear-modulus`` implausible for wheel-rail contact."""
+    allow = args.allow_implausible
+    plausibility.check("friction_coefficient", args.mu, what="--mu", allow=allow)
+    plausibility.check("shear_modulus", args.shear_modulus, what="--shear-modulus", allow=allow)
+
+
+def check_plausible_creepages(xi: float, eta: float, phi: float, *, allow: bool,
+                              where: str = "") -> None:
+    """Refuse creepages implausible for wheel-rail contact; ``where`` prefixes their names."""
+    for name, quantity, value in (("xi", "creepage", xi), ("eta", "creepage", eta),
+                                  ("phi", "spin", phi)):
+        plausibility.check(quantity, value, what=f"{where}{name}", allow=allow)
 
 
 def _check_exact_grid(area: areas.GridArea, *, forces: bool,
@@ -458,6 +569,11 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     if args.method == "fastrip" and not isinstance(law, ConstantFriction):
         raise UsageError("--method fastrip takes constant friction (--friction-law constant)")
     patch = _force_area(args)
+    # before any solve: a unit mistake is refused, not answered with believable numbers
+    check_plausible_area(args, patch)
+    check_plausible_material(args)
+    check_plausible_creepages(args.xi, args.eta, args.phi, allow=args.allow_implausible,
+                              where="--")
     result: dict[str, Any] = {"method": args.method, "N": patch.load, "bound": args.bound,
                               "friction_law": law.name}
     if isinstance(law, ExponentialFriction):
@@ -623,11 +739,42 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
             if all(v is not None for _, v in values):
                 print("  " + "  ".join(f"{k} = {v:9.4f}" for k, v in values))
     else:
-        print(f"method {result['method']}, N = {result['N']:.6g} N, friction "
-              f"{result['friction_law']}")
-        print(f"  Fx = {result['Fx']:.6g} N\n  Fy = {result['Fy']:.6g} N\n"
-              f"  Mz = {result['Mz']:.6g} N m\n"
-              f"  slip fraction = {result['slip_fraction']:.4g}")
+        print_forces(result)
+
+
+#: units of the ``forces`` result's numbers in the readable table (the rest: none)
+FORCE_UNITS = {"N": "N", "Fx": "N", "Fy": "N", "Mz": "N m", "split_y": "m", "speed": "m/s",
+               "friction_decay": "s/m", "area": "m^2", "a": "m", "b": "m", "x_c": "m",
+               "y_c": "m"}
+
+
+def _text(key: str, value: Any) -> str:
+    """Return one value of a result as the readable table shows it, with its unit."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        unit = FORCE_UNITS.get(key)
+        return f"{value:.6g}" + (f" {unit}" if unit else "")
+    if isinstance(value, dict):
+        return ", ".join(f"{k} {_text(k, v)}" for k, v in value.items())
+    if isinstance(value, list):
+        if key == "cells":
+            return " x ".join(str(v) for v in value)
+        return "; ".join(f"[{_text(key, v)}]" for v in value)
+    return str(value)
+
+
+def print_forces(result: dict[str, Any]) -> None:
+    """Print every field of a ``forces`` result, one ``key = value`` line each (JSON's keys)."""
+    first = [k for k in ("method", "N", "Fx", "Fy", "Mz", "slip_fraction") if k in result]
+    for key in first + [k for k in result if k not in first]:
+        text = _text(key, result[key])
+        if key == "cells" and result.get("extrapolated"):
+            # the exact forces on a shape: the two grids of the extrapolation, cells across
+            text = " and ".join(str(n) for n in result[key]) + " across (extrapolated)"
+        print(f"  {key} = {text}")
 
 
 def _run(argv: Sequence[str] | None) -> tuple[argparse.Namespace, dict[str, Any]]:

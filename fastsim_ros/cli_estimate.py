@@ -12,10 +12,18 @@ wheel in N, METHOD.md's signs) on the area of ``forces`` (``--shape ellipse
 and ``--friction-decay`` give the starting point.  ``--json`` prints
 ``mu_s``, the law's parameters, their standard deviations (null where the
 data do not determine them) and the fitted curve's worst and rms errors in
-% of ``mu_s N``.  Bad files and flags: one line on stderr, exit status 2
-(the checks and messages of :mod:`fastsim_ros.cli`).
+% of ``mu_s N``, and ``model_correction`` (``knee_factor`` or ``none``,
+with ``model_correction_note`` in words, also in the readable table): the
+correction the fit's model applies to the method's force.  Bad files and
+flags: one line on stderr, exit status 2 (the checks and messages of
+:mod:`fastsim_ros.cli`); so are values implausible for wheel-rail contact
+(:mod:`fastsim_ros.plausibility`: the area, ``--load``, ``--mu``,
+``--shear-modulus`` and the measured creepages) unless
+``--allow-implausible``.  Material, friction and bound default to the
+node's parameters.
 
-The default model is Kalker's exact theory (``--method exact``): an offline
+The default model is Kalker's exact theory (``--method exact``, as for
+``coefficients``: a fitted ``mu_s`` is the exact theory's number): an offline
 fit is where the reference belongs; it recovers ``mu_s``, ``A`` and ``B``
 (seconds for a constant law, tens of seconds for the exponential one on a
 dozen samples at the default 60 x 60 cells).  ``--method mae_calibrated``
@@ -59,32 +67,39 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
                    help="constant (fit mu_s) or exponential (fit mu_s, A, B of mu(v) = "
                    "mu_s ((1 - A) exp(-B v) + A))")
-    p.add_argument("--mu", type=finite, default=0.3, help="starting mu_s (default 0.3)")
+    p.add_argument("--mu", type=finite, default=cli.node_default("friction_coefficient"),
+                   help="starting mu_s (default %(default)g, the node's friction_coefficient)")
+    # the fit's starting point of A and B, not the node's (A = 1 would leave B unseen)
     p.add_argument("--friction-limit-ratio", type=finite, default=0.5, metavar="A",
-                   help="starting A of the exponential law (default 0.5)")
+                   help="starting A of the exponential law (default %(default)g)")
     p.add_argument("--friction-decay", type=finite, default=1.0, metavar="B",
-                   help="starting B (s/m) of the exponential law (default 1)")
+                   help="starting B (s/m) of the exponential law (default %(default)g)")
     p.add_argument("--speed", type=finite, metavar="V",
                    help="rolling speed V (m/s; its magnitude is used), for the exponential law")
     p.add_argument("--load", type=finite, help="normal load N (N)")
-    p.add_argument("--shear-modulus", type=finite, default=8.0e10, help="combined G (Pa)")
-    p.add_argument("--nu", type=finite, default=0.28, help="Poisson ratio (default 0.28)")
+    cli.add_material(p, finite)
     p.add_argument("--method", choices=METHODS, default="exact",
                    help="the measurement model: exact (default: Kalker's exact theory, the "
-                   "reference; seconds to a minute), mae_calibrated (the node's model, "
-                   "fast), mae or fastsim_ellipse")
-    p.add_argument("--bound", choices=BOUNDS, default="given",
-                   help="traction bound: mu p as given, or parabolic")
+                   "reference, as for coefficients; seconds to a minute), mae_calibrated "
+                   "(the node's method times the knee factor, the node's estimator's "
+                   "model; fast), mae or fastsim_ellipse (times the knee factor too)")
+    p.add_argument("--bound", choices=BOUNDS, default=cli.node_default("traction_bound"),
+                   help="traction bound: mu p as given, or parabolic; default %(default)s, "
+                   "the node's")
+    cli.add_allow_implausible(p)
 
 
-def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
+def read_measured(path: Path, *,
+                  allow_implausible: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Read the measured samples: ``(n, 3)`` creepages and ``(n, 1 or 2)`` forces (N).
 
     Refused (:class:`InvalidInputError`, one line naming the file and the
     line): what :func:`fastsim_ros.cli.read_patch` refuses of a text file,
     a header other than :data:`HEADERS`, a row of the wrong length, a value
     that is not a finite number, a creepage beyond the command line's limits,
-    more than :data:`MAX_SAMPLES` rows, no row.
+    more than :data:`MAX_SAMPLES` rows, no row; and, unless
+    ``allow_implausible``, a creepage implausible for wheel-rail contact
+    (:mod:`fastsim_ros.plausibility`: a percentage typed as a fraction).
     """
     rows = cli._rows(path, cli._patch_lines(path, "measured file"))
     first = next(rows, None)
@@ -109,6 +124,8 @@ def read_measured(path: Path) -> tuple[np.ndarray, np.ndarray]:
                                     f"{spin_max:g} 1/m)")
         if max(abs(v) for v in row[3:]) > 1e12:
             raise InvalidInputError(f"{path}, line {line}: a force beyond 1e12 N")
+        cli.check_plausible_creepages(row[0], row[1], row[2], allow=allow_implausible,
+                                      where=f"{path}, line {line}: ")
         values.append(row)
         if len(values) > MAX_SAMPLES:
             raise InvalidInputError(f"{path}: more than {MAX_SAMPLES:,} samples")
@@ -125,6 +142,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
     cli._check_material(args.nu, args.shear_modulus)
     cli._in_range("--mu", args.mu, "mu", open_low=True)
+    cli.check_plausible_material(args)
     if args.load is not None and not args.load > 0.0:
         raise InvalidInputError(f"--load must be positive, got {args.load:g}")
     exponential = args.friction_law == "exponential"
@@ -138,8 +156,10 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         if not 0.0 <= args.friction_decay <= 1e4:
             raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
                                     f"{args.friction_decay:g}")
-    creepages, measured = read_measured(args.measured)
+    creepages, measured = read_measured(args.measured,
+                                        allow_implausible=args.allow_implausible)
     patch = cli._force_area(args)
+    cli.check_plausible_area(args, patch)   # before any solve
     solver: Any
     if args.method == "exact":
         from fastsim_ros.estimation.model import ExactSolver
@@ -155,6 +175,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         solver = ExactSolver(args.nu, args.shear_modulus)
     else:
         solver = solver_for(args.method, args.nu, args.shear_modulus)
+    correction, note = model_correction(args.method, args.bound, solver)
     # a fast method as the node's estimator takes it: times the knee factor
     fit = fit_friction(solver, patch, creepages, measured, law=args.friction_law,
                        speed=args.speed, bound=args.bound, mu0=args.mu,
@@ -183,6 +204,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 
     result: dict[str, Any] = {
         "mu_static": fit.mu_s, "friction_law": fit.law, "method": args.method,
+        "model_correction": correction, "model_correction_note": note,
         "N": fit.load, "samples": int(creepages.shape[0]),
         "components": ["Fx", "Fy"][:measured.shape[1]],
         "sigma_mu_static": finite_or_none(fit.sigmas["mu_s"]),
@@ -199,6 +221,27 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     return result
 
 
+def model_correction(method: str, bound: str, solver: Any) -> tuple[str, str]:
+    """Return the correction the fit's model applies to the method's force, and why, in words.
+
+    ``("knee_factor", ...)`` for a fast method under the given bound (the
+    node's estimator's model, :class:`~fastsim_ros.estimation.model.CreepModel`),
+    ``("none", ...)`` otherwise: a fitted ``mu_s`` differs from the one that
+    made forces with the method alone by the knee factor's share.
+    """
+    if method == "exact":
+        return "none", "the exact theory's forces, uncorrected"
+    from fastsim_ros.estimation.model import CreepModel
+    if not CreepModel(solver, bound=bound).knee_corrected:
+        return "none", (f"{method}'s forces, uncorrected (the knee factor is tabulated for "
+                        "--bound given only)")
+    return "knee_factor", (
+        f"{method}'s force times the knee factor (fastsim_ros/contact/knee.py): "
+        "|F_exact| / |F_FastSim| at the same normalised creepage, as the node's estimator; "
+        f"forces {method} made alone are fitted with a mu_s a few per cent off (the knee "
+        "error, up to 6% of mu N)")
+
+
 def print_table(result: dict[str, Any]) -> None:
     """Print the fit readably."""
     def pm(v: float | None, s: float | None) -> str:
@@ -210,6 +253,8 @@ def print_table(result: dict[str, Any]) -> None:
           f"{result['N']:.6g} N, {result['samples']} samples of "
           f"{', '.join(result['components'])}")
     print(f"  mu_s = {pm(result['mu_static'], result['sigma_mu_static'])}")
+    print(f"  model correction: {result['model_correction']}: "
+          f"{result['model_correction_note']}")
     if result["friction_law"] == "exponential":
         print(f"  A = {pm(result['friction_limit_ratio'], result['sigma_friction_limit_ratio'])}")
         unit = " s/m" if result["friction_decay"] is not None else ""

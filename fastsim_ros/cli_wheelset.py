@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from fastsim_ros import cli, plausibility
 from fastsim_ros.atomic import check_target, write_atomically
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import ContactForces
@@ -86,8 +87,8 @@ def add_parser(sub: Any, finite: Any) -> None:
     g.add_argument("--rail", default=UIC60, help="rail profile (.prr or two-column y z)")
     g.add_argument("--right-wheel", default="", help="right wheel profile (default: mirror)")
     g.add_argument("--right-rail", default="", help="right rail profile (default: mirror)")
-    g.add_argument("--smooth", type=finite, default=0.0,
-                   help="profile smoothing wavelength L_filt (m, 0: none)")
+    g.add_argument("--smooth", type=finite, default=cli.node_default("profile_smoothing"),
+                   help="profile smoothing wavelength L_filt (m, 0: none; default %(default)g)")
     q = p.add_argument_group("pose and load")
     q.add_argument("--dy", type=finite, help="lateral shift (m, positive left)")
     q.add_argument("--yaw", type=finite, help="yaw angle (rad, about z)")
@@ -102,25 +103,34 @@ def add_parser(sub: Any, finite: Any) -> None:
     k.add_argument("--lateral-speed", type=finite, default=0.0, help="lateral speed (m/s)")
     k.add_argument("--yaw-rate", type=finite, default=0.0, help="yaw rate (rad/s)")
     m = p.add_argument_group("material and solver")
-    m.add_argument("--mu", type=finite, default=0.3, help="friction coefficient (default 0.3)")
-    m.add_argument("--shear-modulus", type=finite, default=8.0e10, help="combined G (Pa)")
-    m.add_argument("--nu", type=finite, default=0.28, help="Poisson ratio (default 0.28)")
-    m.add_argument("--method", choices=METHODS, default="mae_calibrated",
-                   help="creep force method: the node's (default mae_calibrated) or exact")
-    m.add_argument("--bound", choices=("given", "parabolic"), default="given",
-                   help="traction bound of the fast methods")
-    m.add_argument("--cell", type=finite, default=2e-4,
-                   help="cell size of the potential contact grid (m, default 2e-4)")
-    t = p.add_argument_group("placement (default: the Manchester benchmark)")
-    t.add_argument("--gauge-width", type=finite, default=1.435, help="track gauge (m)")
-    t.add_argument("--gauge-height", type=finite, default=0.014,
-                   help="gauge measuring depth below the rail top (m)")
-    t.add_argument("--cant", type=finite, default=0.0,
-                   help="rail inclination added to the profile's (rad)")
-    t.add_argument("--flange-back-distance", type=finite, default=1.360, help="(m)")
-    t.add_argument("--flange-back-position", type=finite, default=-0.070,
-                   help="flange back in wheel profile coordinates (m)")
-    t.add_argument("--nominal-radius", type=finite, default=0.460, help="(m)")
+    m.add_argument("--mu", type=finite, default=cli.node_default("friction_coefficient"),
+                   help="friction coefficient (default %(default)g, the node's)")
+    cli.add_material(m, finite)
+    m.add_argument("--method", choices=METHODS, default=cli.node_default("method"),
+                   help="creep force method: the node's methods or exact; default "
+                   "%(default)s, the node's")
+    m.add_argument("--bound", choices=("given", "parabolic"),
+                   default=cli.node_default("traction_bound"),
+                   help="traction bound of the fast methods (default %(default)s, the node's)")
+    m.add_argument("--cell", type=finite, default=cli.node_default("cell_size"),
+                   help="cell size of the potential contact grid (m, default %(default)g, "
+                   "the node's cell_size)")
+    cli.add_allow_implausible(m, ("wheel_load", "friction_coefficient", "shear_modulus"))
+    t = p.add_argument_group("placement (default: the Manchester benchmark, the node's)")
+    t.add_argument("--gauge-width", type=finite, default=cli.node_default("gauge_width"),
+                   help="track gauge (m, default %(default)g)")
+    t.add_argument("--gauge-height", type=finite, default=cli.node_default("gauge_height"),
+                   help="gauge measuring depth below the rail top (m, default %(default)g)")
+    t.add_argument("--cant", type=finite, default=cli.node_default("cant"),
+                   help="rail inclination added to the profile's (rad, default %(default)g)")
+    t.add_argument("--flange-back-distance", type=finite,
+                   default=cli.node_default("flange_back_distance"),
+                   help="(m, default %(default)g)")
+    t.add_argument("--flange-back-position", type=finite,
+                   default=cli.node_default("flange_back_position"),
+                   help="flange back in wheel profile coordinates (m, default %(default)g)")
+    t.add_argument("--nominal-radius", type=finite, default=cli.node_default("nominal_radius"),
+                   help="(m, default %(default)g)")
     s = p.add_argument_group("sweep (instead of one pose)")
     s.add_argument("--sweep-dy", type=finite, nargs=3, metavar=("Y0", "Y1", "STEP"),
                    help="lateral shifts from Y0 to Y1 by STEP (m)")
@@ -129,6 +139,19 @@ def add_parser(sub: Any, finite: Any) -> None:
     s.add_argument("-o", "--output", type=Path, help="the sweep's CSV")
     s.add_argument("--plot", type=Path, help="the sweep's figure (PNG)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+
+
+def check_plausible(args: argparse.Namespace) -> None:
+    """Refuse ``--load``, ``--mu`` or ``--shear-modulus`` implausible for wheel-rail contact.
+
+    Before any pose is solved (:mod:`fastsim_ros.plausibility`); the node's
+    parameter ranges still bound what ``--allow-implausible`` accepts.
+    """
+    if args.load is not None and math.isfinite(args.load) and args.load > 0.0:
+        # a load that is no load at all is refused by its own check, naming its range
+        plausibility.check("wheel_load", args.load, what="--load",
+                           allow=args.allow_implausible)
+    cli.check_plausible_material(args)
 
 
 def _config(args: argparse.Namespace) -> PipelineConfig:
@@ -268,6 +291,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     """Run ``wheelset``: one pose, or a sweep written to ``-o``."""
     if not (args.cell > 0.0):
         raise InvalidInputError(f"--cell must be positive, got {args.cell}")
+    check_plausible(args)
     if args.sweep_dy is None:
         if args.dy is None or args.yaw is None:
             raise InvalidInputError("give --dy and --yaw (or --sweep-dy)")
