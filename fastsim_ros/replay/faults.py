@@ -21,9 +21,11 @@ ENV = "FASTSIM_REPLAY_PAUSE"
 #: first task, its staging directory made), ``replay`` after the warm-up with the input
 #: read and the staged outputs half written, ``commit`` between the renames of the
 #: outputs into place (the bag renamed, the rest not), ``committed`` every output in place,
-#: the result not yet returned, ``replace`` (``--overwrite``) an earlier run's output moved
+#: the result not yet returned
+MOMENTS = ("warm-up", "replay", "commit", "committed")
+#: a moment of an overwriting run only (``--overwrite``): an earlier run's output moved
 #: aside, its successor not yet in its place
-MOMENTS = ("warm-up", "replay", "commit", "committed", "replace")
+REPLACE = "replace"
 #: how long a held process sleeps before going on (bounds a test whose kill never came)
 PAUSE_S = 60.0
 

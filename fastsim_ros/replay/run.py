@@ -297,7 +297,7 @@ def _run_local(task: Task, profile: bool) -> Result:
         for tmp, final in zip(staged, finals):
             if task.overwrite and _set_aside(final, staging):
                 aside.append(final)
-                faults.pause("replace")
+                faults.pause(faults.REPLACE)
             if os.path.lexists(tmp):
                 os.rename(tmp, final)
                 moved.append(final)
@@ -319,16 +319,16 @@ def _run_local(task: Task, profile: bool) -> Result:
     except Exception as e:  # a bug: still one line, and the other inputs go on
         result.status, result.error = 1, f"{source}: internal error: {problem(e)}"
     finally:
-        if not (done and task.retry):   # a committed result stays for another attempt
-            shutil.rmtree(staging, ignore_errors=True)
         if not done:
             result.ok = False
             for p in moved:  # a partial rename: take back what this bag put there
                 shutil.rmtree(p, ignore_errors=True) if p.is_dir() else p.unlink(missing_ok=True)
-            for p in aside:  # and put back what it replaced
+            for p in aside:  # and put back what it replaced (before its staging goes)
                 if not os.path.lexists(p):
                     os.rename(staging / REPLACED / p.name, p)
             result.written = []
+        if not (done and task.retry):   # a committed result stays for another attempt
+            shutil.rmtree(staging, ignore_errors=True)
     return result
 
 
