@@ -486,3 +486,24 @@ def test_overwrite_into_a_url(earlier, tmp_path):
         (tmp_path / "fresh" / "hertz_ramp.csv").read_text()
     assert decoded_without_timing(bag_contents(earlier / "hertz_ramp")[0]) == \
         decoded_without_timing(bag_contents(tmp_path / "fresh" / "hertz_ramp")[0])
+
+
+@pytest.mark.parametrize("steps, last, cycles, path", [
+    ([], 0.3, 5, [0.3]),                                  # held: the start is the path
+    ([(0.01, 0.3), (1.5, 0.4), (3.0, 0.2)], 0.4, 9, [0.3, 0.4, 0.2, 0.4]),
+    ([(1.5, 0.4)], 0.2, 9, [0.3, 0.4, 0.2]),
+])
+def test_the_path_is_the_start_the_level_before_each_step_and_the_last(steps, last, cycles,
+                                                                       path):
+    from fastsim_ros.replay.results import FrictionPath
+    f = FrictionPath(0.3, last, 0.01, cycles, {"updated": cycles}, steps, 0.9)
+    assert f.levels() == path
+    assert f.summary("x.friction.csv")[0].endswith(
+        "; path " + " -> ".join(f"{mu:.3g}" for mu in path))
+
+
+def test_an_estimation_without_a_cycle_says_so():
+    from fastsim_ros.replay.results import FrictionPath
+    (line,) = FrictionPath(0.3).summary("x.friction.csv")
+    assert line == ("  friction estimate: mu_s 0.3 at the start; no estimate published (no rig "
+                    "cycle completed) -> x.friction.csv")

@@ -60,8 +60,8 @@ class FrictionPath:
     def levels(self) -> list[float]:
         """Return the estimate's path: the start, where it settled before each step, the last.
 
-        A step seen right after another (no cycle between them) or at the
-        first cycle adds no level (the estimate had not settled).
+        A level equal to the one before it (a step seen at the first cycle,
+        before the estimate moved) is given once.
         """
         path = [self.start]
         for _, before in self.steps:
@@ -73,6 +73,9 @@ class FrictionPath:
 
     def summary(self, where: str) -> list[str]:
         """Return the summary's lines (``where``: the friction CSV, or empty)."""
+        if not self.cycles:
+            return [f"  friction estimate: mu_s {self.start:g} at the start; no estimate "
+                    "published (no rig cycle completed)" + (f" -> {where}" if where else "")]
         counts = ", ".join(f"{n} {s}" for s, n in self.statuses.items() if n)
         path = " -> ".join(f"{mu:.3g}" for mu in self.levels())
         steps = (f"{len(self.steps)} step{'s' if len(self.steps) != 1 else ''} of mu_s seen"
