@@ -44,7 +44,7 @@ STATUSES = ("updated", "unobservable", "implausible", "no_measurement")
 
 
 def stamp(msg):
-    """Return a message's header stamp (ns)."""
+    """Return the header's time of a message (ns)."""
     return msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
 
 
@@ -342,7 +342,7 @@ def _snapshot(out):
 
 @pytest.fixture
 def earlier(tmp_path):
-    """An OUT holding hertz_ramp's outputs of an earlier run, marked as that run's."""
+    """Return an OUT holding hertz_ramp's outputs of an earlier run, marked as that run's."""
     out = tmp_path / "out"
     status, _, err = quiet_run([BAGS / "hertz_ramp", "-o", out, "--csv", "--plot"])
     assert status == 0, err

@@ -567,7 +567,7 @@ class _Outputs:
             self.estimate(outcome.friction, log_ns)
 
     def estimate(self, e: FrictionEstimate, log_ns: int) -> None:
-        """Record a friction estimate (a rig cycle's); its mu is in force from now on."""
+        """Record a rig cycle's friction estimate; its mu is in force from now on."""
         t = (log_ns - self.first) * 1e-9
         path = self.path
         if path is not None:
