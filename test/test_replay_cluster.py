@@ -233,3 +233,69 @@ def test_jobs_and_scheduler_together_are_refused(tmp_path):
                   "tcp://127.0.0.1:9")
     assert proc.returncode == 2 and "give one" in proc.stderr
     assert not (tmp_path / "out").exists()
+
+
+def _estimate_lines(stdout: str) -> list[str]:
+    return [line for line in stdout.splitlines() if "estimate" in line]
+
+
+@pytest.mark.parametrize("url", [False, True])
+def test_an_overwrite_on_a_cluster_shows_the_estimate_and_survives_a_killed_worker(
+        tmp_path, url):
+    """adhesion_rig over an earlier output, the worker killed with that output set aside.
+
+    The task runs again and finishes the commit it journalled: the new
+    outputs (bag, CSV, friction CSV) in place, the earlier ones gone, the
+    summary with the friction estimate as a local run gives it.
+    """
+    params = BAGS / "adhesion_rig.params.yaml"
+    local = replay(BAGS / "adhesion_rig", "-o", tmp_path / "local", "--csv", "--params", params)
+    assert local.returncode == 0, local.stderr
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "adhesion_rig").mkdir()
+    (out / "adhesion_rig" / "earlier.txt").write_text("of the earlier run")
+    (out / "adhesion_rig.csv").write_text("earlier\n")
+    (out / "adhesion_rig.friction.csv").write_text("earlier\n")
+    refused = replay(BAGS / "adhesion_rig", "-o", out, "--csv", "--params", params)
+    assert refused.returncode == 2 and "exists already" in refused.stderr
+    hold = tmp_path / "hold"
+    hold.mkdir()
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    # an overwrite into a URL sets the earlier outputs aside inside its commit (no moment)
+    moment = "commit" if url else faults.REPLACE
+    cluster = LocalProcesses(logs, 2, env=dict(ENV, **{faults.ENV: f"{moment}:{hold}"}),
+                             cwd=ROOT)
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "fastsim_ros.replay", str(BAGS / "adhesion_rig"), "-o",
+             f"file://{out}" if url else str(out), "--csv", "--params", str(params),
+             "--overwrite", "--scheduler", cluster.address],
+            cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            deadline = time.monotonic() + faults.PAUSE_S
+            while not (hold / "pid").exists():
+                assert proc.poll() is None and time.monotonic() < deadline
+                time.sleep(0.01)
+            pid = int((hold / "pid").read_text())
+            victim = next(w for w in cluster.workers if w.pid == pid)
+            victim.kill()
+            victim.wait(timeout=30)
+            stdout, stderr = proc.communicate(timeout=300)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+    finally:
+        cluster.close()
+    assert proc.returncode == 0, stderr
+    assert stderr == ""
+    assert sorted(p.name for p in out.iterdir()) == [
+        "adhesion_rig", "adhesion_rig.csv", "adhesion_rig.friction.csv"]
+    assert not (out / "adhesion_rig" / "earlier.txt").exists()
+    for name in ("adhesion_rig.csv", "adhesion_rig.friction.csv"):
+        assert (out / name).read_text() == (tmp_path / "local" / name).read_text()
+    assert comparable(out / "adhesion_rig") == comparable(tmp_path / "local" / "adhesion_rig")
+    assert _estimate_lines(stdout) == _estimate_lines(local.stdout) != []
+    assert "retried: 2 attempts" in stdout

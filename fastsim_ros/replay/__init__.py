@@ -3,7 +3,7 @@
 Usage (INTERFACE.md, "The offline replay fastsim_replay")::
 
     fastsim_replay IN [IN ...] -o OUT [--params FILE] [--namespace NS] [--plot] [--csv]
-                   [--jobs N | --scheduler ADDRESS]
+                   [--overwrite] [--jobs N | --scheduler ADDRESS]
 
 Each ``IN`` (a rosbag2 directory, or a single ``.mcap``) named ``NAME`` (the
 directory's name, or the file's without ``.mcap``) gives:
@@ -22,13 +22,33 @@ directory's name, or the file's without ``.mcap``) gives:
   (JSON of every checked parameter, defaults filled), ``fastsim.input``
   (the input's path) and ``fastsim.replay`` (this program).
 - with ``--plot``, ``OUT/NAME.png``: per contact, Fx and Fy against time
-  (with +-mu N dashed) and against the creepage that varies most on that
-  contact (``phi`` counted as ``phi * 5 mm``, a typical semi-axis, when
-  comparing spreads).
+  (with +-mu N dashed, mu the one in force: the given one, or with friction
+  estimation the estimate each wrench was solved with; the title says
+  which) and against the creepage that varies most on that contact
+  (``phi`` counted as ``phi * 5 mm``, a typical semi-axis, when comparing
+  spreads); with friction estimation a last row, the estimate with +-2
+  sigma and the wheelset's adhesion utilisation against time.
 - with ``--csv``, ``OUT/NAME.csv``: one row per wrench, header
   :data:`CSV_HEADER`; floats in Python's shortest round-trip form.  A
   ``no_contact`` row (an empty patch, zero wrench) has ``N, Fx, Fy, Mz`` =
   0 and ``xi, eta, phi, V, slip_fraction`` blank (undefined: no contact).
+- with ``--csv`` and ``friction_estimation: on``, ``OUT/NAME.friction.csv``:
+  one row per ``friction/estimate`` message, header
+  :data:`~fastsim_ros.replay.records.FRICTION_CSV_HEADER` (``stamp_ns, mu,
+  sigma, utilisation, status``; the utilisation the wheelset's, ``sum |(Fx,
+  Fy)| / (mu sum N)``).  A target of the input with ``--csv`` whether or not
+  estimation runs (an existing one is refused, or replaced with
+  ``--overwrite``: none stays beside a CSV of another run).
+
+The summary (stdout), per input: the contacts' patches, wrenches and
+rejections; each input topic the node could take but did not (a patch
+topic of a contact not configured, or under another namespace, the
+measured wrench with estimation off, poses and loads with patches from
+topics) with its messages and the parameter or flag that takes it; the
+twists; with friction estimation the estimate's path (its start, the steps
+of ``mu_s`` it saw, where it settled before each, its last value and
+sigma, the estimates by status); each output topic with its messages and
+where they went (the bag and a CSV, or the bag only); the replay's speed.
 
 Messages are fed to :class:`~fastsim_ros.pipeline.Pipeline` in the bag's
 log-time order, raw CDR as read.  Topic names resolve as ROS resolves them:
@@ -40,13 +60,17 @@ every parameter has its default and the contacts are those with a
 summary names them).  Everything is written under a temporary name inside ``OUT``
 and renamed at the end; on failure, Ctrl-C or SIGTERM nothing is left of
 an unfinished input (inputs already done, whose summaries were printed, stay).
+A target that exists is refused before any work, unless ``--overwrite``:
+then each earlier output is moved aside once its successor is complete
+and removed at the end, or moved back if the run fails.
 A progress bar (tqdm, on stderr) appears when stderr is a terminal, ``--jobs``
 is 1 and a bag takes more than a second.
 
 Exit status: 0 all done; 2 bad flags, a bad params file, two inputs with the
-same NAME or a target that exists (all before any work), or a bad, corrupt,
-truncated or empty input (the others are still done); 1 an output that could
-not be written or an internal error; 130 interrupted.  Every problem is one
+same NAME or a target that exists without ``--overwrite`` (all before any
+work), or a bad, corrupt, truncated or empty input (the others are still
+done); 1 an output that could not be written or an internal error; 130
+interrupted.  Every problem is one
 line on stderr naming the file.
 
 ``--jobs N`` replays N inputs at a time on this machine (a fork pool);

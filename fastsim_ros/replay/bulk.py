@@ -93,6 +93,8 @@ class IndexedReplay:
         self.writer = mcap.McapWriter(out_dir / f"{out_dir.name}.mcap")
         self.phases: dict[str, float] = {"read": 0.0, "copy": 0.0, "encode": 0.0,
                                          "write": 0.0, "diagnostics": 0.0, "csv": 0.0}
+        #: the input's messages read, by channel id
+        self.seen: dict[int, int] = {}
         # the input's channels: copied with their ids and schemas, but those on output topics
         self.skip = {cid for cid, ch in indexed.channels.items()
                      if resolve(ch.topic) in self.output_types}
@@ -170,8 +172,10 @@ class IndexedReplay:
         t0 = time.perf_counter()
         channel, log_time, start, size = arrays
         chunk = self.mcap.chunks[k]
+        counts = np.bincount(channel, minlength=1)
+        for c in np.flatnonzero(counts).tolist():
+            self.seen[c] = self.seen.get(c, 0) + int(counts[c])
         if not np.isin(channel, list(self.skip)).any():
-            counts = np.bincount(channel, minlength=1)
             self.writer.copy_chunk(chunk, raw, {c: int(counts[c]) for c in
                                                 np.flatnonzero(counts).tolist()})
             self.result.messages_out += int(channel.size)
@@ -190,7 +194,8 @@ class IndexedReplay:
 
         ``out``: where each wrench's CSV row and plot sample go (``rows``, a
         csv writer or None; ``series``, per contact, or None; ``method``,
-        ``law``; ``first`` is set; ``outcome(outcome, log_ns)`` records one).
+        ``law``, ``mu`` (the static coefficient in force); ``first`` is set;
+        ``outcome(outcome, log_ns)`` records one, and its friction estimate).
         """
         first: int | None = None
         last = 0
@@ -351,7 +356,12 @@ class IndexedReplay:
             self.phases["csv"] += time.perf_counter() - t2
 
     def _records(self, p: batch.Patches, wrench: NDArray[np.bool_], log: Ints) -> None:
-        """Add the CSV row and plot sample of each wrench, in order (records.record's)."""
+        """Add the CSV row and plot sample of each wrench, in order (records.record's).
+
+        The batch runs without friction estimation (its inputs do not include
+        the measured wrench: :func:`batch.supported`), so ``out.mu``, the
+        given coefficient, is every wrench's.
+        """
         out = self.out
         idx = np.flatnonzero(wrench)
         if idx.size == 0:
@@ -363,7 +373,7 @@ class IndexedReplay:
         cr = p.creep[idx].tolist()
         f = p.force[idx].tolist()
         slip = p.slip[idx].tolist()
-        method, law = out.method, out.law
+        method, law, mu = out.method, out.law, out.mu
         if out.rows is not None:
             out.rows.writerows(
                 (s, c, q[0], q[1], q[2], q[3], g[2], g[0], g[1], g[3], sl, method, law) if ok
@@ -374,9 +384,9 @@ class IndexedReplay:
             nan = float("nan")
             for ok, c, tt, q, g in zip(solved, name, t, cr, f):
                 if ok:
-                    out.series[c].add(tt, q[0], q[1], q[2], g[0], g[1], g[2])
+                    out.series[c].add(tt, q[0], q[1], q[2], g[0], g[1], g[2], mu)
                 else:
-                    out.series[c].add(tt, nan, nan, nan, 0.0, 0.0, 0.0)
+                    out.series[c].add(tt, nan, nan, nan, 0.0, 0.0, 0.0, mu)
 
     def _write(self, parts: list[Any], log: Ints) -> None:
         keys = np.concatenate([k for k, _, _, _ in parts])

@@ -43,7 +43,12 @@ def parser() -> argparse.ArgumentParser:
                    help="the node's namespace: patches on NS/contact/<name>/patch, outputs "
                         "under NS (default /; a bag's relative topic names are in /)")
     p.add_argument("--plot", action="store_true", help="write OUT/NAME.png")
-    p.add_argument("--csv", action="store_true", help="write OUT/NAME.csv, one row per wrench")
+    p.add_argument("--csv", action="store_true",
+                   help="write OUT/NAME.csv, one row per wrench (and with friction estimation "
+                        "OUT/NAME.friction.csv, one row per estimate)")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace the outputs of an earlier run (each once its successor is "
+                        "complete; a failed run leaves them as they were)")
     p.add_argument("--jobs", type=_jobs, default=1, metavar="N",
                    help="replay the inputs on N worker processes (default 1)")
     p.add_argument("--scheduler", metavar="ADDRESS", type=scheduler_address,
@@ -122,8 +127,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.scheduler is not None and args.jobs != 1:
         return _fail("--jobs is for this machine, --scheduler for a cluster: give one")
     names: dict[str, Path | str] = {}
-    # every file each input writes in OUT (NAME, NAME.csv, NAME.png): an input named x.csv
-    # replayed with --csv beside one named x would write x.csv twice
+    # every file each input writes in OUT (NAME, NAME.csv, NAME.friction.csv, NAME.png): an
+    # input named x.csv replayed with --csv beside one named x would write x.csv twice
     written: dict[str, Path | str] = {}
     for src in args.inputs:
         name = input_name(src)
@@ -142,8 +147,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _fail(f"{out}: exists and is not a directory")
         for name in names:
             for target in targets(out, name, args.plot, args.csv):
-                if storage.exists(target):
-                    return _fail(f"{target}: exists already; not overwritten")
+                if not args.overwrite and storage.exists(target):
+                    return _fail(f"{target}: exists already; not overwritten (--overwrite "
+                                 "replaces it)")
         made = not storage.exists(out)
         storage.makedirs(out)
     except (OSError, ValueError, ImportError) as e:
@@ -154,7 +160,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     jobs = min(args.jobs, len(names))
     tasks = [Task(src, name, out, values, plot=args.plot, write_csv=args.csv,
                   contacts_from_bag=args.params is None, namespace=args.namespace, tag=tag,
-                  progress=not args.no_progress and jobs == 1 and args.scheduler is None)
+                  progress=not args.no_progress and jobs == 1 and args.scheduler is None,
+                  overwrite=args.overwrite)
              for name, src in names.items()]
     previous = signal.signal(signal.SIGTERM, _terminate)
     status = 0

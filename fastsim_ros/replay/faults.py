@@ -23,6 +23,9 @@ ENV = "FASTSIM_REPLAY_PAUSE"
 #: outputs into place (the bag renamed, the rest not), ``committed`` every output in place,
 #: the result not yet returned
 MOMENTS = ("warm-up", "replay", "commit", "committed")
+#: a moment of an overwriting run only (``--overwrite``): an earlier run's output moved
+#: aside, its successor not yet in its place
+REPLACE = "replace"
 #: how long a held process sleeps before going on (bounds a test whose kill never came)
 PAUSE_S = 60.0
 

@@ -37,6 +37,58 @@ class Profile:
 
 
 @dataclass
+class FrictionPath:
+    """What online friction estimation did over one replay (``friction/estimate``).
+
+    ``start``: the estimate's start (``friction_coefficient``); ``last`` and
+    ``sigma``: the last estimate and its standard deviation; ``cycles``: the
+    estimates published (one per rig cycle), ``statuses`` by status;
+    ``steps``: the steps of ``mu_s`` the estimator saw (its step gate
+    opened), each as ``(t, before)``: the log time since the first message
+    (s) of the cycle that saw it and the estimate before it (where the
+    estimate had settled); ``utilisation``: the largest of the cycles'.
+    """
+
+    start: float
+    last: float = math.nan
+    sigma: float = math.nan
+    cycles: int = 0
+    statuses: dict[str, int] = field(default_factory=dict)
+    steps: list[tuple[float, float]] = field(default_factory=list)
+    utilisation: float = 0.0
+
+    def levels(self) -> list[float]:
+        """Return the estimate's path: the start, where it settled before each step, the last.
+
+        A level equal to the one before it (a step seen at the first cycle,
+        before the estimate moved) is given once.
+        """
+        path = [self.start]
+        for _, before in self.steps:
+            if before != path[-1]:
+                path.append(before)
+        if self.cycles and self.last != path[-1]:
+            path.append(self.last)
+        return path
+
+    def summary(self, where: str) -> list[str]:
+        """Return the summary's lines (``where``: the friction CSV, or empty)."""
+        if not self.cycles:
+            return [f"  friction estimate: mu_s {self.start:g} at the start; no estimate "
+                    "published (no rig cycle completed)" + (f" -> {where}" if where else "")]
+        counts = ", ".join(f"{n} {s}" for s, n in self.statuses.items() if n)
+        path = " -> ".join(f"{mu:.3g}" for mu in self.levels())
+        steps = (f"{len(self.steps)} step{'s' if len(self.steps) != 1 else ''} of mu_s seen"
+                 + (" (at " + ", ".join(f"{t:.2f}" for t, _ in self.steps) + " s)"
+                    if self.steps else ""))
+        lines = [f"  friction estimate: mu_s {self.start:g} at the start, {self.last:.4g} last "
+                 f"(sigma {self.sigma:.3g}); {steps}; path {path}",
+                 f"    {self.cycles} estimates ({counts or 'none'}), utilisation up to "
+                 f"{self.utilisation:.3g}" + (f" -> {where}" if where else "")]
+        return lines
+
+
+@dataclass
 class Result:
     """What the replay of one input gave (picklable: it crosses process pools and clusters)."""
 
@@ -61,6 +113,14 @@ class Result:
     attempts: int = 1
     resumed: bool = False
     profile: Profile | None = None
+    #: the friction estimate's path (estimation on)
+    friction: FrictionPath | None = None
+    #: messages the node published, by output topic (as written to the bag)
+    published: dict[str, int] = field(default_factory=dict)
+    #: output topics that also went to a file beside the bag: topic -> that file's path
+    tabled: dict[str, str] = field(default_factory=dict)
+    #: input topics the node could take but did not, as ``(topic, messages, what takes them)``
+    unused: list[tuple[str, int, str]] = field(default_factory=list)
 
     @property
     def speed(self) -> float:
@@ -96,12 +156,18 @@ class Result:
                    if rejected else "")
                 + (f"; solve p50 {p50:.1f} us, p99 {p99:.1f} us" if math.isfinite(p50)
                    else "; nothing solved"))
+        lines += [f"  {topic}: {n} messages not replayed; {hint}"
+                  for topic, n, hint in self.unused]
         kin = self.kinematics
         dropped = {key: v for key, v in kin.items() if key not in ("wheel", "rail") and v}
         lines.append(f"  twists: {kin.get('wheel', 0)} wheelset, {kin.get('rail', 0)} rail "
                      f"used; dropped {sum(dropped.values())}"
                      + (" (" + ", ".join(f"{r} {n}" for r, n in dropped.items()) + ")"
                         if dropped else ""))
+        if self.friction is not None:
+            files = [p for t, p in self.tabled.items() if t.endswith("/friction/estimate")]
+            lines += self.friction.summary(files[0] if files else "")
+        lines += self._outputs()
         lines.append(f"  replay: {self.wall_s - self.plot_s:.2f} s, {self.speed:.1f}x real time"
                      + (f"; plot {self.plot_s:.2f} s" if self.plot_s else ""))
         if self.attempts > 1 and self.resumed:
@@ -113,3 +179,13 @@ class Result:
                          "replaying it; what it left was removed)")
         lines += [f"  wrote {p}" for p in self.written[1:]]
         return "\n".join(lines)
+
+    def _outputs(self) -> list[str]:
+        """Return the lines that say where each output topic's messages went."""
+        where: dict[str, list[str]] = {}
+        for topic, n in self.published.items():
+            file = self.tabled.get(topic)
+            key = f"the bag and {file}" if file else "the bag only"
+            where.setdefault(key, []).append(f"{topic} {n}")
+        keys = sorted(where, key=lambda k: k == "the bag only")  # the files first
+        return [f"  published to {k}: {', '.join(where[k])}" for k in keys]

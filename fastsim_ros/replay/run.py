@@ -26,7 +26,7 @@ import sys
 import tempfile
 import time
 import uuid
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -35,13 +35,16 @@ from rclpy.serialization import serialize_message
 
 from fastsim_ros.contact.area import turned_grid
 from fastsim_ros.params import SPECS, ParameterError
-from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, PipelineConfig
-from fastsim_ros.profile_pipeline import AnyPipeline, make_pipeline
+from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC,
+                                  MEASURED_WRENCH_TOPIC, FrictionEstimate, Pipeline,
+                                  PipelineConfig)
+from fastsim_ros.profile_pipeline import LOAD_TOPIC, POSE_TOPIC, AnyPipeline, make_pipeline
 from fastsim_ros.replay import bagio, bulk, faults, heap, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
-from fastsim_ros.replay.records import CSV_HEADER, Series, record
-from fastsim_ros.replay.results import Profile, Result
+from fastsim_ros.replay.records import (CSV_HEADER, ESTIMATE_COLUMNS, FRICTION_CSV_HEADER,
+                                        Series, friction_row, record)
+from fastsim_ros.replay.results import FrictionPath, Profile, Result
 from fastsim_ros.replay.bagio import resolve
 
 PROG = "fastsim_replay"
@@ -57,6 +60,9 @@ STAGING = ".replay-tmp"
 #: the committed result, pickled, in the staging directory of a task that may run again
 #: (``Task.retry``): written before its outputs are renamed into place
 JOURNAL = "result.pickle"
+#: where a commit with ``Task.overwrite`` moves the outputs it replaces, in its staging
+#: directory: removed with it, or moved back if the commit fails
+REPLACED = storage.REPLACED
 
 
 @dataclass(frozen=True)
@@ -80,7 +86,11 @@ class Task:
     (:func:`remove_staging`), so that another attempt finishes that commit
     and returns that result instead of replaying again.  ``given``: the input
     as the user named it, where ``source`` is a local copy of a URL (the
-    output's ``fastsim.input``).
+    output's ``fastsim.input``).  ``overwrite``: outputs of an earlier run at
+    the targets are replaced (each moved aside when its successor is
+    complete and moved back if the commit fails), as is a friction CSV that
+    this run does not write (estimation off): no stale one stays beside the
+    new CSV.
     """
 
     source: Path | str
@@ -97,12 +107,25 @@ class Task:
     retry: bool = False
     #: the input as the user named it (a URL fetched to a local copy), for the output's metadata
     given: str = ""
+    overwrite: bool = False
 
 
 def targets(out: Any, name: str, plot: bool, write_csv: bool) -> list[Any]:
-    """Return the paths (or URLs) an input NAME writes into OUT."""
-    names = [name] + ([f"{name}.csv"] if write_csv else []) + ([f"{name}.png"] if plot else [])
+    """Return the paths (or URLs) an input NAME may write into OUT.
+
+    The bag, with ``write_csv`` the CSV and the friction CSV (written only
+    when friction estimation runs, but a target either way: an existing one
+    is refused, or replaced with ``--overwrite``, so that it never stands
+    beside a CSV of another run), with ``plot`` the PNG.
+    """
+    names = ([name] + ([f"{name}.csv", friction_csv(name)] if write_csv else [])
+             + ([f"{name}.png"] if plot else []))
     return [storage.join(out, n) for n in names]
+
+
+def friction_csv(name: str) -> str:
+    """Return the name of an input's friction CSV (the estimate per rig cycle)."""
+    return f"{name}.friction.csv"
 
 
 def replay_bag(source: Path, name: str, out: Path, values: dict[str, Any], *,
@@ -178,25 +201,60 @@ def _attempt_number(staging_name: str, name: str, tag: str) -> int:
 
 
 def remove_staging(out: Path | str, tag: str) -> None:
-    """Remove the staging directories (and kept results) of the run ``tag`` from OUT."""
+    """Remove the staging directories (and kept results) of the run ``tag`` from OUT.
+
+    An output that an overwriting commit had moved aside and whose place is
+    still empty (its process died between the two renames) is moved back
+    first: a replaced output is lost only once its successor is in place.
+    """
     for name in storage.listing(out):
         if name.startswith(".") and f".{tag}." in name and name.endswith(STAGING):
             if storage.is_url(out):
+                storage.restore_replaced(str(out), name)
                 storage.remove(str(out), name)
             else:
+                _restore_replaced(Path(out), Path(out) / name)
                 shutil.rmtree(Path(out) / name, ignore_errors=True)
 
 
-def _finish_commit(out: Path, earlier: Path, attempt: int) -> Result:
+def _restore_replaced(out: Path, staging: Path) -> None:
+    """Move the outputs a commit set aside in ``staging`` back where nothing took their place."""
+    aside = staging / REPLACED
+    for old in storage.listing(aside):
+        if not os.path.lexists(out / old):
+            try:
+                os.rename(aside / old, out / old)
+            except OSError:
+                pass
+
+
+def _set_aside(final: Path, staging: Path) -> bool:
+    """Move an existing output ``final`` into ``staging``'s :data:`REPLACED`; tell if it was."""
+    if not os.path.lexists(final):
+        return False
+    (staging / REPLACED).mkdir(exist_ok=True)
+    os.rename(final, staging / REPLACED / final.name)
+    return True
+
+
+def _finish_commit(task: Task, out: Path, earlier: Path, attempt: int) -> Result:
     """Finish the commit of an attempt that died after writing its journal; return its result.
 
-    Its outputs were complete when it wrote the journal: those not yet
-    renamed into place are renamed from its staging directory now.
+    Its outputs were complete when it wrote the journal: those still in its
+    staging directory are renamed into place now (with ``Task.overwrite``
+    the outputs they replace, and a friction CSV not written, set aside).
     """
     result: Result = pickle.loads((earlier / JOURNAL).read_bytes())
-    for final in map(Path, result.written):
-        if not os.path.lexists(final):
-            os.rename(earlier / final.name, final)
+    written = {Path(p).name for p in result.written}
+    for final in map(Path, targets(out, task.name, task.plot, task.write_csv)):
+        staged = earlier / final.name
+        if final.name in written and os.path.lexists(staged):
+            if task.overwrite:
+                _set_aside(final, earlier)
+            if not os.path.lexists(final):
+                os.rename(staged, final)
+        elif final.name not in written and task.overwrite:
+            _set_aside(final, earlier)
     result.attempts, result.resumed = attempt, True
     return result
 
@@ -211,11 +269,12 @@ def _run_local(task: Task, profile: bool) -> Result:
     staging = out / f"{staging_prefix(name, tag)}{attempt}-{uuid.uuid4().hex[:12]}{STAGING}"
     done = False
     moved: list[Path] = []
+    aside: list[Path] = []
     try:
         staging.mkdir()   # this attempt's mark, first: an attempt that dies from here counts
         committed = [n for n in earlier if (out / n / JOURNAL).is_file()]
         if committed:
-            result = _finish_commit(out, out / committed[0], attempt)
+            result = _finish_commit(task, out, out / committed[0], attempt)
             done = True
             return result
         for leftover in earlier:
@@ -225,18 +284,23 @@ def _run_local(task: Task, profile: bool) -> Result:
             _replay(task, staging, profile, result)
         staged = targets(staging, name, task.plot, task.write_csv)
         finals = [out / tmp.name for tmp in staged]
-        for final in finals:
-            if os.path.lexists(final):
-                raise OutputError(f"{final}: appeared while replaying; not overwritten")
+        if not task.overwrite:
+            for final in finals:
+                if os.path.lexists(final):
+                    raise OutputError(f"{final}: appeared while replaying; not overwritten")
         result.ok = True
-        result.written = [str(f) for f in finals]
+        result.written = [str(f) for tmp, f in zip(staged, finals) if os.path.lexists(tmp)]
         if task.retry:   # the result, before any output is in place (renamed whole)
             journal = staging / f"{JOURNAL}.tmp"
             journal.write_bytes(pickle.dumps(result))
             os.rename(journal, staging / JOURNAL)
         for tmp, final in zip(staged, finals):
-            os.rename(tmp, final)
-            moved.append(final)
+            if task.overwrite and _set_aside(final, staging):
+                aside.append(final)
+                faults.pause(faults.REPLACE)
+            if os.path.lexists(tmp):
+                os.rename(tmp, final)
+                moved.append(final)
             if task.retry:
                 faults.pause("commit")
         done = True
@@ -255,13 +319,16 @@ def _run_local(task: Task, profile: bool) -> Result:
     except Exception as e:  # a bug: still one line, and the other inputs go on
         result.status, result.error = 1, f"{source}: internal error: {problem(e)}"
     finally:
-        if not (done and task.retry):   # a committed result stays for another attempt
-            shutil.rmtree(staging, ignore_errors=True)
         if not done:
             result.ok = False
             for p in moved:  # a partial rename: take back what this bag put there
                 shutil.rmtree(p, ignore_errors=True) if p.is_dir() else p.unlink(missing_ok=True)
+            for p in aside:  # and put back what it replaced (before its staging goes)
+                if not os.path.lexists(p):
+                    os.rename(staging / REPLACED / p.name, p)
             result.written = []
+        if not (done and task.retry):   # a committed result stays for another attempt
+            shutil.rmtree(staging, ignore_errors=True)
     return result
 
 
@@ -322,8 +389,12 @@ def _run_fetched(task: Task, profile: bool) -> Result:
         names = [Path(p).name for p in result.written]
         result.written = [f"{out.rstrip('/')}/{n}" for n in names]
         try:
+            old = ([storage.basename(str(t))
+                    for t in targets(out, task.name, task.plot, task.write_csv)]
+                   if task.overwrite else None)
             storage.commit(staged, names, out, name,
-                           journal=(JOURNAL, pickle.dumps(result)) if task.retry else None)
+                           journal=(JOURNAL, pickle.dumps(result)) if task.retry else None,
+                           replace=old)
         except OSError as e:
             storage.remove(out, name)
             result.ok, result.status, result.written = False, 1, []
@@ -374,7 +445,7 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
     result.profile = prof
 
     reader = bagio.open_reader(source)
-    csv_file = None
+    csv_file = friction_file = None
     try:
         # metadata.yaml's count is another writer's word: 0 for a file that holds messages
         # is possible, so a zero is checked by reading the first message
@@ -406,14 +477,23 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
                 + _namespaces_hint(reader.connections, namespace))
         custom = {PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
                   "fastsim.input": task.given or str(source), "fastsim.replay": PROG}
-        rows = None
+        estimating = FRICTION_ESTIMATE_TOPIC in pipeline.outputs()
+        rows = friction_rows = None
         if task.write_csv:
             csv_file = open(staging / f"{name}.csv", "w", newline="", encoding="utf-8")
             rows = csv.writer(csv_file, lineterminator="\n")
             rows.writerow(CSV_HEADER)
+            if estimating:
+                friction_file = open(staging / friction_csv(name), "w", newline="",
+                                     encoding="utf-8")
+                friction_rows = csv.writer(friction_file, lineterminator="\n")
+                friction_rows.writerow(FRICTION_CSV_HEADER)
         series = {c: Series() for c in contacts} if task.plot else None
+        mu = float(config["friction_coefficient"])
         out = _Outputs(pipeline, rows, series, str(config["method"]),
-                       str(config["friction_law"]))
+                       str(config["friction_law"]), mu=mu, friction_rows=friction_rows,
+                       estimates=Series(ESTIMATE_COLUMNS) if task.plot and estimating else None,
+                       path=FrictionPath(mu) if estimating else None)
         bar = _progress(name, reader.message_count, task.progress)
         indexed = bulk.open_indexed(source, reader) if task.path != "rosbags" else None
         if indexed is not None:
@@ -432,23 +512,38 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
             result.counts[c] = pipeline.counts(c)
             result.solve_us[c] = pipeline.solve_time_percentiles(c)
         result.kinematics = dict(pipeline.kinematics_counts)
-        if csv_file is not None:
-            csv_file.close()
+        result.friction = out.path
+        result.unused = unused_topics(reader.connections, out.seen, pipeline, namespace)
+        if task.write_csv:
+            result.tabled = {resolve(f"contact/{c}/{kind}", namespace): f"{name}.csv"
+                             for c in contacts for kind in ("wrench", "creepage")}
+            if estimating:
+                result.tabled[resolve(FRICTION_ESTIMATE_TOPIC, namespace)] = friction_csv(name)
+        for f in (csv_file, friction_file):
+            if f is not None:
+                f.close()
         if task.plot and series is not None:
             plot_start = time.perf_counter()
-            write_plot(staging / f"{name}.png", name, contacts, series,
-                       float(config["friction_coefficient"]))
+            write_plot(staging / f"{name}.png", name, contacts, series, mu,
+                       str(config["friction_law"]), out.estimates)
             result.plot_s = time.perf_counter() - plot_start
     finally:
-        if csv_file is not None:
-            csv_file.close()
+        for f in (csv_file, friction_file):
+            if f is not None:
+                f.close()
         reader.close()
     result.wall_s = time.perf_counter() - start_wall
 
 
 @dataclass
 class _Outputs:
-    """Where a wrench's CSV row and plot sample go (either may be off)."""
+    """Where a wrench's and an estimate's CSV rows and plot samples go (each may be off).
+
+    ``mu``: the static coefficient in force (the wrenches of a cycle are
+    solved with the estimate of the cycle before); ``path``: the estimate's
+    path (estimation on); ``seen``: the input messages by channel or
+    connection id (the replay counts them).
+    """
 
     pipeline: AnyPipeline
     rows: Any
@@ -456,13 +551,83 @@ class _Outputs:
     method: str
     law: str
     first: int = 0
+    mu: float = 0.0
+    friction_rows: Any = None
+    estimates: Series | None = None
+    path: FrictionPath | None = None
+    seen: dict[str, int] = field(default_factory=dict)
 
     def outcome(self, outcome: Any, log_ns: int) -> None:
-        """Record one outcome's wrench (the per-message paths)."""
+        """Record one outcome's wrench and friction estimate (the per-message paths)."""
         if outcome.has_wrench:
             record(outcome, log_ns - self.first, self.rows,
                    None if self.series is None else self.series[outcome.contact],
-                   self.method, self.law)
+                   self.method, self.law, self.mu)
+        if outcome.friction is not None:
+            self.estimate(outcome.friction, log_ns)
+
+    def estimate(self, e: FrictionEstimate, log_ns: int) -> None:
+        """Record a rig cycle's friction estimate; its mu is in force from now on."""
+        t = (log_ns - self.first) * 1e-9
+        path = self.path
+        if path is not None:
+            steps = _estimation_counts(self.pipeline)["steps"]
+            if steps > len(path.steps):   # this cycle's update saw a step of mu_s
+                path.steps.append((t, self.mu))
+            path.cycles += 1
+            path.statuses[e.status] = path.statuses.get(e.status, 0) + 1
+            path.last, path.sigma = e.mu, e.sigma
+            path.utilisation = max(path.utilisation, e.utilisation)
+        if self.friction_rows is not None:
+            self.friction_rows.writerow(friction_row(e))
+        if self.estimates is not None:
+            self.estimates.add(t, e.mu, e.sigma, e.utilisation)
+        self.mu = e.mu
+
+
+def _estimation_counts(pipeline: AnyPipeline) -> dict[str, int]:
+    """Return the friction estimator's counts (``steps``: the steps of mu_s it saw)."""
+    inner = pipeline if isinstance(pipeline, Pipeline) else pipeline.pipeline
+    return inner.estimation_counts
+
+
+def unused_topics(connections: Any, seen: dict[str, int], pipeline: AnyPipeline,
+                  namespace: str) -> list[tuple[str, int, str]]:
+    """Return the bag's topics the node could take but this replay did not, and what takes them.
+
+    ``(topic, messages, hint)`` in the bag's order, ``seen``: the messages
+    read by resolved topic.  Patch topics of contacts not configured (the
+    ``contacts`` parameter takes them), or under another namespace; the
+    measured wrench with friction estimation off; poses and loads with
+    patches from topics.  Only copied to the output bag.
+    """
+    inputs = {resolve(i.topic, namespace): i for i in pipeline.inputs()}
+    outputs = {resolve(t, namespace) for t in pipeline.outputs()}
+    from_topics = any(i.kind == "patch" for i in inputs.values())
+    prefix, ns = resolve("contact/", namespace), resolve(namespace)
+    found: dict[str, str] = {}
+    for conn in connections:
+        topic = resolve(conn.topic)
+        if topic in inputs or topic in outputs or topic in found:
+            continue
+        hint = ""
+        m = _PATCH_TOPIC.match(topic)
+        if m is not None and from_topics:
+            if topic.startswith(prefix):
+                contact = topic[len(prefix):-len("/patch")]
+                hint = (f"add {contact!r} to the 'contacts' parameter" if _contact_name(contact)
+                        else f"{contact!r} is not a name the 'contacts' parameter takes")
+            else:
+                other = m.group(1) or "/"
+                hint = f"outside the namespace {ns} (--namespace {other} replays it)"
+        elif topic == resolve(MEASURED_WRENCH_TOPIC, namespace):
+            hint = "set 'friction_estimation' to on to estimate mu_s from it"
+        elif from_topics and topic in (resolve(POSE_TOPIC, namespace),
+                                       resolve(LOAD_TOPIC, namespace)):
+            hint = "set 'patch_source' to profiles to compute the patches from them"
+        if hint:
+            found[topic] = hint
+    return [(topic, seen.get(topic, 0), hint) for topic, hint in found.items()]
 
 
 def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeline: AnyPipeline,
@@ -479,6 +644,11 @@ def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeli
     except BaseException:
         replay.abort()
         raise
+    for cid, n in replay.seen.items():
+        topic = resolve(indexed.channels[cid].topic)
+        out.seen[topic] = out.seen.get(topic, 0) + n
+    result.published = {topic: replay.writer.counts[cid]
+                        for topic, cid in replay.out_channels.items()}
     if prof is not None:
         prof.phases = dict(replay.phases)
         if replay.batch is not None:
@@ -511,16 +681,19 @@ def _replay_messages(task: Task, reader: Any, staging: Path, pipeline: AnyPipeli
                     offered_qos_profiles=qos_out)
             writer.write(conn, log_ns, data)
             result.messages_out += 1
+            result.published[topic] = result.published.get(topic, 0) + 1
 
         diagnostics = resolve(DIAGNOSTICS_TOPIC, namespace)
         first: int | None = None
         last: int | None = None
         next_diag = 0
+        seen: dict[int, int] = {}
         t_read = clock()
         for conn, log_ns, raw in bagio.messages(reader, str(source)):
             if prof is not None:
                 now = clock()
                 prof.read.append(now - t_read)
+            seen[conn.id] = seen.get(conn.id, 0) + 1
             if first is None:
                 first = out.first = log_ns
                 next_diag = first + 1_000_000_000
@@ -565,6 +738,9 @@ def _replay_messages(task: Task, reader: Any, staging: Path, pipeline: AnyPipeli
         if first is None or last is None:
             raise BadInput(f"{source}: empty bag (no messages)")
         put(diagnostics, last, serialize_message(pipeline.diagnostics(last)))
+    for conn in reader.connections:
+        topic = resolve(conn.topic)
+        out.seen[topic] = out.seen.get(topic, 0) + seen.get(conn.id, 0)
     return first, last
 
 

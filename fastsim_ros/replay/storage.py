@@ -18,6 +18,8 @@ from typing import Any
 
 #: the bag file that makes an output directory a bag: moved into place last
 METADATA = "metadata.yaml"
+#: where an overwriting commit moves the outputs it replaces, inside its staging directory
+REPLACED = ".replaced"
 
 
 def is_url(path: Any) -> bool:
@@ -108,7 +110,8 @@ def _moves(fs: Any, root: str, staging: str, moves: list[tuple[str, str]]) -> No
 
 
 def commit(local_out: Path, names: list[str], url: str, staging_name: str,
-           journal: tuple[str, bytes] | None = None) -> list[str]:
+           journal: tuple[str, bytes] | None = None,
+           replace: list[str] | None = None) -> list[str]:
     """Upload ``names`` (files and bag directories in ``local_out``) to the directory ``url``.
 
     Staged under ``url/staging_name/`` and moved into place file by file,
@@ -117,7 +120,11 @@ def commit(local_out: Path, names: list[str], url: str, staging_name: str,
     under a temporary name, then moved) once everything is uploaded and
     before the first move; the staging directory then stays (the journal
     in it) for :func:`finish_commit`, and for the caller to remove.
-    Raises ``OSError`` (the caller removes what was staged: :func:`remove`).
+    ``replace``: names in ``url`` (the outputs of an earlier run, and any
+    target not written this time) moved aside into the staging directory's
+    :data:`REPLACED` once everything is uploaded, and moved back if a move
+    fails.  Raises ``OSError`` (the caller removes what was staged:
+    :func:`remove`).
     """
     fs, root = filesystem(url)
     staging = posixpath.join(root, staging_name)
@@ -136,7 +143,21 @@ def commit(local_out: Path, names: list[str], url: str, staging_name: str,
         file, data = journal
         fs.pipe_file(posixpath.join(staging, file + ".tmp"), data)
         fs.mv(posixpath.join(staging, file + ".tmp"), posixpath.join(staging, file))
-    _moves(fs, root, staging, moves + last)
+    aside: list[str] = []
+    try:
+        for name in replace or ():
+            final = posixpath.join(root, name)
+            if fs.exists(final):
+                fs.mv(final, posixpath.join(staging, REPLACED, name), recursive=True)
+                aside.append(name)
+        _moves(fs, root, staging, moves + last)
+    except OSError:
+        for name in aside:   # the new output (what of it was moved) out, the old one back
+            final = posixpath.join(root, name)
+            if fs.exists(final):
+                fs.rm(final, recursive=True)
+            fs.mv(posixpath.join(staging, REPLACED, name), final, recursive=True)
+        raise
     if journal is None:
         remove(url, staging_name)
     prefix = url.rstrip("/")
@@ -156,12 +177,25 @@ def finish_commit(url: str, staging_name: str, journal: str) -> bytes:
     last: list[tuple[str, str]] = []
     for tmp in sorted(fs.find(staging)):
         rel = posixpath.relpath(tmp, staging)
-        if rel in (journal, MARK):
+        if rel in (journal, MARK) or rel.split("/")[0] == REPLACED:
             continue
         (last if posixpath.basename(rel) == METADATA else moves).append(
             (tmp, posixpath.join(root, rel)))
     _moves(fs, root, staging, moves + last)
     return data
+
+
+def restore_replaced(url: str, staging_name: str) -> None:
+    """Move the outputs a commit set aside in ``url/staging_name`` back where none took over."""
+    fs, root = filesystem(url)
+    aside = posixpath.join(root, staging_name, REPLACED)
+    try:
+        for old in fs.ls(aside, detail=False):
+            final = posixpath.join(root, posixpath.basename(old.rstrip("/")))
+            if not fs.exists(final):
+                fs.mv(old, final, recursive=True)
+    except OSError:
+        pass
 
 
 def remove(url: str, name: str) -> None:
