@@ -376,7 +376,7 @@ def warnings_of(proc, text):
 
 
 def test_an_unknown_parameter_is_a_warning_naming_the_nearest_and_the_node_starts(run_node):
-    """rclpy ignores an override no parameter is declared for: the node says so, and starts."""
+    """An override no parameter is declared for (rclpy ignores it): a warning, and it starts."""
     proc, client = run_node("-p", "friction_coeficient:=0.4", contacts=("left",))
     lines = warnings_of(proc, "friction_coeficient")
     assert len(lines) == 1, proc.output()
