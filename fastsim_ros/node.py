@@ -23,11 +23,15 @@ import contextlib
 import gc
 import importlib
 import math
+import re
 import signal
 import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
 from typing import Any
+
+import yaml
 
 import fastsim_ros.numba_quietly  # noqa: F401  (first: numba without its coverage hook)
 import rclpy
@@ -55,6 +59,7 @@ from fastsim_ros import params as parameters
 from fastsim_ros import pipeline_kernels
 from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
+from msg_adapters.errors import REJECTION_REASONS
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
                                   WHEELSET_WRENCH_TOPIC, InputTopic, Outcome, PipelineConfig,
                                   patch_topic)
@@ -68,6 +73,16 @@ _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
           "string_array": ParameterType.PARAMETER_STRING_ARRAY}
 _MESSAGE_TYPES = {"wrench": WrenchStamped, "creepage": Vector3Stamped, "frame": PoseStamped,
                   "traction": PointCloud2}
+#: the diagnostics key that names the keys counting since the start (a managed node: since
+#: its last configure), beside this_period/* and the status message (the last period)
+SINCE_START_KEY = "since_start"
+SINCE_START = "wrenches, solved, no_contact, rejected, rejected/*, twists/*, dropped/inactive"
+#: the pipeline's status message of a period with rejections: "4 of 4 patches rejected; last: ..."
+_PERIOD_REJECTED = re.compile(r"^(\d+ of \d+ patches rejected)(?=;|$)")
+#: libyaml's loader where built (a params file in 0.5 ms, not 7: the check is on the start)
+_YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+#: least time (s) between two looks at the ROS graph for patch topics no contact takes
+GRAPH_PERIOD = 1.0
 
 
 class ThrottledLog:
@@ -165,6 +180,17 @@ class _FrontEnd:
     _warm: float = 0.0
     _diagnostics: Publisher | None = None
     _timer: Any = None
+    #: each contact's (patches, rejected) counts at the last diagnostics
+    _counted: dict[str, tuple[int, int]]
+    #: patch topics with publishers and no contact: topic -> (contact name, publishers)
+    _unheard: dict[str, tuple[str, int]]
+    #: the unheard topics already logged (once per topic)
+    _unheard_logged: set[str]
+    _graph_next: float = -math.inf
+
+    def finished(self) -> bool:
+        """Return whether the node is done and its process should end (never, here)."""
+        return False
 
     def _apply_descriptor(self, parameter: Parameter, descriptor: Any = None,
                           check_read_only: bool = True) -> SetParametersResult:
@@ -229,6 +255,36 @@ class _FrontEnd:
         except (InvalidParameterValueException, InvalidParameterTypeException,
                 ParameterException) as e:
             raise StartupError(_one_line(e, spec)) from None
+
+    def _warn_unmatched(self, argv: Sequence[str] | None) -> None:
+        """Log what of the launch's parameters no parameter of the node takes; start anyway.
+
+        rclpy ignores an override no parameter is declared for (a typo such
+        as ``-p friction_coeficient:=0.4``), and a params file's section that
+        matches no node name never reaches the node (``fastsim_node:`` for a
+        node named ``fastsim``): both are found by the rule the replay refuses
+        them with (:func:`fastsim_ros.params.unmatched`), on the overrides
+        the node was given and on the ``--params-file`` files of ``argv``
+        (its ROS arguments; None: only the overrides).
+        """
+        node: Node = self  # type: ignore[assignment]
+        fqn = node.get_fully_qualified_name()
+        log = node.get_logger()
+        found: list[str] = []
+        named: set[str] = set()
+        for path in parameters.ros_params_files(argv or ()):
+            try:  # rcl has parsed it already: a file it refused never gets here
+                content = yaml.load(Path(path).read_text(encoding="utf-8"), Loader=_YAML_LOADER)
+            except (OSError, UnicodeDecodeError, yaml.YAMLError):
+                continue
+            for finding in parameters.unmatched(fqn, content):
+                named.add(finding.name)
+                found.append(f"{path}: {finding}")
+        overrides = getattr(node, "_parameter_overrides", {})
+        found += [str(f) for f in parameters.unmatched(fqn, overrides=overrides)
+                  if f.name not in named]
+        for line in found:
+            log.warning(f"not used: {line}")
 
     def _configure(self, log: Callable[[str], None]) -> PipelineConfig:
         """Check the declared values, warm the kernels and build the pipeline."""
@@ -298,6 +354,10 @@ class _FrontEnd:
             self._subs[entry.topic] = node.create_subscription(
                 message_type(entry.msgtype), entry.topic, self._input_callback(entry), qos_in,
                 raw=True)
+        self._counted = {}
+        self._unheard = {}
+        self._unheard_logged = getattr(self, "_unheard_logged", set())
+        self._graph_next = -math.inf
         self._timer = node.create_timer(float(config["diagnostics_period"]),
                                         self._publish_diagnostics)
         source = (f"patches from the profiles {config['wheel_profile']} on "
@@ -434,13 +494,82 @@ class _FrontEnd:
         if node.context.ok():
             raise
 
+    def period_values(self) -> dict[str, list[tuple[str, str]]]:
+        """Return each contact's counts of the last diagnostics period as key-values.
+
+        ``this_period/patches`` and ``this_period/rejected`` (the status
+        message's "N of M patches rejected this period"), and
+        :data:`SINCE_START_KEY` naming the keys that count since the start.
+        """
+        out: dict[str, list[tuple[str, str]]] = {}
+        for c in self.pipeline.config.contacts:
+            counts = self.pipeline.counts(c)
+            now = (sum(counts.values()), sum(counts.get(r, 0) for r in REJECTION_REASONS))
+            before = self._counted.get(c, (0, 0))
+            self._counted[c] = now
+            out[c] = [("this_period/patches", str(now[0] - before[0])),
+                      ("this_period/rejected", str(now[1] - before[1])),
+                      (SINCE_START_KEY, SINCE_START)]
+        return out
+
+    def unheard_values(self) -> list[tuple[str, str]]:
+        """Return the patch topics with publishers that no contact takes, as key-values.
+
+        ``unsubscribed/<topic>`` (relative to the node's namespace, as
+        ``publishers/<topic>``): the publishers' count and the parameter
+        that would take them (``contacts``).  A look at the ROS graph at
+        most every :data:`GRAPH_PERIOD` (the diagnostics timer's, off the
+        hot path); each such topic is logged once.  Topics mode only: in
+        profiles mode the node publishes the patches itself.
+        """
+        node: Node = self  # type: ignore[assignment]
+        if isinstance(self.pipeline, ProfilePipeline):
+            return []
+        now = time.monotonic()
+        if now >= self._graph_next:
+            self._graph_next = now + GRAPH_PERIOD
+            self._unheard = self._find_unheard()
+            for topic, (name, _) in self._unheard.items():
+                if topic not in self._unheard_logged:
+                    self._unheard_logged.add(topic)
+                    node.get_logger().warning(
+                        f"{topic} has publishers and no contact takes it: add {name!r} to "
+                        f"parameter 'contacts' to solve its patches")
+        skip = len(node.get_namespace().rstrip("/")) + 1
+        return [(f"unsubscribed/{topic[skip:]}", f"{count} publisher(s); add {name!r} to "
+                 "parameter 'contacts' to take it")
+                for topic, (name, count) in sorted(self._unheard.items())]
+
+    def _find_unheard(self) -> dict[str, tuple[str, int]]:
+        """Return the graph's ``contact/<name>/patch`` topics with publishers and no contact."""
+        node: Node = self  # type: ignore[assignment]
+        namespace = node.get_namespace().rstrip("/")
+        pattern = re.compile(re.escape(namespace) + r"/contact/([^/]+)/patch")
+        contacts = set(self.pipeline.config.contacts)
+        found = {}
+        for topic, _ in node.get_topic_names_and_types():
+            match = pattern.fullmatch(topic)
+            if match is not None and match.group(1) not in contacts:
+                count = node.count_publishers(topic)
+                if count:
+                    found[topic] = (match.group(1), count)
+        return found
+
     def _publish_diagnostics(self) -> None:
         if not self._active or self._diagnostics is None:
             return
         node: Node = self  # type: ignore[assignment]
+        extra = self.connections()
+        unheard = self.unheard_values()
+        for c, values in self.period_values().items():
+            extra[c] = extra.get(c, []) + values + unheard
         try:
-            self._diagnostics.publish(self.pipeline.diagnostics(
-                node.get_clock().now().nanoseconds, self.connections()))
+            msg = self.pipeline.diagnostics(node.get_clock().now().nanoseconds, extra)
+            for status in msg.status:
+                # the pipeline's message counts the last period: said so beside the counts
+                # since start
+                status.message = _PERIOD_REJECTED.sub(r"\1 this period", status.message)
+            self._diagnostics.publish(msg)
         except _rclpy.RCLError:
             self._raise_unless_shut_down()
 
@@ -488,12 +617,17 @@ def _destroyed_on_failure(node: Node) -> Iterator[None]:
 
 
 class FastsimNode(_FrontEnd, Node):
-    """Creep forces for every contact patch received (INTERFACE.md)."""
+    """Creep forces for every contact patch received (INTERFACE.md).
 
-    def __init__(self, **kwargs: Any) -> None:
+    ``argv``: the process's arguments, whose ``--params-file`` files are
+    checked for sections and names the node does not take (a warning).
+    """
+
+    def __init__(self, *, argv: Sequence[str] | None = None, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
         with _destroyed_on_failure(self):
             self._declare()
+            self._warn_unmatched(argv)
             self._configure(log=self.get_logger().info)
             self._open()
             self.add_on_set_parameters_callback(self._set_running)
@@ -514,17 +648,28 @@ class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
     - ``cleanup`` and ``shutdown``: release the topics and the pipeline.
 
     Start-only parameters may change while ``unconfigured`` (the next
-    ``configure`` reads them); the dynamic ones at any time.
+    ``configure`` reads them); the dynamic ones at any time.  ``finalized``
+    ends the process (:meth:`finished`).  ``argv``: as :class:`FastsimNode`'s.
     """
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, *, argv: Sequence[str] | None = None, **kwargs: Any) -> None:
         super().__init__(NODE_NAME, **kwargs)
         self._active = False
         self._configured = False
         self._subs, self._pubs, self._wanted = {}, {}, set()
         with _destroyed_on_failure(self):
             self._declare(start_only_read_only=False)
+            self._warn_unmatched(argv)
             self.add_on_set_parameters_callback(self._on_set_parameters)
+        name = self.get_fully_qualified_name()
+        self.get_logger().info(
+            f"managed node {name} unconfigured: configure, then activate it through "
+            f"{name}/change_state (lifecycle_msgs); shutdown ends the process")
+
+    def finished(self) -> bool:
+        """Return whether the node is ``finalized`` (after ``shutdown``): the process ends."""
+        label: str = self._state_machine.current_state[1]  # (id, label), as rclpy reads it
+        return label == "finalized"
 
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
         """Check the parameters and build the pipeline (profiles, contact table)."""
@@ -637,12 +782,18 @@ def main(args: Sequence[str] | None = None) -> int:
 
 
 def main_lifecycle(args: Sequence[str] | None = None) -> int:
-    """Run the managed node (unconfigured until told) until SIGINT or SIGTERM."""
+    """Run the managed node (unconfigured until told) until ``finalized``, SIGINT or SIGTERM."""
     return _run(FastsimLifecycleNode, "fastsim_lifecycle_node", args)
 
 
-def _run(make: Callable[[], Node], program: str, args: Sequence[str] | None) -> int:
-    """Build a node, spin it until a signal, always destroy it and shut down."""
+#: seconds a finished node still serves before its process ends: the answer to the
+#: transition that finished it is sent, but DDS delivers it (and a reliable writer's
+#: resends) only while the node exists; a client then sees the new state too
+FINISHED_GRACE = 0.5
+
+
+def _run(make: Callable[..., Node], program: str, args: Sequence[str] | None) -> int:
+    """Build a node, spin it until a signal or it finished, always destroy it and shut down."""
     # SIGINT: rclpy's handler (installed by init) shuts the context down, then calls the
     # handler it found, Python's, which raises KeyboardInterrupt wherever the main thread
     # is: inside a callback, rclpy's executor logs it as FATAL with a traceback.  While
@@ -660,7 +811,7 @@ def _run(make: Callable[[], Node], program: str, args: Sequence[str] | None) -> 
         signal.signal(signal.SIGINT, previous)
 
 
-def _run_node(make: Callable[[], Node], program: str, args: Sequence[str] | None,
+def _run_node(make: Callable[..., Node], program: str, args: Sequence[str] | None,
               spinning: list[bool]) -> int:
     """:func:`_run` with Python's SIGINT handler in place (``spinning``: set while spinning)."""
     try:
@@ -672,7 +823,7 @@ def _run_node(make: Callable[[], Node], program: str, args: Sequence[str] | None
     executor: Executor | None = None
     status = 0
     try:
-        node = make()
+        node = make(argv=list(args) if args is not None else sys.argv)
         kind = node.get_parameter("executor").value  # checked at configure, else events
         executor = make_executor(kind if kind in ("events", "single_threaded") else "events")
         executor.add_node(node)
@@ -684,8 +835,14 @@ def _run_node(make: Callable[[], Node], program: str, args: Sequence[str] | None
         # runs Python timers nor returns on SIGTERM in this rclpy; spin_once
         # raises ExternalShutdownException once the signal shut the context down
         spinning[0] = True
-        while rclpy.ok():
+        finished = node.finished if isinstance(node, _FrontEnd) else (lambda: False)
+        while rclpy.ok() and not finished():
             executor.spin_once(timeout_sec=0.25)
+        if rclpy.ok():
+            node.get_logger().info("finalized: exiting")
+            end = time.monotonic() + FINISHED_GRACE
+            while rclpy.ok() and time.monotonic() < end:
+                executor.spin_once(timeout_sec=max(0.0, end - time.monotonic()))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     except _rclpy.RCLError:

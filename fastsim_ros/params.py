@@ -8,9 +8,10 @@ same message.  INTERFACE.md ("Executables and parameters") fixes the names.
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -341,6 +342,149 @@ def _node_key_pattern(key: str) -> re.Pattern[str]:
     return re.compile("".join(parts))
 
 
+#: the prefix of rclpy's QoS override parameters (``qos_overrides./topic.publisher.depth``)
+QOS_OVERRIDES = "qos_overrides."
+#: every name a parameter of the node has (the table's and rclpy's own)
+KNOWN_NAMES: tuple[str, ...] = tuple(SPECS) + ROS_NODE_PARAMETERS
+
+
+def section_matches(key: str, node_fqn: str, also: Iterable[str] = ()) -> bool:
+    """Return whether a parameter file's section ``key`` is for the node ``node_fqn``.
+
+    As rcl matches it (:func:`_node_key_pattern`), or ``key`` is one of ``also``.
+    """
+    return key in also or bool(_node_key_pattern(key).fullmatch(node_fqn))
+
+
+@dataclass(frozen=True)
+class Unmatched:
+    """A params file's section or a parameter name that no parameter of the node takes.
+
+    ``kind``: ``"section"``, a section for another node (``hint``: the key of
+    this node's section), or ``"parameter"``, a name no parameter has
+    (``hint``: the nearest parameter's name, empty if none is near);
+    ``section``: the section a parameter is in (empty: an override).
+    ``str()`` is one line.
+    """
+
+    kind: str
+    name: str
+    hint: str
+    section: str = ""
+
+    def __str__(self) -> str:
+        if self.kind == "section":
+            return (f"section {self.name!r} is for another node: this node's section is "
+                    f"{self.hint!r} or a wildcard such as '/**'")
+        where = f" in section {self.section!r}" if self.section else ""
+        near = f"; did you mean {self.hint!r}?" if self.hint else ""
+        return f"unknown parameter {self.name!r}{where}{near}"
+
+
+def _names(params: Mapping[Any, Any], prefix: str = "") -> Iterator[str]:
+    """Yield a section's parameter names, nested maps as rcl flattens them (``a.b``)."""
+    for key, value in params.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, Mapping):
+            yield from _names(value, name + ".")
+        else:
+            yield name
+
+
+def _known(name: str) -> bool:
+    return name in SPECS or name in ROS_NODE_PARAMETERS or name.startswith(QOS_OVERRIDES)
+
+
+def _near_node_name(key: str, node_name: str) -> bool:
+    """Return whether a section key names a node close to ``node_name`` (a typo of it).
+
+    ``fastsim_node`` or ``fastsim_lifecycle_node`` (the executable's name),
+    ``fastsimm``; not ``node_name`` itself (a section for a node of that name
+    in another namespace, as a file for several rigs has) nor a wildcard.
+    """
+    last = key.rstrip("/").rsplit("/", 1)[-1]
+    if not last or "*" in last or last == node_name:
+        return False
+    return (last.startswith(node_name)
+            or bool(difflib.get_close_matches(last, [node_name], n=1, cutoff=0.8)))
+
+
+def unmatched(node_fqn: str, content: Any = None, overrides: Iterable[str] = (), *,
+              also: Sequence[str] = ()) -> list[Unmatched]:
+    """Return what of a params file and of overrides the node ``node_fqn`` does not take.
+
+    ``content``: a parsed ROS 2 parameter file (``<node>: ros__parameters:
+    {...}``) or None; ``overrides``: parameter names given otherwise (``-p``;
+    a dict's keys); ``also``: section keys taken besides those rcl matches
+    with ``node_fqn`` (:func:`section_matches`).  Found, in the file's order:
+
+    - a section for no node of this name, when no section is the node's (the
+      file is another node's) or when its key names a node near the node's
+      name (``fastsim_node`` for ``fastsim``); a section of a node with
+      another name beside the node's own (a file several nodes share) is
+      that node's business, not a finding;
+    - a parameter name, in a section of the node or among ``overrides``,
+      that no parameter has (nor rclpy's own, :data:`ROS_NODE_PARAMETERS`,
+      ``qos_overrides.*``), with the nearest parameter's name: each name
+      once, where it is first found (the file before the overrides).
+
+    The replay refuses a file with findings; the node warns and starts
+    (rclpy ignores a value no parameter is declared for).
+    """
+    node_name = node_fqn.rsplit("/", 1)[-1]
+    namespace = node_fqn[:-len(node_name)].rstrip("/")
+    hint = f"{namespace}/{node_name}" if namespace else node_name
+    found: list[Unmatched] = []
+    named: set[str] = set()
+
+    def unknown(names: Iterable[str], section: str) -> None:
+        for name in names:
+            if name in named or _known(name):
+                continue
+            named.add(name)
+            near = difflib.get_close_matches(name, KNOWN_NAMES, n=1, cutoff=0.6)
+            found.append(Unmatched("parameter", name, near[0] if near else "", section))
+
+    sections = ({k: v for k, v in content.items() if isinstance(k, str)}
+                if isinstance(content, Mapping) else {})
+    mine = {k for k in sections if section_matches(k, node_fqn, also)}
+    for key, section in sections.items():
+        if key in mine:
+            params = section.get("ros__parameters") if isinstance(section, Mapping) else None
+            if isinstance(params, Mapping):
+                unknown(_names(params), key)
+        elif not mine or _near_node_name(key, node_name):
+            found.append(Unmatched("section", key, hint))
+    unknown(overrides, "")
+    return found
+
+
+def ros_params_files(argv: Sequence[str]) -> list[str]:
+    """Return the ``--params-file`` paths among the ROS arguments of ``argv``, in order.
+
+    ROS arguments are those after ``--ros-args`` up to ``--`` (there may be
+    several such blocks); the flags that take a value skip it, so that a
+    value is never read as a flag.
+    """
+    with_value = {"-p", "--param", "-r", "--remap", "--params-file", "--log-level",
+                  "--log-config-file", "--log-file-name", "-e", "--enclave"}
+    files: list[str] = []
+    inside = False
+    k = 0
+    while k < len(argv):
+        arg = argv[k]
+        if arg == "--ros-args":
+            inside = True
+        elif arg == "--":
+            inside = False
+        elif inside and arg in with_value and k + 1 < len(argv):
+            if arg == "--params-file":
+                files.append(argv[k + 1])
+            k += 1
+        k += 1
+    return files
+
+
 def load_params_file(path: Path, node_name: str = "fastsim",
                      namespace: str = "/") -> dict[str, Any]:
     """Read a ROS 2 parameter file (``<node>: ros__parameters: ...``) and check it.
@@ -352,7 +496,9 @@ def load_params_file(path: Path, node_name: str = "fastsim",
     namespace as well); sections with a wildcard first, then the node's own,
     each in the file's order (a later one wins).  rclpy's own parameters
     (:data:`ROS_NODE_PARAMETERS`, e.g. ``use_sim_time``) are accepted and
-    not used.  Raises ParameterError naming the file on any problem.
+    not used.  What :func:`unmatched` finds (a section for another node's
+    name, a parameter name no parameter has) is refused, as is a bad value:
+    raises ParameterError, one line naming the file.
     """
     try:
         text = Path(path).read_text(encoding="utf-8")
@@ -363,12 +509,13 @@ def load_params_file(path: Path, node_name: str = "fastsim",
         raise ParameterError(f"{path}: not a ROS 2 parameter file")
     fqn = f"{namespace.rstrip('/')}/{node_name}"
     own = (node_name, "/" + node_name)
-    keys = [k for k in data if isinstance(k, str)
-            and (k in own or _node_key_pattern(k).fullmatch(fqn))]
+    keys = [k for k in data if isinstance(k, str) and section_matches(k, fqn, own)]
     keys.sort(key=lambda k: "*" not in k)   # stable: the file's order within each kind
+    found = unmatched(fqn, data, also=own)
     if not keys:
-        raise ParameterError(f"{path}: no section for node {fqn!r} ({node_name!r}, {fqn!r} "
-                             "or a wildcard such as '/**')")
+        why = ("; ".join(str(f) for f in found) if found
+               else f"({node_name!r}, {fqn!r} or a wildcard such as '/**')")
+        raise ParameterError(f"{path}: no section for node {fqn!r}: {why}")
     values: dict[str, Any] = {}
     for key in keys:
         section = data[key]
@@ -376,6 +523,8 @@ def load_params_file(path: Path, node_name: str = "fastsim",
         if not isinstance(params, dict):
             raise ParameterError(f"{path}: section {key!r} has no ros__parameters")
         values.update(params)
+    if found:
+        raise ParameterError(f"{path}: " + "; ".join(str(f) for f in found))
     for name in ROS_NODE_PARAMETERS:
         values.pop(name, None)
     try:

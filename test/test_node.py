@@ -13,11 +13,13 @@ import subprocess
 import numpy as np
 import pytest
 from geometry_msgs.msg import PoseStamped
+from sensor_msgs.msg import PointCloud2
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import samples
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
-from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns
+from ros_harness import (DIAGNOSTICS_PERIOD, NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess,
+                         stamp_ns)
 from ros_messages import WHEEL_RADIUS as R
 from ros_messages import cloud_msg, in_plane_area, rolling_twist, twist_msg
 
@@ -366,6 +368,87 @@ def test_diagnostics_report_the_peers_each_topic_matched(run_node):
         assert status["publishers/rail/twist"] == "1"
         assert status["subscribers/wheelset/wrench"] == "1"
         assert status["subscribers/contact/markers"] == "0"
+
+
+def warnings_of(proc, text):
+    """Return the node's warning lines that contain ``text``."""
+    return [line for line in proc.output().splitlines() if "WARN" in line and text in line]
+
+
+def test_an_unknown_parameter_is_a_warning_naming_the_nearest_and_the_node_starts(run_node):
+    """An override no parameter is declared for (rclpy ignores it): a warning, and it starts."""
+    proc, client = run_node("-p", "friction_coeficient:=0.4", contacts=("left",))
+    lines = warnings_of(proc, "friction_coeficient")
+    assert len(lines) == 1, proc.output()
+    assert ("unknown parameter 'friction_coeficient'; did you mean 'friction_coefficient'?"
+            in lines[0])
+    assert client.get_parameter("friction_coefficient") == 0.3
+    assert proc.proc.poll() is None
+
+
+def test_a_params_file_for_another_node_name_is_a_warning_and_the_node_starts(
+        run_node, tmp_path):
+    """A section keyed ``fastsim_node`` never reaches the node ``fastsim``: the node says so."""
+    path = tmp_path / "p.yaml"
+    path.write_text("fastsim_node:\n  ros__parameters:\n    friction_coefficient: 0.4\n")
+    proc, client = run_node("--params-file", str(path), contacts=("left",))
+    lines = warnings_of(proc, "fastsim_node")
+    assert len(lines) == 1, proc.output()
+    assert (f"{path}: section 'fastsim_node' is for another node: this node's section is "
+            "'fastsim' or a wildcard such as '/**'") in lines[0]
+    assert client.get_parameter("friction_coefficient") == 0.3
+    assert proc.proc.poll() is None
+
+
+def test_diagnostics_say_which_counts_are_this_period_and_which_since_start(run_node):
+    """The status message counts the last period, ``rejected`` and its reasons since start."""
+    _, client = run_node(contacts=("left",))
+    for k in range(2):  # no twist yet: each rejected
+        assert exchange(client, "left", cloud_msg(egg(), stamp_ns=T0 + k * MS),
+                        rejected="no_kinematics") == []
+    statuses = [status for array in client.diagnostics for status in array.status
+                if status.name == "fastsim: left"]
+    periods = []
+    for status in statuses:
+        values = {kv.key: kv.value for kv in status.values}
+        assert values["since_start"].startswith("wrenches, solved, no_contact, rejected, "
+                                                "rejected/*"), values
+        periods.append((int(values["this_period/patches"]),
+                        int(values["this_period/rejected"])))
+        if values["this_period/rejected"] != "0":
+            n, m = values["this_period/rejected"], values["this_period/patches"]
+            assert status.message.startswith(f"{n} of {m} patches rejected this period; "
+                                             "last: "), status.message
+    # the periods add up to the counts since start
+    assert tuple(map(sum, zip(*periods))) == (2, 2)
+    last = client.diagnostic_values("left")
+    assert last["rejected"] == "2" and last["rejected/no_kinematics"] == "2"
+
+
+def test_publishers_on_a_patch_topic_of_no_contact_are_named_in_diagnostics(run_node):
+    """A patch topic the node does not take: its publishers named, with the parameter."""
+    proc, client = run_node(contacts=("left",))  # the node serves left and right
+    flange = client.node.create_publisher(PointCloud2, "contact/left_flange/patch", client.qos)
+    key = "unsubscribed/contact/left_flange/patch"
+    assert client.wait_for(lambda: key in client.diagnostic_values("left")), (
+        client.diagnostic_values("left"))
+    for contact in ("left", "right"):
+        assert client.diagnostic_values(contact)[key] == (
+            "1 publisher(s); add 'left_flange' to parameter 'contacts' to take it")
+    assert not any(k.startswith("unsubscribed/contact/left/")
+                   for k in client.diagnostic_values("left"))
+    # logged once for the topic, however many looks at the graph find it: the node's
+    # diagnostics count its time, a look at most every GRAPH_PERIOD
+    from fastsim_ros.node import GRAPH_PERIOD
+    seen, periods = len(client.diagnostics), 2 * math.ceil(GRAPH_PERIOD / DIAGNOSTICS_PERIOD)
+    assert client.wait_for(lambda: len(client.diagnostics) >= seen + periods, 30.0)
+    assert key in client.diagnostic_values("left")
+    lines = warnings_of(proc, "/contact/left_flange/patch")
+    assert len(lines) == 1, proc.output()
+    assert "add 'left_flange' to parameter 'contacts'" in lines[0]
+    # gone with its publisher
+    client.node.destroy_publisher(flange)
+    assert client.wait_for(lambda: key not in client.diagnostic_values("left"))
 
 
 def test_sigterm_and_sigint_end_cleanly(tmp_path):

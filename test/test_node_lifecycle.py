@@ -6,12 +6,11 @@ what is published in each state: nothing while ``unconfigured`` or
 ``inactive`` (inputs dropped and counted), the library's wrenches while
 ``active``; ``cleanup`` releases the topics, start-only parameters may change
 while ``unconfigured``, a bad value fails ``configure`` with one line and
-leaves the node ``unconfigured``; ``shutdown`` finalizes it.
+leaves the node ``unconfigured``; ``shutdown`` finalizes it and ends its process.
 """
 
 from __future__ import annotations
 
-import signal
 import time
 
 import pytest
@@ -167,10 +166,10 @@ def test_every_transition_publishes_what_its_state_allows(managed):
     (result,) = client.set_parameters(friction_coefficient=0.4)
     assert result.successful, result.reason
 
+    # shutdown finalizes the node, and its process ends
     assert node.transition(Transition.TRANSITION_ACTIVE_SHUTDOWN)
-    assert node.state() == State.PRIMARY_STATE_FINALIZED
     assert client.wait_for(lambda: publishers_of(client, "/contact/wheel/wrench") == 0)
-    assert proc.stop(signal.SIGTERM) == 0
+    assert proc.proc.wait(timeout=30.0) == 0, proc.output()
 
 
 def test_a_bad_value_fails_configure_and_the_node_stays_unconfigured(managed):
@@ -190,3 +189,24 @@ def test_a_bad_value_fails_configure_and_the_node_stays_unconfigured(managed):
     assert node.transition(Transition.TRANSITION_CONFIGURE)
     assert node.state() == State.PRIMARY_STATE_INACTIVE
     assert proc.proc.poll() is None
+
+
+def test_the_managed_node_says_it_started_and_exits_0_after_shutdown(managed):
+    """A start line in the log; ``shutdown`` from ``unconfigured`` ends the process, exit 0.
+
+    The launch's parameters are checked as the plain node's: a typo is a
+    warning naming the nearest parameter, and the node starts.
+    """
+    proc, client, node = managed("-p", "friction_coeficient:=0.4")
+    assert node.state() == State.PRIMARY_STATE_UNCONFIGURED  # answered: it has started
+    out = proc.output()
+    assert ("managed node /fastsim unconfigured: configure, then activate it through "
+            "/fastsim/change_state (lifecycle_msgs); shutdown ends the process") in out, out
+    assert ("unknown parameter 'friction_coeficient'; did you mean 'friction_coefficient'?"
+            in out), out
+    assert node.transition(Transition.TRANSITION_UNCONFIGURED_SHUTDOWN)
+    assert proc.proc.wait(timeout=30.0) == 0, proc.output()
+    out = proc.output()
+    assert "finalized: exiting" in out
+    for mark in ("Traceback", "FATAL", "ERROR"):
+        assert mark not in out, out

@@ -161,3 +161,105 @@ def test_a_switch_takes_yamls_booleans_for_on_and_off(given, taken):
 def test_a_switch_refuses_other_words():
     with pytest.raises(ParameterError, match="friction_estimation"):
         SPECS["friction_estimation"].check("yes please")
+
+
+def _file(*sections: str) -> dict:
+    """Return a parsed params file of sections ``key`` or ``key=name,name`` (values 1)."""
+    out = {}
+    for section in sections:
+        key, _, names = section.partition("=")
+        out[key] = {"ros__parameters": {n: 1 for n in names.split(",") if n}}
+    return out
+
+
+@pytest.mark.parametrize("fqn, content, overrides, found", [
+    # a typo: the nearest parameter named
+    ("/fastsim", None, ["friction_coeficient"],
+     ["unknown parameter 'friction_coeficient'; did you mean 'friction_coefficient'?"]),
+    ("/fastsim", None, ["frobnicate"], ["unknown parameter 'frobnicate'"]),
+    # rclpy's own parameters and the node's are known
+    ("/fastsim", None, ["use_sim_time", "qos_overrides./x.publisher.depth", "method"], []),
+    # the node's section under another node's name (the executable's): no section is the node's
+    ("/fastsim", _file("fastsim_node=friction_coefficient"), [],
+     ["section 'fastsim_node' is for another node: this node's section is 'fastsim' "
+      "or a wildcard such as '/**'"]),
+    # beside the node's own: a near name is a typo, another node's section is not ours
+    ("/fastsim", _file("fastsim=method", "fastsim_lifecycle_node=method",
+                       "robot_state_publisher=robot_description"), [],
+     ["section 'fastsim_lifecycle_node' is for another node: this node's section is "
+      "'fastsim' or a wildcard such as '/**'"]),
+    ("/fastsim", _file("/fastsimm=method", "/**=use_sim_time"), [],
+     ["section '/fastsimm' is for another node: this node's section is 'fastsim' "
+      "or a wildcard such as '/**'"]),
+    # wildcards match (their unknown names are found too); /* is one token
+    ("/fastsim", _file("/**=friction_coeficient"), [],
+     ["unknown parameter 'friction_coeficient' in section '/**'; did you mean "
+      "'friction_coefficient'?"]),
+    ("/rig1/fastsim", _file("/rig1/**=method", "/*/fastsim=methd"), [],
+     ["unknown parameter 'methd' in section '/*/fastsim'; did you mean 'method'?"]),
+    ("/fastsim", _file("/*/fastsim=method"), [],
+     ["section '/*/fastsim' is for another node: this node's section is 'fastsim' "
+      "or a wildcard such as '/**'"]),
+    # namespaced: rcl gives a key without a namespace to the root's node only
+    ("/rig1/fastsim", _file("fastsim=method"), [],
+     ["section 'fastsim' is for another node: this node's section is '/rig1/fastsim' "
+      "or a wildcard such as '/**'"]),
+    ("/rig1/fastsim", _file("/rig1/fastsim=method", "/rig2/fastsim=method"), [], []),
+    ("/rig1/fastsim", _file("rig1/fastsim=method"), [], []),
+    # each name once, where first found: the file before the overrides
+    ("/fastsim", _file("fastsim=mu,method"), ["mu", "friction_coeficient"],
+     ["unknown parameter 'mu' in section 'fastsim'",
+      "unknown parameter 'friction_coeficient'; did you mean 'friction_coefficient'?"]),
+    # nested maps are dotted names, as rcl flattens them
+    ("/fastsim", {"fastsim": {"ros__parameters": {"friction": {"coefficient": 0.3}}}}, [],
+     ["unknown parameter 'friction.coefficient' in section 'fastsim'; did you mean "
+      "'friction_coefficient'?"]),
+])
+def test_unmatched_finds_other_nodes_sections_and_unknown_names(fqn, content, overrides, found):
+    assert [str(f) for f in params.unmatched(fqn, content, overrides)] == found
+
+
+def test_unmatched_takes_the_replays_own_keys_too():
+    content = _file("fastsim=method")
+    assert params.unmatched("/rig1/fastsim", content, also=("fastsim", "/fastsim")) == []
+
+
+@pytest.mark.parametrize("argv, files", [
+    (["node", "--ros-args", "--params-file", "a.yaml", "-p", "x:=1"], ["a.yaml"]),
+    (["node", "--params-file", "no.yaml", "--ros-args", "-r", "__ns:=/r",
+      "--params-file", "a.yaml", "--", "--params-file", "no.yaml",
+      "--ros-args", "--params-file", "b.yaml"], ["a.yaml", "b.yaml"]),
+    # a flag's value is no flag
+    (["node", "--ros-args", "-p", "--params-file", "-p", "y:=2"], []),
+    (["node"], []),
+])
+def test_ros_params_files(argv, files):
+    assert params.ros_params_files(argv) == files
+
+
+@pytest.mark.parametrize("text, line", [
+    ("fastsim_node:\n  ros__parameters:\n    friction_coefficient: 0.4\n",
+     "no section for node '/fastsim': section 'fastsim_node' is for another node: this "
+     "node's section is 'fastsim' or a wildcard such as '/**'"),
+    ("fastsim:\n  ros__parameters:\n    friction_coeficient: 0.4\n",
+     "unknown parameter 'friction_coeficient' in section 'fastsim'; did you mean "
+     "'friction_coefficient'?"),
+    ("fastsim:\n  ros__parameters:\n    method: mae\nfastsim_node:\n  ros__parameters:\n"
+     "    friction_coefficient: 0.4\n",
+     "section 'fastsim_node' is for another node: this node's section is 'fastsim' or a "
+     "wildcard such as '/**'"),
+])
+def test_the_replay_refuses_what_the_node_warns_of_in_one_line_exit_2(tmp_path, capsys,
+                                                                      text, line):
+    from fastsim_ros.replay import cli
+
+    path = tmp_path / "p.yaml"
+    path.write_text(text)
+    with pytest.raises(ParameterError) as info:
+        load_params_file(path)
+    assert str(info.value) == f"{path}: {line}"
+    assert cli.main([str(tmp_path / "in.mcap"), "-o", str(tmp_path / "out"),
+                     "--params", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"fastsim_replay: {path}: {line}\n"
+    assert not (tmp_path / "out").exists()
