@@ -29,7 +29,7 @@ CREEPAGES = ((4e-4, 0.0, 0.12), (0.0, 8e-4, 0.0))
 
 
 def wide_end_patch(rows_above: int) -> GridArea:
-    """Return a semi-ellipse (a 5 mm, b 8 mm) below y = 0, ``rows_above`` rows of a flatter one above.
+    """Return a semi-ellipse (a 5 mm, b 8 mm) below y = 0 and rows of a flatter one above.
 
     The longest chord is the join line's; the rows above it (of a
     semi-ellipse of the same ``a`` and ``b`` 2 mm, cells of 0.25 mm) hold a
