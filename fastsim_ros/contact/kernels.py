@@ -1238,23 +1238,31 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, 
     many faces above the rule's lower face (1: the upper face of
     :func:`split_blend`'s pair).
     """
-    status = check_grid(x0, y0, dx, dy)
+    status = mae_scan(p, x0, y0, dx, dy, geo, env, strips)
     if status != OK:
         return status, 0.0
+    return mae_zones(p, x0, y0, dx, dy, split_face(strips[0], rule) + shift, shear_modulus,
+                     knots, polys, geo, env, strips, calibrated, pair_knots, pair_values)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_scan(p, x0, y0, dx, dy, geo, env, strips):
+    """:func:`mae_prepare`'s part that does not depend on the split: check, scan, centroid.
+
+    Fills ``env``, ``strips`` and ``geo``'s centroid, cells in contact, load,
+    area and equivalent ellipse; return the status.
+    """
+    status = check_grid(x0, y0, dx, dy)
+    if status != OK:
+        return status
     count, first, last = strips[0], strips[1], strips[2]
     status, n, si, sj, sii, sjj, total = scan_patch(p, count, first, last, env)
     if status != OK:
-        return status, 0.0
+        return status
     # the centroid from exact index sums: the reference's sum(x)/n to rounding
-    x_c = x0 + dx * (si / n)
-    y_c = y0 + dy * (sj / n)
+    geo[G_XC] = x0 + dx * (si / n)
+    geo[G_YC] = y0 + dy * (sj / n)
     e_xc, e_yc, e_a, e_b = ellipse_from_sums(n, si, sj, sii, sjj, x0, y0, dx, dy)
-    f = split_face(count, rule) + shift
-    y_s = y0 + (f - 0.5) * dy
-    geo[G_XC] = x_c
-    geo[G_YC] = y_c
-    geo[G_YS] = y_s
-    geo[G_FACE] = f
     geo[G_NCONTACT] = n
     geo[G_LOAD] = total * (dx * dy)
     geo[G_AREA] = n * (dx * dy)
@@ -1262,6 +1270,22 @@ def mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env, 
     geo[G_ELLIPSE + 1] = e_yc
     geo[G_ELLIPSE + 2] = e_a
     geo[G_ELLIPSE + 3] = e_b
+    return OK
+
+
+@njit(cache=True, error_model="numpy")
+def mae_zones(p, x0, y0, dx, dy, f, shear_modulus, knots, polys, geo, env, strips,
+              calibrated, pair_knots, pair_values):
+    """:func:`mae_prepare`'s part for the split along face ``f``, on :func:`mae_scan`'s ``geo``.
+
+    Writes the split line and face, the zones and their ``L1 .. L4``; return
+    ``(status, info)`` as :func:`mae_prepare`.
+    """
+    count, first, last = strips[0], strips[1], strips[2]
+    x_c = geo[G_XC]
+    y_s = y0 + (f - 0.5) * dy
+    geo[G_YS] = y_s
+    geo[G_FACE] = f
     zone_geometry(x0, y0, dx, dy, count, first, last, env, f, x_c, y_s, True,
                   geo[G_ZONE1:G_ZONE1 + 6])
     zone_geometry(x0, y0, dx, dy, count, first, last, env, f, x_c, y_s, False,
@@ -1450,18 +1474,21 @@ def mae_flexibility(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, e
     yaw moment from nothing (either face alone gave an ellipse ``C~13`` of
     -0.03).
     """
-    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, geo, env,
-                               strips, calibrated, pair_knots, pair_values)
+    status = mae_scan(p, x0, y0, dx, dy, geo, env, strips)
+    if status != OK:
+        return status, 0.0
+    f, t = split_blend(strips[0], rule)
+    status, info = mae_zones(p, x0, y0, dx, dy, f, shear_modulus, knots, polys, geo, env,
+                             strips, calibrated, pair_knots, pair_values)
     if status != OK:
         return status, info
     mae_strip_flexibility(geo, flex)
-    t = split_blend(strips[0], rule)[1]
     if t == 0.0:
         return OK, 0.0
-    other = np.empty(GEO_SIZE)
-    other_env = np.empty_like(env)
-    status, info = mae_prepare(p, x0, y0, dx, dy, rule, shear_modulus, knots, polys, other,
-                               other_env, strips, calibrated, pair_knots, pair_values, 1)
+    # the other face: the same scan, its own zones
+    other = geo.copy()
+    status, info = mae_zones(p, x0, y0, dx, dy, f + 1, shear_modulus, knots, polys, other,
+                             env, strips, calibrated, pair_knots, pair_values)
     if status != OK:
         return status, info
     upper = np.empty_like(flex)
