@@ -105,6 +105,22 @@ SOURCES = ("flange_shift", "hertz_ramp", "semi_ellipses_spin")
 COPIES = 4   # 12 bags
 
 
+def kill_held_worker(cluster, hold: Path, proc: subprocess.Popen) -> None:
+    """Wait for the worker the fault hook holds (its pid in ``hold``), then SIGKILL it.
+
+    SIGKILL: the worker gets no clean-up of its own.  ``proc`` (the replay)
+    must still run while the hook has not fired.
+    """
+    deadline = time.monotonic() + faults.PAUSE_S
+    while not (hold / "pid").exists():
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.01)
+    pid = int((hold / "pid").read_text())
+    victim = next(w for w in cluster.workers if w.pid == pid)
+    victim.kill()
+    victim.wait(timeout=30)
+
+
 def comparable(bag: Path):
     """Return a bag's messages by topic: raw CDR, the diagnostics decoded without timing."""
     raw: dict[str, list] = {}
@@ -157,14 +173,7 @@ def test_a_worker_killed_at_any_moment_loses_nothing(tmp_path, reference, moment
             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
             if moment != "before":
-                deadline = time.monotonic() + faults.PAUSE_S
-                while not (hold / "pid").exists():
-                    assert proc.poll() is None and time.monotonic() < deadline
-                    time.sleep(0.01)
-                pid = int((hold / "pid").read_text())
-                victim = next(w for w in cluster.workers if w.pid == pid)
-                victim.kill()   # SIGKILL: no clean-up of its own
-                victim.wait(timeout=30)
+                kill_held_worker(cluster, hold, proc)
             stdout, stderr = proc.communicate(timeout=120)
         finally:
             if proc.poll() is None:
@@ -274,14 +283,7 @@ def test_an_overwrite_on_a_cluster_shows_the_estimate_and_survives_a_killed_work
              "--overwrite", "--scheduler", cluster.address],
             cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         try:
-            deadline = time.monotonic() + faults.PAUSE_S
-            while not (hold / "pid").exists():
-                assert proc.poll() is None and time.monotonic() < deadline
-                time.sleep(0.01)
-            pid = int((hold / "pid").read_text())
-            victim = next(w for w in cluster.workers if w.pid == pid)
-            victim.kill()
-            victim.wait(timeout=30)
+            kill_held_worker(cluster, hold, proc)
             stdout, stderr = proc.communicate(timeout=300)
         finally:
             if proc.poll() is None:
