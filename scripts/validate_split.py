@@ -46,6 +46,7 @@ from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
 from fastsim_ros.contact import exact, kernels  # noqa: E402
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact import area as areas  # noqa: E402
+from fastsim_ros.contact import samples  # noqa: E402
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,  # noqa: E402
                                           MaeSolver)
 from fastsim_ros.geometry import benchmark  # noqa: E402
@@ -99,14 +100,7 @@ def tread_patches() -> dict[float, tuple[GridArea, tuple[float, float, float]]]:
 
 def two_semi_ellipses(ratio: float) -> GridArea:
     """Return semi-ellipses (a, b1) below and (a, ratio b1) above y = 0, Hertz-like, 50 kN."""
-    a, b1, cell = 5e-3, 8e-3, 0.25e-3
-    b2 = ratio * b1
-    x = -a + cell * (np.arange(int(round(2 * a / cell))) + 0.5)
-    y = cell * (np.arange(-int(np.ceil(b1 / cell)), max(1, int(np.ceil(b2 / cell)))) + 0.5)
-    xx, yy = np.meshgrid(x, y)
-    b = np.where(yy < 0.0, b1, b2)
-    p = np.sqrt(np.clip(1.0 - (xx / a) ** 2 - (yy / b) ** 2, 0.0, None))
-    return GridArea(float(x[0]), float(y[0]), cell, cell, p * 5e4 / (p.sum() * cell * cell))
+    return samples.wide_end(a=5e-3, b_lower=8e-3, b_upper=ratio * 8e-3, cell=0.25e-3, load=5e4)
 
 
 def cut_ellipse(c: float) -> GridArea:

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from fastsim_ros.contact import area as areas
-from fastsim_ros.contact import exact
+from fastsim_ros.contact import exact, samples
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
 
@@ -36,13 +36,8 @@ def wide_end_patch(rows_above: int) -> GridArea:
     smaller zone of 0 to 20% of the area: a conformal tread patch's wide
     end.  Hertz-like pressure, 20 kN.
     """
-    a, b1, b2, cell = 5e-3, 8e-3, 2e-3, 0.25e-3
-    x = -a + cell * (np.arange(int(round(2 * a / cell))) + 0.5)
-    y = cell * (np.arange(-int(np.ceil(b1 / cell)), rows_above) + 0.5)
-    xx, yy = np.meshgrid(x, y)
-    b = np.where(yy < 0.0, b1, b2)
-    p = np.sqrt(np.clip(1.0 - (xx / a) ** 2 - (yy / b) ** 2, 0.0, None))
-    return GridArea(float(x[0]), float(y[0]), cell, cell, p * 2e4 / (p.sum() * cell * cell))
+    return samples.wide_end(a=5e-3, b_lower=8e-3, b_upper=2e-3, cell=0.25e-3, load=2e4,
+                            rows_above=rows_above)
 
 
 def ellipse_rows(rows: int) -> GridArea:

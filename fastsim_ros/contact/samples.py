@@ -9,6 +9,9 @@ extrapolated over several grids, the online methods are judged on one.
 - two overlapping lobes of different size (a waisted, two-lobed area);
 - an ellipse truncated just beyond its centre line (a patch cut off where a
   profile region ends): its longest chord lies on its edge;
+- a wide end: two semi-ellipses sharing their join chord, the upper one
+  flatter and possibly cut to a few rows (a conformal tread patch whose
+  longest chord lies near one end);
 - a flange-root patch: the normal contact of a gap whose lateral curvature
   is ten times larger on the flange side (``y > 0``) than on the tread side,
   as where a wheel's flange root runs against the rail's gauge corner.
@@ -135,6 +138,25 @@ def truncated_ellipse(*, cells: int, scale: float = 1.0, load: float | None = No
     xx, yy = x[None, :], y[:, None]
     p = _hertz_like(xx, yy, a, b) * (yy <= cut * b)
     return _finish(x, y, dx, dy, p, scale, load).cropped()
+
+
+def wide_end(*, a: float, b_lower: float, b_upper: float, cell: float, load: float,
+             rows_above: int | None = None) -> GridArea:
+    """Return semi-ellipses ``(a, b_lower)`` below and ``(a, b_upper)`` above ``y = 0`` (m).
+
+    Square cells of ``cell`` (m), the join line on a cell face; above it
+    ``rows_above`` rows (default: the upper half's, at least one), so a
+    sweep of ``rows_above`` trims the smaller zone row by row.  Hertz-like
+    pressure per half, scaled to ``load`` (N).
+    """
+    if rows_above is None:
+        rows_above = max(1, int(np.ceil(b_upper / cell)))
+    x = -a + cell * (np.arange(int(round(2 * a / cell))) + 0.5)
+    y = cell * (np.arange(-int(np.ceil(b_lower / cell)), rows_above) + 0.5)
+    xx, yy = np.meshgrid(x, y)
+    b = np.where(yy < 0.0, b_lower, b_upper)
+    p = np.sqrt(np.clip(1.0 - (xx / a) ** 2 - (yy / b) ** 2, 0.0, None))
+    return GridArea(float(x[0]), float(y[0]), cell, cell, p * load / (p.sum() * cell * cell))
 
 
 def flange_root_gap(x: np.ndarray, y: np.ndarray) -> np.ndarray:
