@@ -59,7 +59,6 @@ from fastsim_ros import params as parameters
 from fastsim_ros import pipeline_kernels
 from fastsim_ros.contact import compiled
 from msg_adapters import patch as patch_adapter
-from msg_adapters.errors import REJECTION_REASONS
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
                                   WHEELSET_WRENCH_TOPIC, InputTopic, Outcome, PipelineConfig,
                                   patch_topic)
@@ -73,12 +72,6 @@ _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
           "string_array": ParameterType.PARAMETER_STRING_ARRAY}
 _MESSAGE_TYPES = {"wrench": WrenchStamped, "creepage": Vector3Stamped, "frame": PoseStamped,
                   "traction": PointCloud2}
-#: the diagnostics key that names the keys counting since the start (a managed node: since
-#: its last configure), beside this_period/* and the status message (the last period)
-SINCE_START_KEY = "since_start"
-SINCE_START = "wrenches, solved, no_contact, rejected, rejected/*, twists/*, dropped/inactive"
-#: the pipeline's status message of a period with rejections: "4 of 4 patches rejected; last: ..."
-_PERIOD_REJECTED = re.compile(r"^(\d+ of \d+ patches rejected)(?=;|$)")
 #: libyaml's loader where built (a params file in 0.5 ms, not 7: the check is on the start)
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 #: least time (s) between two looks at the ROS graph for patch topics no contact takes
@@ -180,8 +173,6 @@ class _FrontEnd:
     _warm: float = 0.0
     _diagnostics: Publisher | None = None
     _timer: Any = None
-    #: each contact's (patches, rejected) counts at the last diagnostics
-    _counted: dict[str, tuple[int, int]]
     #: patch topics with publishers and no contact: topic -> (contact name, publishers)
     _unheard: dict[str, tuple[str, int]]
     #: the unheard topics already logged (once per topic)
@@ -354,7 +345,6 @@ class _FrontEnd:
             self._subs[entry.topic] = node.create_subscription(
                 message_type(entry.msgtype), entry.topic, self._input_callback(entry), qos_in,
                 raw=True)
-        self._counted = {}
         self._unheard = {}
         self._unheard_logged = getattr(self, "_unheard_logged", set())
         self._graph_next = -math.inf
@@ -494,24 +484,6 @@ class _FrontEnd:
         if node.context.ok():
             raise
 
-    def period_values(self) -> dict[str, list[tuple[str, str]]]:
-        """Return each contact's counts of the last diagnostics period as key-values.
-
-        ``this_period/patches`` and ``this_period/rejected`` (the status
-        message's "N of M patches rejected this period"), and
-        :data:`SINCE_START_KEY` naming the keys that count since the start.
-        """
-        out: dict[str, list[tuple[str, str]]] = {}
-        for c in self.pipeline.config.contacts:
-            counts = self.pipeline.counts(c)
-            now = (sum(counts.values()), sum(counts.get(r, 0) for r in REJECTION_REASONS))
-            before = self._counted.get(c, (0, 0))
-            self._counted[c] = now
-            out[c] = [("this_period/patches", str(now[0] - before[0])),
-                      ("this_period/rejected", str(now[1] - before[1])),
-                      (SINCE_START_KEY, SINCE_START)]
-        return out
-
     def unheard_values(self) -> list[tuple[str, str]]:
         """Return the patch topics with publishers that no contact takes, as key-values.
 
@@ -561,15 +533,11 @@ class _FrontEnd:
         node: Node = self  # type: ignore[assignment]
         extra = self.connections()
         unheard = self.unheard_values()
-        for c, values in self.period_values().items():
-            extra[c] = extra.get(c, []) + values + unheard
+        for c in self.pipeline.config.contacts:
+            extra[c] = extra.get(c, []) + unheard
         try:
-            msg = self.pipeline.diagnostics(node.get_clock().now().nanoseconds, extra)
-            for status in msg.status:
-                # the pipeline's message counts the last period: said so beside the counts
-                # since start
-                status.message = _PERIOD_REJECTED.sub(r"\1 this period", status.message)
-            self._diagnostics.publish(msg)
+            self._diagnostics.publish(self.pipeline.diagnostics(
+                node.get_clock().now().nanoseconds, extra))
         except _rclpy.RCLError:
             self._raise_unless_shut_down()
 

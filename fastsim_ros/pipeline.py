@@ -212,6 +212,12 @@ class Outcome:
         return self.status in (SOLVED, NO_CONTACT)
 
 
+#: the diagnostics key that names the keys counting since the start (a managed node: since
+#: its last configure), beside this_period/* and the status message (the last period)
+SINCE_START_KEY = "since_start"
+SINCE_START = "wrenches, solved, no_contact, rejected, rejected/*, twists/*, dropped/inactive"
+
+
 @dataclass
 class ContactStats:
     """Counters and solve times of one contact (cumulative since start)."""
@@ -1214,12 +1220,16 @@ class Pipeline:
         if self._transient:  # why the contact's traction state was reset (transient.py)
             counts = self._reset_counts.get(contact, {})
             values += [(f"transient/{r}", str(counts.get(r, 0))) for r in RESET_REASONS]
+        # the counts above are since the start; these and the message, of the last period
+        values += [("this_period/patches", str(stats.window_inputs)),
+                   ("this_period/rejected", str(stats.window_rejected)),
+                   (SINCE_START_KEY, SINCE_START)]
         level, message = 0, "ok"
         if stats.window_inputs == 0:
             level, message = 1, "no patch in the last period"
         elif stats.window_rejected:
             level, message = 1, (f"{stats.window_rejected} of {stats.window_inputs} patches "
-                                 f"rejected; last: {stats.last_detail}")
+                                 f"rejected this period; last: {stats.last_detail}")
         stats.window_inputs = stats.window_rejected = 0
         stats.window_first_ns = stats.window_last_ns = None
         return ContactReport(f"fastsim: {contact}", level, message, tuple(values))
