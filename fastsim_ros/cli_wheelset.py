@@ -168,7 +168,7 @@ def _config(args: argparse.Namespace) -> PipelineConfig:
         "friction_coefficient": args.mu,
         "method": "mae" if args.method == "exact" else args.method,
         "traction_bound": args.bound, "max_patch_cells": MAX_PATCH_CELLS,
-        "publish_markers": False,
+        "publish_markers": False, "allow_implausible": bool(args.allow_implausible),
     }
     try:
         return PipelineConfig.from_values(values)

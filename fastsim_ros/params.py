@@ -138,6 +138,12 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("publish_traction", "bool", False,
                   "publish contact/<name>/traction (PointCloud2 of tau_x, tau_y, slip)",
                   dynamic=True),
+    ParameterSpec("allow_implausible", "bool", False,
+                  "accept patches and loads that wheel-rail contact does not have in SI units "
+                  "(fastsim_ros/plausibility.py: a patch over 0.1 m across, pressures under "
+                  "1e5 Pa, |xi| or |eta| over 0.1, |phi| over 50 1/m, a wheel load outside "
+                  "100 N..1 MN): a scaled rig, a full-slip test; otherwise they are rejected "
+                  "as 'implausible', a likely unit mistake"),
     ParameterSpec("max_patch_cells", "integer", 16384,
                   "largest patch grid (height x width) accepted, checked before any "
                   "allocation; larger patches are rejected as too_large",

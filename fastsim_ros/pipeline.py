@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from fastsim_ros import params as parameters
+from fastsim_ros import plausibility
 from fastsim_ros import pipeline_kernels as fast
 from fastsim_ros.contact import compiled
 from fastsim_ros.contact.area import nearest_cells, regridded, turned_grid
@@ -216,6 +217,37 @@ class Outcome:
 #: its last configure), beside this_period/* and the status message (the last period)
 SINCE_START_KEY = "since_start"
 SINCE_START = "wrenches, solved, no_contact, rejected, rejected/*, twists/*, dropped/inactive"
+
+
+def patch_extent(pressure: np.ndarray, dx: float, dy: float) -> tuple[float, float]:
+    """Return a patch's span (m) along x and y: its grid's, or its cells in contact's if over.
+
+    The grid's span bounds the contact's, so the cells in contact are looked
+    at only where the grid spans more than a plausible patch.
+    """
+    ny, nx = pressure.shape
+    high = plausibility.PLAUSIBLE["patch_extent"].high
+    if nx * dx <= high and ny * dy <= high:
+        return nx * dx, ny * dy
+    rows, cols = np.nonzero(pressure > 0.0)
+    if cols.size == 0:
+        return 0.0, 0.0
+    return (float(np.ptp(cols)) + 1.0) * dx, (float(np.ptp(rows)) + 1.0) * dy
+
+
+def implausible(pressure: np.ndarray, dx: float, dy: float, load: float, cells: int,
+                creep: Creepage) -> str | None:
+    """Return why a solved patch is a likely unit mistake (one line), or None.
+
+    :func:`fastsim_ros.plausibility.stream_problem` on the patch's extent,
+    its mean pressure (its largest where the mean is under the table's
+    bound) and its creepages: the replay's batch applies the same rule.
+    """
+    ex, ey = patch_extent(pressure, dx, dy)
+    p = load / (cells * dx * dy) if cells > 0 else 0.0
+    if not p >= plausibility.PLAUSIBLE["peak_pressure"].low:
+        p = float(pressure.max())
+    return plausibility.stream_problem(ex, ey, p, creep.xi, creep.eta, creep.phi)
 
 
 @dataclass
@@ -432,6 +464,7 @@ class Pipeline:
         self._max_age_ns = round(config["max_kinematics_age"] * 1e9)
         self._min_speed = float(config["min_rolling_speed"])
         self._rail_required = bool(config["rail_twist_required"])
+        self._allow_implausible = bool(config["allow_implausible"])
         self._tractions = bool(config["publish_traction"])
         rate = float(config["marker_rate"])
         self._markers = bool(config["publish_markers"])
@@ -834,6 +867,11 @@ class Pipeline:
                           o[0] * f_ws[1] - o[1] * f_ws[0] + m_ws[2])
             else:
                 patch, creep, forces, f_ws, torque = done
+            if not self._allow_implausible:
+                why = implausible(patch.pressure, patch.dx, patch.dy, patch.load, patch.cells,
+                                  creep)
+                if why is not None:
+                    raise RejectedInput("implausible", why)
         except RejectedInput as e:
             stats.counts[e.reason] += 1
             stats.window_rejected += 1

@@ -33,6 +33,8 @@ from fastsim_ros.params import SPECS
 
 #: how the command line accepts an implausible value; the node and the replay pass theirs
 OVERRIDE_FLAG = "--allow-implausible"
+#: how the node and the replay accept one (their parameter)
+OVERRIDE_PARAMETER = "parameter allow_implausible: true"
 
 
 class ImplausibleValueError(InvalidInputError):
@@ -196,5 +198,32 @@ def check_patch(extent_x: float, extent_y: float, peak_pressure: float | None, *
               override=override)
 
 
-__all__ = ["ImplausibleValueError", "OVERRIDE_FLAG", "PLAUSIBILITY", "PLAUSIBLE", "Plausible",
-           "check", "check_patch", "message"]
+def stream_problem(extent_x: float, extent_y: float, pressure: float, xi: float, eta: float,
+                   phi: float, *, override: str = OVERRIDE_PARAMETER) -> str | None:
+    """Return why a solved patch of a stream is implausible (one line), or None.
+
+    The unit mistakes a patch topic or a recording can carry: coordinates in
+    millimetres (an extent, m, over the table's), pressures in megapascals
+    (``pressure``: the largest, Pa, under the table's; a value at or above
+    the bound, such as the mean pressure, clears it), and creepages or spin
+    beyond the table's.  The lower extent bound and the load are not
+    applied: a patch that starts or ends (a flange just touching, a wheel
+    lifting) is small and light, and right.  The node and the replay
+    reject such a patch as ``implausible`` (no wrench published).
+    """
+    high = PLAUSIBLE["patch_extent"].high
+    for axis, extent in (("x", extent_x), ("y", extent_y)):
+        if extent > high:
+            return message("patch_extent", extent, what=f"patch extent along {axis}",
+                           override=override)
+    if pressure < PLAUSIBLE["peak_pressure"].low:
+        return message("peak_pressure", pressure, what="largest pressure", override=override)
+    for name, quantity, value in (("xi", "creepage", xi), ("eta", "creepage", eta),
+                                  ("phi", "spin", phi)):
+        if not PLAUSIBLE[quantity].contains(value):
+            return message(quantity, value, what=name, override=override)
+    return None
+
+
+__all__ = ["ImplausibleValueError", "OVERRIDE_FLAG", "OVERRIDE_PARAMETER", "PLAUSIBILITY",
+           "PLAUSIBLE", "Plausible", "check", "check_patch", "message", "stream_problem"]

@@ -47,6 +47,7 @@ from typing import Any, Literal, Protocol
 
 import numpy as np
 
+from fastsim_ros import plausibility
 from fastsim_ros.contact.errors import ContactError
 from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
 from fastsim_ros.geometry.placement import Placement, Pose, rotation
@@ -387,6 +388,7 @@ class ProfilePipeline:
         for load in reversed(self._loads):
             if load.stamp_ns <= stamp_ns:
                 if stamp_ns - load.stamp_ns <= max_age:
+                    self._check_plausible(0.5 * load.linear[2], "wheelset/load: half its force.z")
                     return self.split_load(load.linear[2], load.angular[0])
                 raise RejectedInput("stale_kinematics", f"the last wheelset/load is "
                                     f"{(stamp_ns - load.stamp_ns) * 1e-6:.3g} ms older than "
@@ -394,7 +396,20 @@ class ProfilePipeline:
         if self._loads:
             raise RejectedInput("stale_kinematics", "no wheelset/load at or before the pose")
         per_wheel = float(self.config["wheel_load"])
+        self._check_plausible(per_wheel, "parameter wheel_load")
         return (per_wheel, per_wheel) if per_wheel > 0.0 else None
+
+    def _check_plausible(self, per_wheel: float, what: str) -> None:
+        """Reject a load per wheel (N) a wheel-rail contact does not have (a unit mistake).
+
+        A wheelset's mean load per wheel, not one wheel's share: a share passes
+        through nothing as a wheel lifts, and zero (no load given, or the
+        wheelset lifted) is no mistake.  Unless ``allow_implausible``.
+        """
+        if (per_wheel > 0.0 and not self.config["allow_implausible"]
+                and not plausibility.PLAUSIBLE["wheel_load"].contains(per_wheel)):
+            raise RejectedInput("implausible", plausibility.message(
+                "wheel_load", per_wheel, what=what, override=plausibility.OVERRIDE_PARAMETER))
 
     def split_load(self, total: float, roll_moment: float) -> tuple[float, float]:
         """Return the left and right wheels' shares of a load ``total`` (N), moment ``M`` (N m)."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 REJECTION_REASONS = (
     "nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",
     "old_stamp", "no_kinematics", "stale_kinematics", "standstill", "too_large",
-    "degenerate", "out_of_table", "derailment",
+    "degenerate", "out_of_table", "derailment", "implausible",
 )
 
 

@@ -60,7 +60,7 @@ PATCH_OFFSET = 0.0025  # patches lie between twists: no stamp ties, no boundary 
 FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "pressure")
 REASONS = ("nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",
            "old_stamp", "no_kinematics", "stale_kinematics", "standstill", "too_large",
-           "degenerate", "out_of_table", "derailment")
+           "degenerate", "out_of_table", "derailment", "implausible")
 #: parameters of the node that the bad-input bag relies on
 MAX_PATCH_CELLS = 4096
 MAX_KINEMATICS_AGE = 0.05
@@ -496,7 +496,8 @@ def bad_inputs() -> tuple[Bag, dict[str, Any]]:
     kinds = ["nonfinite_p", "negative_pressure", "missing_field", "wrong_frame", "old_stamp",
              "irregular_grid", "too_large", "degenerate", "nonfinite_x", "negative_pressure",
              "missing_field", "wrong_frame", "old_stamp", "irregular_grid", "too_large",
-             "degenerate", "nonfinite_n"]
+             "degenerate", "nonfinite_n", "implausible_mm", "implausible_mpa", "implausible_mm",
+             "implausible_mpa"]
     bad: dict[str, dict[int, str]] = {c: {} for c in contacts}
     for c, first in (("left", 20), ("right", 22)):  # slots from 0.2025 s, every 5th
         for i, kind in enumerate(kinds):
@@ -548,6 +549,10 @@ def bad_patch(kind: str, ns: int, prev_ns: int, good: np.ndarray, area: GridArea
         p = np.zeros_like(area.pressure)
         p[j, i - 1:i + 2] = area.pressure[j, i]
         pts = cloud_points(area.with_pressure(p), origin, normal)
+    elif kind == "implausible_mm":   # the positions in millimetres
+        pts[..., 0:3] *= np.float32(1e3)
+    elif kind == "implausible_mpa":  # the pressures in megapascals
+        pts[..., 6] *= np.float32(1e-6)
     elif kind == "no_contact":
         pts[..., 6] = 0.0
     else:
@@ -563,9 +568,9 @@ def classify_bag(path: Path, params: dict[str, Any]) -> list[tuple[str, str, int
     The rules of INTERFACE.md, in this order: the size bound, frame, fields,
     non-finite values, negative pressure, grid regularity, stamp order, empty
     (``no_contact``), fewer than 4 cells (``degenerate``), kinematics
-    (``no_kinematics``, ``stale_kinematics``), ``standstill``; else
-    ``served``.  Each bad patch of the bag has one fault only, so the order
-    does not decide any outcome.
+    (``no_kinematics``, ``stale_kinematics``), ``standstill``, a likely unit
+    mistake (``implausible``); else ``served``.  Each bad patch of the bag has
+    one fault only, so the order does not decide any outcome.
     """
     max_cells = int(params.get("max_patch_cells", MAX_PATCH_CELLS))
     out: list[tuple[str, str, int]] = []
@@ -638,7 +643,15 @@ def _kinematics(msg: Any, ns: int, twist: Any) -> str:
     u_w = lin + np.cross(ang, c)
     cp = lin + np.cross(np.array([ang[0], 0.0, ang[2]]), c)
     speed = float(ex @ (cp - u_w / 2.0))
-    return "standstill" if abs(speed) < MIN_ROLLING_SPEED else "served"
+    if abs(speed) < MIN_ROLLING_SPEED:
+        return "standstill"
+    # a likely unit mistake: cells in contact over 0.1 m across (millimetres), or no
+    # pressure reaching 1e5 Pa (megapascals); the bag's creepages are plausible
+    rows, cols = np.nonzero(p > 0.0)
+    step = (np.linalg.norm(pts[0, 1, 0:3].astype(float) - pts[0, 0, 0:3]),
+            np.linalg.norm(pts[1, 0, 0:3].astype(float) - pts[0, 0, 0:3]))
+    extent = max((np.ptp(cols) + 1) * step[0], (np.ptp(rows) + 1) * step[1])
+    return "implausible" if extent > 0.1 or p.max() < 1e5 else "served"
 
 
 def expected_counts(outcomes: list[tuple[str, str, int]]) -> dict[str, Any]:
@@ -904,7 +917,8 @@ def build(name: str, out: Path) -> Path:
             assert len(seen) == len(keys)
             for got, key in zip(seen, keys):
                 want = bag.tags[key]
-                want = "nonfinite" if want.startswith("nonfinite") else want
+                want = ("nonfinite" if want.startswith("nonfinite") else
+                        "implausible" if want.startswith("implausible") else want)
                 if want == "good":
                     assert got in ("served", "no_kinematics", "stale_kinematics",
                                    "standstill"), got

@@ -226,12 +226,19 @@ def bad_inputs():
         return cloud_msg(area.scaled(1e-200), origin=(0.0, 0.0, 0.0), stamp_ns=stamp,
                          dtype="<f8")
 
+    def in_mm(stamp):  # positions in millimetres: a patch 12 m across
+        return cloud_msg(area.scaled(1e3), origin=(0.0, 750.0, -460.0), stamp_ns=stamp,
+                         dtype="<f8")
+
+    def in_mpa(stamp):  # pressures in megapascals
+        return cloud_msg(area, stamp_ns=stamp, pressure=area.pressure * 1e-6)
+
     return [("nonfinite", nonfinite), ("negative_pressure", negative),
             ("irregular_grid", irregular), ("irregular_grid", stray),
             ("missing_field", missing),
             ("wrong_frame", lambda s: cloud_msg(area, stamp_ns=s, frame_id="base_link")),
             ("too_large", huge), ("degenerate", degenerate), ("degenerate", tiny),
-            ("out_of_table", out_of_table)]
+            ("out_of_table", out_of_table), ("implausible", in_mm), ("implausible", in_mpa)]
 
 
 def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):

@@ -1,6 +1,7 @@
 """The shared pipeline: library-equal wrenches, reverse running, kinematics rules, outputs."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -257,6 +258,50 @@ def test_patch_rejections_then_the_next_good_patch_is_served():
     p[3, 3] = -5.0
     assert solve(pipe, egg(), stamp=T0 + 25 * MS, pressure=p).status == "negative_pressure"
     assert solve(pipe, egg(), stamp=T0 + 30 * MS).status == "solved"
+
+
+def _in_mm(area):
+    """Return ``area`` with its coordinates in millimetres where metres belong."""
+    return areas.GridArea(area.x0 * 1e3, area.y0 * 1e3, area.dx * 1e3, area.dy * 1e3,
+                          area.pressure)
+
+
+@pytest.mark.parametrize("case, cloud, twist, words", [
+    ("coordinates in mm", dict(area=_in_mm(egg())), rolling_twist(1e-3, stamp_ns=T0),
+     r"patch extent along x 12\.7662 m is implausible for wheel-rail contact: .* likely "
+     "coordinates in millimetres where metres belong; if intended, give parameter "
+     "allow_implausible: true"),
+    ("pressures in MPa", dict(pressure=egg().pressure * 1e-6),
+     rolling_twist(1e-3, stamp_ns=T0),
+     "largest pressure 1397.59 Pa is implausible for wheel-rail contact: .* likely "
+     r"megapascals typed as pascals \(1000 MPa is 1e9 Pa\); if intended, give parameter "
+     "allow_implausible: true"),
+    ("a percentage as a creepage", {}, rolling_twist(0.2, stamp_ns=T0),
+     "xi 0.2 is implausible for wheel-rail contact: .* likely a percentage typed where the "
+     r"fraction belongs \(0.2 % is 0.002\); if intended, give parameter allow_implausible: "
+     "true"),
+])
+def test_a_likely_unit_mistake_is_rejected_unless_allowed(case, cloud, twist, words):
+    """Patches and creepages wheel-rail contact does not have in SI units: no wrench.
+
+    The same inputs with ``allow_implausible`` are solved (a scaled rig, a
+    full-slip test), as every plausible patch is.
+    """
+    area = cloud.pop("area", egg())
+    for allow in (False, True):
+        pipe = make(allow_implausible=allow)
+        pipe.on_wheel_twist(cdr(twist))
+        out = solve(pipe, area, **cloud)
+        if allow:
+            assert out.status == "solved" and math.isfinite(out.forces.fx), case
+            continue
+        assert out.status == "implausible", case
+        assert re.fullmatch(words, out.detail), out.detail
+        assert pipe.messages(out) == []
+        assert pipe.counts("left")["implausible"] == 1
+        # the next good patch, with a plausible twist, is served
+        pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=T0 + 15 * MS)))
+        assert solve(pipe, egg(), stamp=T0 + 20 * MS).status == "solved"
 
 
 @pytest.mark.parametrize("method", ["mae", "mae_calibrated"])

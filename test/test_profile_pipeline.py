@@ -357,3 +357,31 @@ def test_the_table_needs_a_reference_load(table_cache):
     with pytest.raises(ParameterError, match="divide"):
         ProfilePipeline(_config(**{**TABLE, "table_dy_step": 3e-3},
                                 table_cache=str(table_cache)))
+
+
+def test_a_wheel_load_in_kilonewtons_is_rejected_unless_allowed():
+    """``wheel_load`` 10 (kN typed as N) and a ``wheelset/load`` of 20 N: likely unit mistakes.
+
+    The pose is dropped for every contact, named ``implausible`` with the
+    value and the parameter that accepts it; ``allow_implausible`` solves it;
+    a lifted wheelset (no load) is no mistake.
+    """
+    p = ProfilePipeline(_config(wheel_load=10.0))
+    p.on_wheel_twist(_twist(0))
+    cycle = p.on_pose(_pose(1 * MS, 0.0))
+    assert _reasons(cycle) == {"implausible"}
+    assert all(o.detail.startswith("parameter wheel_load 10 N is implausible for wheel-rail "
+                                   "contact") and "kilonewtons typed as newtons" in o.detail
+               and o.detail.endswith("give parameter allow_implausible: true")
+               for o in cycle.outcomes)
+    allowed = ProfilePipeline(_config(wheel_load=10.0, allow_implausible=True))
+    allowed.on_wheel_twist(_twist(0))
+    assert "implausible" not in _reasons(allowed.on_pose(_pose(1 * MS, 0.0)))
+    assert p.on_load(StampedTwist(2 * MS, "wheelset", (0.0, 0.0, 20.0), (0.0, 0.0, 0.0))) == "ok"
+    p.on_wheel_twist(_twist(2 * MS))
+    cycle = p.on_pose(_pose(3 * MS, 0.0))
+    assert _reasons(cycle) == {"implausible"}
+    assert cycle.outcomes[0].detail.startswith("wheelset/load: half its force.z 10 N")
+    assert p.on_load(StampedTwist(4 * MS, "wheelset", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))) == "ok"
+    p.on_wheel_twist(_twist(4 * MS))
+    assert _reasons(p.on_pose(_pose(5 * MS, 0.0))) == {"no_contact"}

@@ -559,10 +559,10 @@ def test_summary_reports_rejections(tmp_path, capsys):
                           BAGS / "bad_inputs.params.yaml"], capsys)
     assert status == 0
     assert "bad_inputs: 1140 messages in" in out
-    assert ("left: 300 patches, 238 wrenches (228 solved, 10 no_contact), rejected 62 "
+    assert ("left: 300 patches, 234 wrenches (224 solved, 10 no_contact), rejected 66 "
             "(nonfinite 3, negative_pressure 2, irregular_grid 2, missing_field 2, "
             "wrong_frame 2, old_stamp 2, no_kinematics 10, stale_kinematics 15, "
-            "standstill 20, too_large 2, degenerate 2)") in out
+            "standstill 20, too_large 2, degenerate 2, implausible 4)") in out
     assert "x real time" in out and "solve p50" in out
 
 

@@ -52,8 +52,9 @@ from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import friction_law
+from fastsim_ros import plausibility
 from fastsim_ros.pipeline import (FRAME_TOLERANCE, NO_CONTACT, SOLVE_TIME_WINDOW, SOLVED,
-                                  TWIST_HISTORY, Pipeline, PipelineConfig)
+                                  TWIST_HISTORY, Pipeline, PipelineConfig, patch_extent)
 from fastsim_ros.replay import kernels
 from fastsim_ros.replay.mcap import Window
 from msg_adapters.cdr import read_cloud, read_twist
@@ -337,6 +338,7 @@ class Batch:
         self.max_cells = int(config["max_patch_cells"])
         self.max_age = round(float(config["max_kinematics_age"]) * 1e9)
         self.min_speed = float(config["min_rolling_speed"])
+        self.allow_implausible = bool(config["allow_implausible"])
         self.rail_required = bool(config["rail_twist_required"])
         rate = float(config["marker_rate"])
         self.markers_on = bool(config["publish_markers"])
@@ -782,6 +784,8 @@ class Batch:
             for j in np.flatnonzero(ok & ~finite).tolist():
                 p.status[rows[j]] = CODE["nonfinite"]
                 p.detail[rows[j]] = "nonfinite: the solve gave a non-finite force"
+            if not self.allow_implausible:
+                self._implausible(p, rows[ok & finite], ps[ok & finite], grid[ok & finite])
         elapsed = time.perf_counter() - t0
         done = np.concatenate(solved)
         self.timing.solves += done.size
@@ -791,6 +795,33 @@ class Batch:
                 times = self.state.solve_times[int(c)]
                 times += [mean] * int(k)
                 del times[:-SOLVE_TIME_WINDOW]
+
+    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats) -> None:
+        """``implausible``: the pipeline's rule (:func:`fastsim_ros.pipeline.implausible`).
+
+        Its bounds tested on every row at once (the grid's span, the largest
+        pressure, the creepages); the rows that fail one get the pipeline's
+        own words from :func:`~fastsim_ros.plausibility.stream_problem`.
+        """
+        if rows.size == 0:
+            return
+        table = plausibility.PLAUSIBLE
+        ny, nx = ps.shape[1], ps.shape[2]
+        peak = ps.max(axis=(1, 2))
+        creep = p.creep[rows]
+        suspect = ((nx * grid[:, 2] > table["patch_extent"].high)
+                   | (ny * grid[:, 3] > table["patch_extent"].high)
+                   | ~(peak >= table["peak_pressure"].low)
+                   | ~(np.abs(creep[:, 0]) <= table["creepage"].high)
+                   | ~(np.abs(creep[:, 1]) <= table["creepage"].high)
+                   | ~(np.abs(creep[:, 2]) <= table["spin"].high))
+        for j in np.flatnonzero(suspect).tolist():
+            ex, ey = patch_extent(ps[j], float(grid[j, 2]), float(grid[j, 3]))
+            why = plausibility.stream_problem(ex, ey, float(peak[j]), float(creep[j, 0]),
+                                              float(creep[j, 1]), float(creep[j, 2]))
+            if why is not None:
+                p.status[rows[j]] = CODE["implausible"]
+                p.detail[rows[j]] = f"implausible: {why}"
 
     # ---------------------------------------------------------------- state
 
