@@ -861,6 +861,26 @@ def test_bad_params_file_exits_before_work(tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.parametrize("text, words", [
+    ("fastsim:\n  ros__parameters:\n    friction_coeficient: 0.4\n",
+     "unknown parameter 'friction_coeficient' in section 'fastsim'; did you mean "
+     "'friction_coefficient'?"),
+    ("fastsim_node:\n  ros__parameters:\n    friction_coefficient: 0.4\n",
+     "no section for node '/fastsim': section 'fastsim_node' is for another node: this "
+     "node's section is 'fastsim' or a wildcard such as '/**'"),
+], ids=["typo", "another node's section"])
+def test_a_params_file_the_node_would_not_take_exits_before_work(tmp_path, capsys, text,
+                                                                 words):
+    """A typo or a section for another node name: what the node warns of, the replay refuses."""
+    params = tmp_path / "p.yaml"
+    params.write_text(text)
+    status, _, err = run([BAGS / "hertz_ramp", "-o", tmp_path / "out", "--params", params],
+                         capsys)
+    assert status == 2 and err.count("\n") == 1
+    assert f"{params}: {words}" in err, err
+    assert not (tmp_path / "out").exists()
+
+
 # ------------------------------------------------------------------------ golden files
 
 def write_golden(names=NAMES) -> None:
