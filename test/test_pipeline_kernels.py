@@ -125,7 +125,9 @@ def test_settings_reach_the_compiled_solve(settings):
 
 
 def test_reverse_running_and_a_moving_rail_equal_the_python_path():
-    fast, slow = pair(contacts=["left"])
+    # the roller case below slides the wheel at rest on a rail at 20 m/s (xi = 2: a full-slip
+    # test, which the plausibility rule takes only when marked intended)
+    fast, slow = pair(contacts=["left"], allow_implausible=True)
     # reverse running, yawed and spinning: every creepage nonzero
     twist((fast, slow), twist_msg((-20.0, 0.05, 0.0), (0.01, -20.0 / R * 1.001, 0.02),
                                   stamp_ns=T0))
