@@ -28,9 +28,7 @@ reads it with ``rosbags`` instead.
 from __future__ import annotations
 
 import io
-import json
 import os
-import re
 import struct
 import threading
 from collections.abc import Iterator
@@ -41,6 +39,7 @@ from zlib import crc32
 
 import numpy as np
 import zstandard
+import yaml
 from mcap import records as rec
 from mcap.data_stream import ReadDataStream, RecordBuilder
 from mcap.exceptions import McapError as LibraryError
@@ -703,63 +702,25 @@ def bag_metadata(path_name: str, channels: list[tuple[Channel, str, list[Any], s
     }}
 
 
-_PLAIN_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_.]*$")
+class _BlockDumper(yaml.CSafeDumper):
+    """PyYAML's safe dumper on libyaml's emitter, writing every repeated node out.
+
+    rosbag2's ``metadata.yaml`` has no anchors: the QoS profiles a writer
+    shares between topics are printed in full at each topic.
+    """
+
+    def ignore_aliases(self, data: Any) -> bool:
+        """Write a node shared by several parents in full at each (no ``&id``/``*id``)."""
+        return True
 
 
 def dump_yaml(data: Any) -> str:
     """Return ``data`` (dicts, lists, strings, integers, booleans, None) as block YAML.
 
-    Strings are double-quoted in JSON's escapes (valid YAML): rosbag2's and
-    rosbags' readers take it as they take rosbags' own ``metadata.yaml``.
-    A few lines of Python: PyYAML's representer (Python even with libyaml)
-    took longer than replaying a small bag.
+    PyYAML's safe representer on libyaml's C emitter (about 0.2 ms for a
+    bag's ``metadata.yaml``), keys in the dict's order, every nested
+    collection in block style, no aliases: rosbag2's and rosbags' readers
+    take it as they take rosbags' own ``metadata.yaml``.
     """
-    lines: list[str] = []
-    _emit(data, 0, lines)
-    return "\n".join(lines) + "\n"
-
-
-def _scalar(value: Any) -> str:
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):
-        return str(value)
-    if isinstance(value, float):
-        return repr(value)
-    return json.dumps(str(value))
-
-
-def _key(key: Any) -> str:
-    return key if isinstance(key, str) and _PLAIN_KEY.match(key) else json.dumps(str(key))
-
-
-def _emit(data: Any, indent: int, lines: list[str], first: str | None = None) -> None:
-    """Add ``data`` at ``indent``; ``first``: the prefix of its first line (a list's dash)."""
-    pad = " " * indent
-    if isinstance(data, dict) and data:
-        for k, (key, value) in enumerate(data.items()):
-            head = (first if k == 0 and first is not None else pad) + _key(key) + ":"
-            if isinstance(value, (dict, list)) and value:
-                lines.append(head)
-                _emit(value, indent + 2 if isinstance(value, dict) else indent, lines)
-            else:
-                lines.append(f"{head} {_inline(value)}")
-    elif isinstance(data, list) and data:
-        for k, value in enumerate(data):
-            dash = (first if k == 0 and first is not None else pad) + "- "
-            if isinstance(value, (dict, list)) and value:
-                _emit(value, indent + 2, lines, dash)
-            else:
-                lines.append(dash + _inline(value))
-    else:
-        lines.append((first if first is not None else pad) + _inline(data))
-
-
-def _inline(value: Any) -> str:
-    if isinstance(value, dict):
-        return "{}"
-    if isinstance(value, list):
-        return "[]"
-    return _scalar(value)
+    return str(yaml.dump(data, Dumper=_BlockDumper, sort_keys=False,
+                         default_flow_style=False, allow_unicode=True, width=1 << 30))
