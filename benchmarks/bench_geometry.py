@@ -44,7 +44,7 @@ sys.path.insert(0, str(ROOT))
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.placement import Pose  # noqa: E402
 from fastsim_ros.geometry.planar import planar_grid  # noqa: E402
-from fastsim_ros.machine import machine  # noqa: E402
+from machine import machine  # noqa: E402  (the one machine line of every benchmark)
 from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
 from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
 from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402

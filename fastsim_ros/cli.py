@@ -55,6 +55,7 @@ from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
                                         check_poisson_ratio)
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
+from fastsim_ros.errors import UsageError
 from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, FrictionLaw
 from fastsim_ros.params import SPECS
 
@@ -111,10 +112,6 @@ LIMITS = {
     "spin": (0.0, 1e6),           # |phi|, 1/m
     "a_over_b": (1e-3, 1e3),      # --a-over-b
 }
-
-
-class UsageError(Exception):
-    """A command line that cannot be run: reported in one line, exit status 2."""
 
 
 # argparse reads a token that starts with "-" as a flag unless it looks like a

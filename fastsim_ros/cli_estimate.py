@@ -47,6 +47,7 @@ import numpy as np
 from fastsim_ros import cli
 from fastsim_ros.contact.checks import BOUNDS
 from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.errors import UsageError
 
 #: the most samples a measured file may hold
 MAX_SAMPLES = 100_000
@@ -148,7 +149,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     exponential = args.friction_law == "exponential"
     if exponential:
         if args.speed is None:
-            raise cli.UsageError("--friction-law exponential requires --speed")
+            raise UsageError("--friction-law exponential requires --speed")
         cli._speed(args.speed)
         if not 0.0 < args.friction_limit_ratio <= 1.0:
             raise InvalidInputError("--friction-limit-ratio must lie in (0, 1], got "
@@ -164,8 +165,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     if args.method == "exact":
         from fastsim_ros.estimation.model import ExactSolver
         if args.bound != "given":
-            raise cli.UsageError("--method exact (the default) takes the pressure as given "
-                                 "(--bound given); --bound parabolic needs a fast method")
+            raise UsageError("--method exact (the default) takes the pressure as given "
+                             "(--bound given); --bound parabolic needs a fast method")
         if creepages.shape[0] > MAX_EXACT_SAMPLES:
             raise InvalidInputError(f"--method exact (the default) takes at most "
                                     f"{MAX_EXACT_SAMPLES} samples, got {creepages.shape[0]}: "

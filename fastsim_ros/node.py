@@ -58,6 +58,7 @@ from visualization_msgs.msg import MarkerArray
 from fastsim_ros import params as parameters
 from fastsim_ros import pipeline_kernels
 from fastsim_ros.contact import compiled
+from fastsim_ros.errors import ParameterError, StartupError
 from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
                                   WHEELSET_WRENCH_TOPIC, InputTopic, Outcome, PipelineConfig,
@@ -110,10 +111,6 @@ class ThrottledLog:
             message += f" (and {self.suppressed} more in the last {self._period:g} s)"
             self.suppressed = 0
         self._logger.warning(message)
-
-
-class StartupError(Exception):
-    """A configuration the node cannot start with: reported in one line, exit 2."""
 
 
 def descriptor(spec: parameters.ParameterSpec, *,
@@ -227,7 +224,7 @@ class _FrontEnd:
                 descriptor(source_spec, read_only=start_only_read_only)).value
         except (InvalidParameterValueException, InvalidParameterTypeException,
                 ParameterException) as e:
-            raise StartupError(_one_line(e, source_spec)) from None
+            raise StartupError(_parameter_problem(e, source_spec)) from None
         spec = source_spec
         try:
             for spec in parameters.PARAMETERS:
@@ -245,7 +242,7 @@ class _FrontEnd:
                     spec, read_only=start_only_read_only and not spec.dynamic))
         except (InvalidParameterValueException, InvalidParameterTypeException,
                 ParameterException) as e:
-            raise StartupError(_one_line(e, spec)) from None
+            raise StartupError(_parameter_problem(e, spec)) from None
 
     def _warn_unmatched(self, argv: Sequence[str] | None) -> None:
         """Log what of the launch's parameters no parameter of the node takes; start anyway.
@@ -295,7 +292,7 @@ class _FrontEnd:
                 # the mode's own contacts (profiles: fixed per wheel), not a declared default
                 del values["contacts"]
             config = PipelineConfig.from_values(values)
-        except parameters.ParameterError as e:
+        except ParameterError as e:
             raise StartupError(str(e)) from None
         warm = compiled.warm_up()
         start = time.perf_counter()
@@ -304,7 +301,7 @@ class _FrontEnd:
         self._warm = warm + time.perf_counter() - start
         try:  # profiles mode reads and places its profiles here (and builds its table)
             self.pipeline = make_pipeline(config, log=log)
-        except parameters.ParameterError as e:  # a profile file or placement: one line
+        except ParameterError as e:  # a profile file or placement: one line
             raise StartupError(str(e)) from None
         return config
 
@@ -555,11 +552,11 @@ class _FrontEnd:
                     f"parameter {p.name!r} is set at start only"))
             try:
                 values[p.name] = spec.check(p.value)
-            except parameters.ParameterError as e:
+            except ParameterError as e:
                 return SetParametersResult(successful=False, reason=str(e))
         try:
             self.pipeline.update(values)
-        except parameters.ParameterError as e:
+        except ParameterError as e:
             return SetParametersResult(successful=False, reason=str(e))
         node.get_logger().info("parameters set: " + ", ".join(
             f"{k} = {v!r}" for k, v in values.items()))
@@ -710,16 +707,16 @@ class FastsimLifecycleNode(_FrontEnd, LifecycleNode):
                                            reason=f"unknown parameter {p.name!r}")
             try:
                 spec.check(p.value)
-            except parameters.ParameterError as e:
+            except ParameterError as e:
                 return SetParametersResult(successful=False, reason=str(e))
             if p.name == "contacts":
                 self._contacts_given = True
         return SetParametersResult(successful=True)
 
 
-def _one_line(error: Exception, spec: parameters.ParameterSpec) -> str:
+def _parameter_problem(error: Exception, spec: parameters.ParameterSpec) -> str:
     """Return a start-up parameter error as one line naming the parameter and its range."""
-    if isinstance(error, parameters.ParameterError):
+    if isinstance(error, ParameterError):
         return str(error)
     return (f"parameter {spec.name!r}: {str(error).splitlines()[0]}; it must be "
             f"{spec.allowed()}")

@@ -18,6 +18,8 @@ from typing import Any
 
 import yaml
 
+from fastsim_ros.errors import ParameterError
+
 #: the methods of the library the node offers (INTERFACE.md: ``method``): the paper's
 #: MAE, the calibrated MAE (the default since docs/validation_wider.md shows it better
 #: than the paper's on every validation area) and FastSim on the equivalent ellipse
@@ -32,10 +34,6 @@ PATCH_SOURCES = ("topics", "profiles")
 #: the contacts of profiles mode, fixed per wheel: the patch nearer the tread, then a second
 PROFILE_CONTACTS = ("left", "right", "left_flange", "right_flange")
 _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
-
-
-class ParameterError(ValueError):
-    """A parameter value outside its type or range; the message names both."""
 
 
 @dataclass(frozen=True)
@@ -317,7 +315,7 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
-def _one_line(error: Exception) -> str:
+def _yaml_problem(error: Exception) -> str:
     """Return a file error as one line: YAML's where and what, without its quoted snippet."""
     if isinstance(error, yaml.MarkedYAMLError) and error.problem_mark is not None:
         mark = error.problem_mark
@@ -510,7 +508,7 @@ def load_params_file(path: Path, node_name: str = "fastsim",
         text = Path(path).read_text(encoding="utf-8")
         data = yaml.safe_load(text)
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as e:
-        raise ParameterError(f"{path}: cannot read parameters: {_one_line(e)}") from None
+        raise ParameterError(f"{path}: cannot read parameters: {_yaml_problem(e)}") from None
     if not isinstance(data, dict):
         raise ParameterError(f"{path}: not a ROS 2 parameter file")
     fqn = f"{namespace.rstrip('/')}/{node_name}"

@@ -42,6 +42,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
+from fastsim_ros.errors import ParameterError
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
 from fastsim_ros.estimation.model import model_error
 from fastsim_ros.contact import kernels as contact_kernels
@@ -543,7 +544,7 @@ class Pipeline:
         for name in ("contacts", "wheelset_frame", "shear_modulus", "poisson_ratio",
                      "friction_estimation"):
             if config[name] != self.config[name]:
-                raise parameters.ParameterError(f"parameter {name!r} is set at start only")
+                raise ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config, tuple(changes))
 
     def outputs(self) -> dict[str, str]:

@@ -33,7 +33,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
+from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import exact, samples  # noqa: E402
 from fastsim_ros.contact.coefficients import CreepCoefficients  # noqa: E402

@@ -55,7 +55,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
+from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros import cli  # noqa: E402
 from fastsim_ros.cli_wheelset import result_of, solve_pose, wheel_twist  # noqa: E402
 from fastsim_ros.geometry import benchmark  # noqa: E402

@@ -38,7 +38,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
+from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.contact import area as areas  # noqa: E402
 from fastsim_ros.contact import asm, dlm  # noqa: E402
 from fastsim_ros.contact.fastsim import sweep_integrals  # noqa: E402

@@ -53,7 +53,7 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,  #
                                           MaeSolver)
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.wheelset import Pose  # noqa: E402
-from fastsim_ros.machine import machine  # noqa: E402
+from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.params import load_params_file  # noqa: E402
 from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
 from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402

@@ -45,7 +45,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from fastsim_ros.machine import machine  # noqa: E402  (the one machine line)
+from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry import table as table_module  # noqa: E402

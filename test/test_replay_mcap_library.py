@@ -2,7 +2,7 @@
 
 Its output read back by the library with every CRC checked, the summary's
 CRC as the library's writer computes it, and malformed files refused as
-:class:`~fastsim_ros.replay.mcap.McapError` (never the library's or
+:class:`~fastsim_ros.replay.McapError` (never the library's or
 Python's own exceptions).
 """
 
@@ -22,6 +22,7 @@ sys.path.insert(0, str(ROOT))
 
 from fastsim_ros import replay  # noqa: E402
 from fastsim_ros.replay import bagio, mcap  # noqa: E402
+from fastsim_ros.replay.errors import McapError  # noqa: E402
 
 BAGS = ROOT / "bags"
 
@@ -66,7 +67,7 @@ def test_a_chunk_whose_records_fail_their_crc_is_refused(tmp_path, capsys):
     path.write_bytes(bytes(data))
     indexed = mcap.open_indexed(path)
     try:
-        with pytest.raises(mcap.McapError, match="checksum mismatch"):
+        with pytest.raises(McapError, match="checksum mismatch"):
             for _ in mcap.windows(indexed, lambda *args: None):
                 pass
     finally:
@@ -79,7 +80,7 @@ def test_a_summary_record_longer_than_the_file_is_refused(tmp_path):
     summary_start = struct.unpack_from("<Q", data, len(data) - 37 + 9)[0]
     struct.pack_into("<Q", data, summary_start + 1, 10 ** 12)
     path.write_bytes(bytes(data))
-    with pytest.raises(mcap.McapError, match="malformed summary"):
+    with pytest.raises(McapError, match="malformed summary"):
         mcap.open_indexed(path)
 
 
@@ -87,5 +88,5 @@ def test_a_summary_record_longer_than_the_file_is_refused(tmp_path):
 def test_not_mcap_is_refused(tmp_path, content):
     path = tmp_path / "x.mcap"
     path.write_bytes(content)
-    with pytest.raises(mcap.McapError):
+    with pytest.raises(McapError):
         mcap.open_indexed(path)

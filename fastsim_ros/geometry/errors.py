@@ -39,3 +39,11 @@ class NoContactError(GeometryError):
 
 class BalanceError(GeometryError):
     """No vertical position of a wheel carries its load (the balance did not converge)."""
+
+
+class TableError(GeometryError):
+    """A contact table cannot be built, read or used as asked."""
+
+
+class TableRangeError(TableError):
+    """A pose outside the table's grid (the node's ``out_of_table``)."""

@@ -75,7 +75,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
+from fastsim_ros.geometry.errors import (DerailmentError, GeometryError, NoContactError,
+                                         TableError, TableRangeError)
 from fastsim_ros.geometry.placement import Pose
 from fastsim_ros.geometry.wheelset import (MAX_PATCHES, MIN_PATCH_CELLS, SIDES, Side,
                                            WheelPatch, Wheelset)
@@ -120,14 +121,6 @@ NODE_SNAP = 1e-9
 #: the roll that levels both rigid wheels is solved to this height difference (m)
 ROLL_TOLERANCE = 1e-10
 ROLL_ITERATIONS = 60
-
-
-class TableError(GeometryError):
-    """A contact table cannot be built, read or used as asked."""
-
-
-class TableRangeError(TableError):
-    """A pose outside the table's grid (the node's ``out_of_table``)."""
 
 
 # ---------------------------------------------------------------------------- the roll

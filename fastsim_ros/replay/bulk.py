@@ -31,7 +31,7 @@ from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRE
 from fastsim_ros.profile_pipeline import AnyPipeline
 from fastsim_ros.replay import bagio, batch, encode, faults, kernels, mcap
 from fastsim_ros.replay.bagio import resolve
-from fastsim_ros.replay.errors import BadInput
+from fastsim_ros.replay.errors import BadInput, McapError
 from fastsim_ros.replay.results import Result
 
 Ints = NDArray[np.int64]
@@ -55,7 +55,7 @@ def open_indexed(source: Path, reader: Any) -> mcap.IndexedMcap | None:
         return None
     try:
         indexed = mcap.open_indexed(Path(getattr(files[0], "path")))
-    except (mcap.McapError, OSError) as e:
+    except (McapError, OSError) as e:
         raise BadInput(f"{source}: unreadable: {e}") from None
     if indexed is not None and not (indexed.chunks
                                     and all(c.index_offsets for c in indexed.chunks)):
@@ -239,7 +239,7 @@ class IndexedReplay:
                 if progress is not None:
                     progress(n)
                 t_read = time.perf_counter()
-        except mcap.McapError as e:
+        except McapError as e:
             raise BadInput(f"{self.source}: unreadable: {e}") from None
         if first is None:
             raise BadInput(f"{self.source}: empty bag (no messages)")

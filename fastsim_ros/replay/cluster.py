@@ -40,7 +40,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from fastsim_ros.replay.errors import problem
+from fastsim_ros.replay.errors import ClusterError, problem
 from fastsim_ros.replay.results import Result
 from fastsim_ros.replay.run import Task, run_task, warm_up
 
@@ -65,10 +65,6 @@ def connect_timeout() -> float:
 #: about 1.4 ms less CPU per task on this machine (bench_replay.py --scheduler)
 LEAN = {"DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED": "False",
         "DASK_DISTRIBUTED__SCHEDULER__WORK_STEALING": "False"}
-
-
-class ClusterError(Exception):
-    """The cluster cannot be reached, or was lost while replaying."""
 
 
 def warm_worker() -> str:

@@ -50,6 +50,7 @@ from mcap.writer import MCAP0_MAGIC
 from numpy.typing import NDArray
 
 from fastsim_ros.replay import kernels
+from fastsim_ros.replay.errors import McapError
 
 MAGIC = MCAP0_MAGIC
 #: uncompressed bytes of new messages after which a chunk is written (rosbags: 1 MiB)
@@ -61,10 +62,6 @@ _MESSAGE_HEAD = struct.Struct("<BQHIQQ")
 _TAIL = 9 + 20 + 8
 #: what a file's bytes or the library's parsers raise on a malformed file
 _MALFORMED = (LibraryError, ValueError, struct.error, EOFError)
-
-
-class McapError(Exception):
-    """A file that does not follow the MCAP format where the replay reads it."""
 
 
 @dataclass(frozen=True)
