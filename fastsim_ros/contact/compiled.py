@@ -42,6 +42,7 @@ from fastsim_ros.contact.equivalent import EquivalentEllipse
 from fastsim_ros.contact.errors import (ContactError, EmptyContactError, InvalidInputError,
                                         OutOfTableError)
 from fastsim_ros.contact.friction import ExponentialFriction, FrictionLaw, check_speed, resolve
+from fastsim_ros.contact.knee import knee_factors, knee_pack
 from fastsim_ros.contact.mae import MaeGeometry, Zone, ZoneFlexibility
 from fastsim_ros.contact.pairs import pair_factors
 from fastsim_ros.contact.rules import ellipse_grid
@@ -286,6 +287,8 @@ class MaeSolver(_Solver):
         # the pair factors (read by the calibrated method only; one argument type for both)
         self._pair_knots = np.zeros(2)
         self._pair_values = np.ones((4, 2, 2))
+        # the knee factors strip by strip (the calibrated method's option), else none
+        self._knee = k.NO_KNEE
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
                eta: float, phi: float, law: tuple[int, FloatArray, float, float],
@@ -298,8 +301,13 @@ class MaeSolver(_Solver):
                              float(phi), float(mu), float(reference[0]), float(reference[1]),
                              self._rule, _bound(bound), self.shear_modulus, self._knots,
                              self._polys, code, prm, speed, out[0], out[1], out[2], tractions,
-                             self._calibrated, self._pair_knots, self._pair_values)
+                             self._calibrated, self._pair_knots, self._pair_values,
+                             self._knee_for(bound))
         return self._forces(result, grid, out, tractions)
+
+    def _knee_for(self, bound: str) -> FloatArray:
+        """Return the packed knee table the solve applies (none with the parabolic bound)."""
+        return self._knee if bound == "given" else k.NO_KNEE
 
     def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
                     dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
@@ -323,7 +331,7 @@ class MaeSolver(_Solver):
                                           self._rule, _bound(bound), self.shear_modulus,
                                           self._knots, self._polys, code, prm, speeds, out,
                                           self._calibrated, self._pair_knots,
-                                          self._pair_values)
+                                          self._pair_values, self._knee_for(bound))
         if status:
             _raise(status, info, self._knots, f"batch item {index}: ")
         return out
@@ -367,13 +375,20 @@ class CalibratedMaeSolver(MaeSolver):
     on the patch's own cells and the rigid-slip return; ``nu``,
     ``shear_modulus`` (Pa) and ``rule`` as :class:`MaeSolver`, whose calls
     it has (``flexibility`` gives the calibrated ``L1 .. L4``).
+
+    ``knee``: FastSim's knee corrected strip by strip with the knee factors
+    of :mod:`fastsim_ros.contact.knee` (:func:`~fastsim_ros.contact.kernels.strip_knee`;
+    the given bound only; the steady solves, not the transient ones).
     """
 
     def __init__(self, nu: float, shear_modulus: float, *,
-                 rule: Rule = "auto") -> None:
+                 rule: Rule = "auto", knee: bool = False) -> None:
         super().__init__(nu, shear_modulus, rule=rule)
         pairs = pair_factors(self.nu)  # refuses nu outside the pair factors' range
         self._calibrated = True
+        self.knee = bool(knee)
+        if self.knee:
+            self._knee = knee_pack(knee_factors(self.nu))
         # private, writeable copies (the pair factors are read-only): the kernels' argument
         # types are then the paper's MAE's, one compiled specialisation for both
         self._pair_knots = np.array(pairs.knots, dtype=np.float64)

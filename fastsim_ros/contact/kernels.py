@@ -302,6 +302,10 @@ def law_ratio(law, prm, v):
 
 #: the previous traction state of a steady sweep: none (never read)
 _NO_STATE = np.zeros((0, 0))
+#: rows of :func:`rolling_sweep`'s ``strip_sums``
+STRIP_SUMS = 6
+#: no knee table (:func:`mae_sweep`)
+NO_KNEE = np.zeros(0)
 
 
 @njit(cache=True, error_model="numpy")
@@ -449,7 +453,7 @@ def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, rolled, nsub, s, v_
 
 @njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
-          law, prm, speed, out_x, out_y, slip, store, rigid):
+          law, prm, speed, out_x, out_y, slip, store, rigid, strip_sums=_NO_STATE):
     """March every strip from its leading edge; return ``(Fx, Fy, Mz, slipping, in contact)``.
 
     The steady state: :func:`rolling_sweep` with an infinite distance rolled
@@ -457,13 +461,13 @@ def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s
     """
     return rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c,
                          y_s, xp, yp, law, prm, speed, out_x, out_y, slip, store, rigid,
-                         _NO_STATE, _NO_STATE, math.inf, 0.0, 0.0, 1.0, 1.0)
+                         _NO_STATE, _NO_STATE, math.inf, 0.0, 0.0, 1.0, 1.0, strip_sums)
 
 
 @njit(cache=True, error_model="numpy")
 def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp,
                   yp, law, prm, speed, out_x, out_y, slip, store, rigid, prev_x, prev_y,
-                  rolled, shift_x, shift_y, relax_x, relax_y):
+                  rolled, shift_x, shift_y, relax_x, relax_y, strip_sums=_NO_STATE):
     """March every strip from its leading edge over one time step of rolling ``rolled`` (m).
 
     Kalker's non-steady FASTSIM (Kalker 1990, "Three-dimensional elastic
@@ -517,12 +521,24 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     (:func:`rigid_slip_return`, the reference's ``slip_rule="rigid_slip"``)
     instead of the radial return.
 
+    ``strip_sums`` ``(6, ny)``, if given (else an empty array): per strip the
+    sums over its cells of the traction ``tau_x``, ``tau_y`` (Pa), of ``x
+    tau_y - y tau_x`` about ``(xp, yp)`` (Pa m), of the steady march's
+    traction without a bound (the strip in full adhesion: Kalker's linear
+    force of FastSim) in ``x`` and ``y`` (Pa), and of the bound ``g`` (Pa);
+    times ``dx dy`` they are forces (:func:`strip_knee`).
+
     Like the reference, the march goes column by column with the strips side
     by side: the strips are independent, so the CPU overlaps their chains of
     dependent operations (a strip alone is a chain of square root, division
     and product per slipping cell, three times slower).
     """
     ny, nx = shape.shape
+    record = strip_sums.shape[0] == STRIP_SUMS
+    # the strips in full adhesion (record): the steady march's traction without a bound, and
+    # the sums of it and of the bound
+    lin = np.zeros((5, ny if record else 1))
+    ulx, uly, slx, sly, sgb = lin[0], lin[1], lin[2], lin[3], lin[4]
     da = dx * dy
     half = 0.5 * dx
     # per-strip state, constants and partial sums in one block (one allocation)
@@ -611,6 +627,17 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
             g = outer * (shape[j, i] * inner)
             if not g > 0.0:
                 continue
+            if record:
+                # the steady march without a bound, from the segment's front face
+                s_l = dx if cont[j] == i else half
+                if cont[j] != i:
+                    ulx[j] = 0.0
+                    uly[j] = 0.0
+                ulx[j] = ulx[j] - rate_x[j] * s_l
+                uly[j] = uly[j] - (rate_y0[j] + rate_yx[j] * (x_rel + 0.5 * s_l)) * s_l
+                slx[j] += ulx[j]
+                sly[j] += uly[j]
+                sgb[j] += g
             if cont[j] == i:
                 s = dx
                 t_x = tx[j]
@@ -778,7 +805,66 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
         fx += sx[j]
         fy += sy[j]
         mz += sm[j]
+        if record:
+            strip_sums[0, j] = sx[j]
+            strip_sums[1, j] = sy[j]
+            strip_sums[2, j] = sm[j]
+            strip_sums[3, j] = slx[j]
+            strip_sums[4, j] = sly[j]
+            strip_sums[5, j] = sgb[j]
     return fx * da, fy * da, mz * da, nslip, ncontact
+
+
+# ---------------------------------------------------------------- FastSim's knee, strip by strip
+
+
+@njit(cache=True, error_model="numpy")
+def knee_arrays(knee):
+    """Return ``(log_aspect, s, kappa)`` of a packed knee table (:func:`knee_pack`)."""
+    na = int(knee[0])
+    ns = int(knee[1])
+    kappa = knee[2 + na + ns:2 + na + ns + 2 * na * ns].reshape((2, na, ns))
+    return knee[2:2 + na], knee[2 + na:2 + na + ns], kappa
+
+
+@njit(cache=True, error_model="numpy")
+def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store):
+    """Return ``(Fx, Fy, Mz)`` (N, N, N m): each strip's force times its knee factor.
+
+    :mod:`fastsim_ros.contact.knee`, applied strip by strip: strip ``j``
+    with ``F_lin,j`` its force in full adhesion and ``g`` summed over it
+    (``mu N_j``) is at ``s_j = |F_lin,j| / (mu N_j)``, and its force and
+    moment (``strip_sums``, :func:`rolling_sweep`) are multiplied by
+    ``kappa(s_j, a/b, F_lin,x^2 / |F_lin|^2)`` of the packed table ``knee``
+    (:func:`knee_pack`) at ``log(a/b)`` = ``log_aspect`` (the patch's
+    equivalent ellipse).  On an ellipse every strip is at the patch's ``s``
+    (FastSim's strip force and load both go as the chord squared) and this
+    is the tabulated factor; on a patch of another shape each strip reads
+    the knee at its own share of the saturation.  With ``store`` the
+    strip's tractions ``out_x``, ``out_y`` (Pa) are scaled alike, so that
+    they sum to the forces.
+    """
+    la, sn, kap = knee_arrays(knee)
+    ny = strip_sums.shape[1]
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    for j in range(ny):
+        lx = strip_sums[3, j]
+        ly = strip_sums[4, j]
+        l2 = lx * lx + ly * ly
+        k = 1.0
+        if l2 > 0.0 and strip_sums[5, j] > 0.0:
+            k, _ = knee_interpolate(la, sn, kap, math.sqrt(l2) / strip_sums[5, j], log_aspect,
+                                    lx * lx / l2)
+        fx += k * strip_sums[0, j]
+        fy += k * strip_sums[1, j]
+        mz += k * strip_sums[2, j]
+        if store and k != 1.0:
+            for i in range(out_x.shape[1]):
+                out_x[j, i] *= k
+                out_y[j, i] *= k
+    return fx * da, fy * da, mz * da
 
 
 # ---------------------------------------------------------------- the slope in mu_s
@@ -1693,11 +1779,14 @@ def creepages_at_s(geo, xi, eta, phi, xp, yp):
 
 @njit(cache=True, error_model="numpy")
 def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, phi, xp, yp,
-              law, prm, speed, out_x, out_y, slip, store, rigid):
+              law, prm, speed, out_x, out_y, slip, store, rigid, knee=NO_KNEE):
     """MAE step 7: FastSim with each zone's ``L``'s, creepages moved to ``S = (x_c, y_s)``.
 
     The bound is ``mu p``, or with ``parabolic`` the finished ``bound`` (Pa);
-    ``rigid``: the calibrated method's rigid-slip return (:func:`sweep`).
+    ``rigid``: the calibrated method's rigid-slip return (:func:`sweep`);
+    ``knee``: a packed knee table (:func:`knee_pack`) to correct FastSim's
+    knee strip by strip (:func:`strip_knee`, at the patch's equivalent
+    ellipse's ``a/b``; the given bound only), or :data:`NO_KNEE`.
     """
     x_c = geo[G_XC]
     y_s = geo[G_YS]
@@ -1705,8 +1794,17 @@ def mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex, xi, eta, 
     if parabolic:
         return sweep(bound, 1.0, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s,
                      xp, yp, law, prm, speed, out_x, out_y, slip, store, rigid)
-    return sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
-                 law, prm, speed, out_x, out_y, slip, store, rigid)
+    if knee.shape[0] == 0:
+        return sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp,
+                     law, prm, speed, out_x, out_y, slip, store, rigid)
+    sums = np.empty((STRIP_SUMS, p.shape[0]))
+    _, _, _, nslip, ncontact = sweep(p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex,
+                                     x_c, y_s, xp, yp, law, prm, speed, out_x, out_y, slip,
+                                     store, rigid, sums)
+    fx, fy, mz = strip_knee(sums, dx * dy, knee,
+                            math.log(geo[G_ELLIPSE + 2] / geo[G_ELLIPSE + 3]), out_x, out_y,
+                            store)
+    return fx, fy, mz, nslip, ncontact
 
 
 @njit(cache=True, error_model="numpy")
@@ -1742,7 +1840,7 @@ def mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic, shea
 @njit(cache=True, error_model="numpy")
 def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
               shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store,
-              calibrated, pair_knots, pair_values):
+              calibrated, pair_knots, pair_values, knee=NO_KNEE):
     """Solve MAE + FastSim on one patch (:func:`fastsim_ros.contact.mae.mae_fastsim`).
 
     ``p`` (Pa) on the grid ``x0, y0, dx, dy`` (m); creepages ``xi``, ``eta``
@@ -1753,6 +1851,7 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
     (:func:`fastsim_ros.contact.mae_calibrated.mae_calibrated_fastsim`) with
     the pair factors ``pair_values`` ``(4, n, n)`` on the nodes
     ``pair_knots`` (``log(a/b)``); else the paper's (those arrays unread).
+    ``knee``: :func:`mae_sweep`'s.
     """
     status, info, geo, env, flex, bound = mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp,
                                                     rule, parabolic, shear_modulus, knots,
@@ -1761,7 +1860,7 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
     fx, fy, mz, nslip, _ = mae_sweep(p, mu, parabolic, bound, env, x0, y0, dx, dy, geo, flex,
                                      xi, eta, phi, xp, yp, law, prm, speed, out_x, out_y,
-                                     slip, store, calibrated)
+                                     slip, store, calibrated, knee)
     return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT])
 
 
@@ -1849,7 +1948,8 @@ def _same_patch(b, pb, prev_pb, x0, y0, dx, dy):
 
 @njit(cache=True, error_model="numpy")
 def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modulus,
-              knots, polys, law, prm, speed, out, calibrated, pair_knots, pair_values):
+              knots, polys, law, prm, speed, out, calibrated, pair_knots, pair_values,
+              knee=NO_KNEE):
     """MAE + FastSim on a batch; write ``Fx, Fy, Mz`` (N, N, N m) of item ``b`` to ``out[b]``.
 
     ``ps`` ``(P, ny, nx)`` (Pa) with ``P`` = batch size, or ``P = 1`` for one
@@ -1859,7 +1959,7 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
     geometry, look-ups and bound are redone only when the patch (or, for the
     parabolic bound, ``mu``) changes from one item to the next.  Return
     ``(status, index of the failing item, info)``; stops at the first error.
-    ``calibrated``, ``pair_knots``, ``pair_values``: as :func:`mae_solve`.
+    ``calibrated``, ``pair_knots``, ``pair_values``, ``knee``: as :func:`mae_solve`.
     """
     nb = creep.shape[0]
     ny, nx = ps.shape[1], ps.shape[2]
@@ -1890,7 +1990,8 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
         prev_pb = pb
         fx, fy, mz, _, _ = mae_sweep(p, mu[b], parabolic, bound, env, x0[b], y0[b], dx[b],
                                      dy[b], geo, flex, xi, eta, phi, xp, yp, law, prm,
-                                     speed[b], empty_f, empty_f, empty_b, False, calibrated)
+                                     speed[b], empty_f, empty_f, empty_b, False, calibrated,
+                                     knee)
         out[b, 0] = fx
         out[b, 1] = fy
         out[b, 2] = mz

@@ -205,6 +205,18 @@ def interpolate(log_aspect: FloatArray, s_nodes: FloatArray, kappa: FloatArray, 
     return k, dk
 
 
+def knee_pack(factors: KneeFactors) -> FloatArray:
+    """Return the table as one array for the kernels: ``na, ns``, the nodes, then ``kappa``.
+
+    ``[na, ns, log_aspect (na), s (ns), kappa (2 * na * ns, C order)]``
+    (:func:`fastsim_ros.contact.kernels.knee_arrays` unpacks it).
+    """
+    na = factors.log_aspect.shape[0]
+    ns = factors.s.shape[0]
+    return np.concatenate([np.array([na, ns], dtype=np.float64), factors.log_aspect,
+                           factors.s, np.ascontiguousarray(factors.kappa).ravel()])
+
+
 def _read() -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Return the file's nodes ``nu``, ``a/b``, ``s`` and ``kappa[nu, dir, a/b, s]``."""
     try:
