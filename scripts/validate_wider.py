@@ -394,7 +394,7 @@ def coefficient_grid_check(names: list[str]) -> dict[str, Any]:
 
 
 def cost_ratio(calls: int = 3000) -> dict[str, Any]:
-    """Time the calibrated and the paper's MAE side by side on 30x30 patches (TARGETS.md).
+    """Time the calibrated and the paper's MAE side by side on 30x30 patches.
 
     ``benchmarks/bench_fastsim.py``'s patches (two semi-ellipses 0.5/2 of 1 cm^2 and a
     Hertzian 6 x 4 mm ellipse, 50 kN), creepages and interleaved timing (``per_call``);
@@ -591,7 +591,7 @@ def report(res: dict[str, Any]) -> None:
     # ------------------------------------------------------------------ coefficients
     add("## 2. Linear-range coefficients\n")
     add(f"nu = {NU}, about each area's origin. Exact: full adhesion extrapolated to zero cell"
-        f" size over n = {EXACT_GRIDS} (fit C0 + k/n, METHOD.md 5; error = change without the"
+        f" size over n = {EXACT_GRIDS} (fit C0 + k/n; error = change without the"
         f" coarsest grid). Methods at vanishing creepage on {ONLINE_CELLS} cells: MAE +"
         " FastSim, FaStrip and equivalent-ellipse FastSim. Deviation from exact in %; C13 (a"
         " coupling that crosses zero) in % of C11.\n")
@@ -707,10 +707,10 @@ def _curve_excess(e: dict[str, Any], m: str, base: str) -> tuple[float, str]:
 
 
 def _beyond(add: Callable[[str], None], res: dict[str, Any]) -> None:
-    """Write section 6: the calibrated MAE on areas outside its selection (issue 22)."""
+    """Write section 6: the calibrated MAE on areas outside its selection."""
     d = res["areas"]
     m = "mae_calibrated"
-    add("## 6. The calibrated MAE beyond its selection (issue 22)\n")
+    add("## 6. The calibrated MAE beyond its selection\n")
     fresh = [n for n in BEYOND if n not in SEEN]
     add(f"{len(BEYOND)} areas made after the calibrated MAE's rules were fixed (`BEYOND` in"
         " the script): eggs with the longer half trailing and leading, crescents of other"
@@ -897,7 +897,7 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
     d = res["areas"]
     m = "mae_calibrated"
     add("## 0. The calibrated MAE and its targets\n")
-    add("The paper's MAE (METHOD.md 3) stays as it is (`mae`); the calibrated MAE keeps its"
+    add("The paper's MAE stays as it is (`mae`); the calibrated MAE keeps its"
         " steps 1-3 (centroid, split, each zone likened to a semi-ellipse) and changes what"
         " the validation below shows off, each by a rule from the exact theory"
         " (`fastsim_ros/contact/mae_calibrated.py` states each with its evidence):\n")
@@ -921,7 +921,7 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
         " centroid (the strips' centres fitted as `alpha + beta l + kappa l^2` in the"
         " half-chord `l`, the `kappa` part counted: a crescent's offsets count, an egg's,"
         " proportional to the chord, do not; no parameter fitted). The first form (every"
-        " offset counted) was 26% high in C~23 on an egg whose longer half trails (issue 22);"
+        " offset counted) was 26% high in C~23 on an egg whose longer half trails;"
         " section 6 shows the selection of the second form and the rules' check beyond their"
         " selection.\n")
     non_ell = [n for n in d if not n.startswith("ellipse")]
@@ -937,7 +937,7 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
                               - (curve_error(d[hertz], c, "mae") or 0.0)), c) for c in CURVES)
     worst_coef = max(((abs(_c_error(d[n], m, key)), n, key) for n in d
                       for key in ("C11", "C22", "C23")))
-    add("| target (issue 12, TARGETS.md) | measured | |")
+    add("| target | measured | |")
     add("| --- | --- | --- |")
     add(f"| force-creepage curves within 10% of mu N where the exact force exceeds 5% of mu N,"
         f" every area | worst {100 * worst[m][0]:.1f}% ({worst[m][1]}) |"
@@ -990,11 +990,10 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
         + (" (every one)" if len(better) == len(d) else
            f" (not on {', '.join(n for n in d if n not in better)})")
         + ", and smaller than every other method's worst case over all areas: so"
-        + (" `mae_calibrated` is the default of the node (and of `fastsim_contact wheelset`;"
-           " `fastsim_contact forces` keeps the paper's `mae`, the default INTERFACE.md fixes"
-           " for that command)"
-           " (INTERFACE.md: the default changes when the report shows another method better"
-           " on every area)." if len(better) == len(d) else " the default stays `mae`.")
+        + (" `mae_calibrated` is the default of the node and of `fastsim_contact forces` and"
+           " `wheelset` (a method becomes the default when this report shows it better than"
+           " the paper's MAE on every area)." if len(better) == len(d)
+           else " the default stays `mae`.")
         + " The table that decides it (worst curve error per area, % of mu N):\n")
     add("| area | " + " | ".join(LABELS[k] for k in METHODS) + " |")
     add("| --- | " + " | ".join("---" for _ in METHODS) + " |")

@@ -112,7 +112,7 @@ def slip_ratio(m: FloatArray, level: FloatArray, q: FloatArray,
     radial return onto ``k g_s``, whose slip per unit rolling distance
     follows from the traction increment, ``s = w + L (tau_k - tau_prev)/h =
     L (tau_k - t*)/h`` (componentwise ``L = (L1, L2)``), ``|s| = (m - k g_s)
-    |L t*| / (m h)``, so the slip velocity is
+    |L t*| / (m h)``, so the slip velocity is::
 
         v = |V| |s| = q (m - k g_s),    q = |V| |L t*| / (m h)  (m/(s Pa)),
 

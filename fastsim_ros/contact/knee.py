@@ -11,7 +11,7 @@ up to 1.6% of ``mu N`` above the exact one in the early partial slip and
 up to 6.6% below it at the knee (``docs/validation_estimation.md``).
 
 Both curves are functions of one variable on an ellipse: the creepage
-normalised by its saturation value,
+normalised by its saturation value::
 
     s = |F_lin| / (mu_s N),
 
@@ -20,7 +20,7 @@ FastSim's flexibilities reproduce: :func:`linear_force`), ``mu_s`` the static
 coefficient, ``N`` the load.  FastSim's curve ``|F| / (mu N)`` against ``s``
 is the same on every ellipse (its flexibilities make it so); the exact one
 moves with the ellipse's ``a/b``, the creepage's direction and ``nu`` by
-about a point of ``mu N`` at the knee.  So the *knee factor*
+about a point of ``mu N`` at the knee.  So the *knee factor*::
 
     kappa(s, a/b, direction, nu) = |F_exact| / |F_fastsim|   at the same s
 
