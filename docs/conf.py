@@ -43,6 +43,9 @@ autodoc_default_options = {"members": True, "undoc-members": False}
 autodoc_typehints = "none"
 autodoc_member_order = "bysource"
 
+# Straight quotes: the pages quote code, parameter values and messages verbatim.
+smartquotes = False
+
 html_theme = "alabaster"
 html_static_path: list[str] = []
 html_title = "fastsim_ros"
