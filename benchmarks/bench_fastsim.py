@@ -17,7 +17,7 @@ each call, after a warm-up; the three compiled calls interleaved in blocks):
 - the numpy reference ``mae_fastsim`` (with its traction bound; fewer calls),
 - ``EquivalentEllipseSolver.solve`` (the baseline, same patch),
 - ``CalibratedMaeSolver.solve`` (the second MAE method, same patch; the
-  target is at most 1.5x ``MaeSolver.solve``, TARGETS.md),
+  target is at most 1.5x ``MaeSolver.solve``),
 - ``TransientSolver.step`` on the calibrated MAE (transient rolling: the
   traction carried from the last step, which rolled two cells; the issue's
   target is at most 1.5x the steady ``CalibratedMaeSolver.solve``),

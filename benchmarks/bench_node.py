@@ -388,7 +388,7 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
                   node_args: list[str], bound: bool = False) -> None:
     """Run the node and the floor alternately ``rounds`` times; print medians and ratios.
 
-    TARGETS.md (4 x 1 kHz): received share within 0.2 points of the floor's,
+    The target (4 x 1 kHz): received share within 0.2 points of the floor's,
     p99 at most 2x the floor's, CPU at most 1.5x the floor's.  ``bound``:
     the floor that also solves a fixed patch per patch (``dds_floor.py
     --solve``) runs in the rotation too: what the solve alone adds.

@@ -1,6 +1,6 @@
 """The one machine line every benchmark and validation script prints beside its figures.
 
-A figure means little without the machine it was measured on (TARGETS.md):
+A figure means little without the machine it was measured on:
 platform, CPU model, cores (and how many this process may use), the load
 average when the line was taken (a shared machine slows runs), Python,
 numpy and numba (where installed).

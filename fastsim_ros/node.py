@@ -1,7 +1,6 @@
 """``fastsim_node``: the ROS 2 node (default name ``fastsim``), a thin front end of the pipeline.
 
-Topics, frames and parameters: INTERFACE.md (and the README's "Running the
-node").  The node declares every parameter of :mod:`fastsim_ros.params`
+Topics, frames and parameters: docs/guide_node.md.  The node declares every parameter of :mod:`fastsim_ros.params`
 with its descriptor and range, builds one :class:`~fastsim_ros.pipeline.Pipeline`
 and wires topics to it: it subscribes to every input of the pipeline's one
 table (:meth:`~fastsim_ros.pipeline.Pipeline.inputs`: a topic, its type and
@@ -189,7 +188,7 @@ class _FrontEnd:
 
         rclpy refuses a value of another type before any callback of ours
         runs, with "Wrong parameter type, expected ... got ..." alone;
-        INTERFACE.md wants every refusal to name the parameter and its range.
+        every refusal names the parameter and its range (docs/guide_node.md).
         The reason keeps rclpy's words first (rclpy maps them to its type
         exception) and adds the parameter's name and what it takes.
         """
@@ -235,7 +234,7 @@ class _FrontEnd:
                     continue
                 default: Any = spec.default
                 if spec.name == "contacts":
-                    # INTERFACE.md: in profiles mode the contacts are fixed per wheel, so
+                    # in profiles mode the contacts are fixed per wheel, so
                     # they are the default there and any other value is refused
                     default = list(parameters.PROFILE_CONTACTS if source == "profiles"
                                    else spec.default)
@@ -333,7 +332,7 @@ class _FrontEnd:
             outputs[FRICTION_ESTIMATE_TOPIC] = Vector3Stamped
         if isinstance(self.pipeline, ProfilePipeline):
             # profiles mode computes the patches and publishes them, so that a recording
-            # replays in either mode (INTERFACE.md)
+            # replays in either mode
             outputs.update({patch_topic(c): PointCloud2 for c in config.contacts})
         for topic, msgtype in outputs.items():
             self._pubs[topic] = node.create_publisher(
@@ -585,7 +584,7 @@ def _destroyed_on_failure(node: Node) -> Iterator[None]:
 
 
 class FastsimNode(_FrontEnd, Node):
-    """Creep forces for every contact patch received (INTERFACE.md).
+    """Creep forces for every contact patch received.
 
     ``argv``: the process's arguments, whose ``--params-file`` files are
     checked for sections and names the node does not take (a warning).

@@ -171,7 +171,8 @@ def _as_dict(c: CreepCoefficients) -> dict[str, float]:
 def _notch_carry_over() -> dict[str, float]:
     """C11 of the notched ellipse: exact, FastSim restarting behind the notch, and carrying on.
 
-    METHOD.md 2 pins the restart (each strip segment starts from zero traction);
+    FastSim's fixed discretisation (docs/guide_physics.md) has the restart (each strip
+    segment starts from zero traction);
     the variant keeps integrating the adhesion traction across the notch to
     show how much of MAE + FastSim's shortfall there the restart accounts for.
     """
@@ -605,7 +606,8 @@ def _report_coefficients(add: Callable[[str], None]) -> None:
     if notch:
         add("The notched ellipse is where MAE + FastSim falls short although MAE's own"
             " coefficients are right: FastSim restarts each strip segment from zero traction"
-            " behind the notch (FastSim's fixed discretisation: each segment starts from its own leading edge). On the same 60-cell grid C11 is"
+            " behind the notch (FastSim's fixed discretisation: each segment starts from its"
+            " own leading edge). On the same 60-cell grid C11 is"
             f" {notch['exact_same_grid']:.3f} exact, {notch['restart']:.3f} with the restart"
             f" ({_pct(notch['restart'] / notch['exact_same_grid'] - 1)}) and"
             f" {notch['carry_over']:.3f} if the adhesion traction carried on across the notch"

@@ -16,7 +16,7 @@ For each area: force-creepage curves under ``xi``, ``eta``, ``phi`` and
 combined (the levels of ``scripts/validate.py``) from the exact theory
 (Coulomb friction, given pressure) and the four online methods on one
 grid; the linear-range ``C~11, C~22, C~23`` (exact: extrapolated over four
-grids, METHOD.md 5; the methods on 60 cells); the cost per solve; and a grid
+grids, docs/guide_physics.md; the methods on 60 cells); the cost per solve; and a grid
 check of the curves on a finer grid for two areas.  Besides, the selection
 areas (pairs of semi-ellipses other than the validation's and two
 notches: neither validation areas nor the pair-factor table's own) on which the calibrated MAE's
@@ -236,7 +236,7 @@ def coefficients_of(make: AreaMaker) -> dict[str, Any]:
     out: dict[str, Any] = {"exact": _extrapolated(make)}
     calibrated: Callable[[Any, Any], Any] = (
         lambda a, tab: mae_calibrated_coefficients(a, tab, pairs))
-    # MAE's own coefficients (METHOD.md 3.5, eq. 7 with the zones' semi-ellipses, no FastSim):
+    # MAE's own coefficients (the physics guide, eq. 7 with the zones' semi-ellipses, no FastSim):
     # what the calibrated method's rules 2 and 3 leave as they are
     own: Callable[[Any, Any], Any] = lambda a, tab: mae_coefficients(mae_geometry(a), tab)
     for m, f in (("mae_calibrated", calibrated), ("mae", mae_fastsim_coefficients),
@@ -723,7 +723,7 @@ def _beyond(add: Callable[[str], None], res: dict[str, Any]) -> None:
         " a bend only where its horns lead, and two more crescents with trailing horns were"
         " made after the change to check it: that one area is the change's fit data, the"
         f" other {len(fresh)} were never looked at while choosing any rule. Targets"
-        " (issue 22, TARGETS.md): curves within 10% of mu N where the exact force exceeds 5%"
+        ": curves within 10% of mu N where the exact force exceeds 5%"
         " of mu N; C~23 within 5% of exact, or 0.05 where it is near zero (below 1); no curve"
         " worse than the paper's MAE's by more than 1 point of mu N.\n")
     add("| area | worst curve, calibrated / paper's MAE | largest excess over the paper's MAE"

@@ -1,4 +1,4 @@
-"""``fastsim_contact`` on any file and any flag (INTERFACE.md "Bad input", TARGETS.md robustness).
+"""``fastsim_contact`` on any file and any flag (docs/guide_node.md, robustness).
 
 The contract: a right answer, or one line on stderr naming the problem and exit
 status 2; never a traceback, never a non-finite number printed, no warning on
@@ -548,7 +548,7 @@ def test_an_answer_that_cannot_be_written_is_one_line(tmp_path):
 
 
 def test_exact_forces_on_a_shape_are_extrapolated_within_one_percent(capsys):
-    """INTERFACE.md: exact's default grid converged within 1%; on 60 cells alone Fy was 1.7% off.
+    """Exact's default grid converges within 1%; on 60 cells alone Fy is 1.7% off.
 
     An ellipse under spin (the audit's case): the default answer, extrapolated
     from 30 and 60 cells, against the extrapolation from 60 and 120.

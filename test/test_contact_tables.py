@@ -59,7 +59,7 @@ def test_every_published_entry_within_one_percent_or_shown_converged():
             if abs(mine - pub) <= max(0.01 * pub, rounding(pub)):
                 continue
             misses.append((key, name, pub, mine))
-            # METHOD.md 6: at the long end the published values may be ~1% low; such an
+            # docs/guide_physics.md: at the long end the published values may be ~1% low; such an
             # entry must be converged on two cell shapes that agree with each other.
             shapes = checked.get((float(row["a_over_b"]), float(row["nu"])))
             assert shapes is not None and len(shapes) == 2, (key, name, pub, mine)

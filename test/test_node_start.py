@@ -257,7 +257,7 @@ def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
 
 
 def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range():
-    """INTERFACE.md: a bad value is refused naming the parameter and the allowed range.
+    """A bad value is refused naming the parameter and the allowed range.
 
     rclpy refuses a value of another type before the node's callbacks see
     it, with "Wrong parameter type ..." alone; the reason now goes on with

@@ -15,7 +15,7 @@ it.  As the issue reads the paper (the paper's own text was not at hand):
 - full adhesion is imposed at two points per strip on its centre line, at
   ``s = ASM_COLLOCATION`` (fractions of its length from the leading edge):
   ``du/dx = w`` for both components, the displacement difference of the
-  Boussinesq-Cerruti half-spaces (as the exact theory's, METHOD.md 5) of all
+  Boussinesq-Cerruti half-spaces (as the exact theory's, docs/guide_physics.md) of all
   strips' tractions; four equations per strip, one dense linear system;
 - the two points are placed to minimise the error on ellipses (against
   Kalker's coefficients, nu = 0.25; ``scripts/validate_seed.py`` fits them on

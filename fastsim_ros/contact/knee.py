@@ -92,7 +92,7 @@ def linear_force(a: float, b: float, l1: float, l2: float, l3: float, xi: float,
     """Return ``(F_x, F_y)`` (N): Kalker's linear force with the creepages' sign.
 
     An ellipse of semi-axes ``a`` (along x), ``b`` (m) with Kalker's
-    flexibilities ``l1, l2, l3`` (m/Pa, METHOD.md 2: ``L1 = 8 a / (3 G
+    flexibilities ``l1, l2, l3`` (m/Pa, docs/guide_physics.md "FastSim": ``L1 = 8 a / (3 G
     C11)``, ``L2 = 8 a / (3 G C22)``, ``L3 = pi a sqrt(a/b) / (4 G C23)``)
     under ``xi``, ``eta`` (1) at its centre and spin ``phi`` (1/m):
     ``G a b (C11 xi, C22 eta) + G (ab)^1.5 C23 (0, phi)`` (Kalker's
