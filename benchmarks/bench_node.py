@@ -294,8 +294,8 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
         # (measured: a fresh clone whose cache was filled elsewhere gave up at 30 s)
         if time.monotonic() - start > START_TIMEOUT or proc.poll() is not None:
             status = proc.poll()
-            # stop it before giving up: a target left running kept its DDS domain busy
-            # (a test run that drew the same domain later saw its /diagnostics publisher)
+            # stop it before giving up: a target left running keeps its DDS domain busy
+            # (a test run that draws the same domain later sees its /diagnostics publisher)
             proc.terminate()
             try:
                 proc.wait(10)

@@ -250,7 +250,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_allow_implausible(fo)
     from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
     cli_wheelset.add_parser(sub, _finite)
-    from fastsim_ros import cli_estimate  # the friction fit too (issue 28)
+    from fastsim_ros import cli_estimate  # the friction fit lives in its own module too
     cli_estimate.add_parser(sub, _finite)
     return parser
 

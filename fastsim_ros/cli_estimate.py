@@ -1,4 +1,4 @@
-"""``fastsim_contact estimate``: fit a friction law to a measured creep curve (issue 28).
+"""``fastsim_contact estimate``: fit a friction law to a measured creep curve.
 
 ``--measured FILE.csv`` (header ``xi,eta,phi,Fx`` or ``xi,eta,phi,Fx,Fy``;
 creepages in 1, 1, 1/m about the area's origin, forces of the rail on the

@@ -1,8 +1,9 @@
 """``fastsim_node``: the ROS 2 node (default name ``fastsim``), a thin front end of the pipeline.
 
-Topics, frames and parameters: docs/guide_node.md.  The node declares every parameter of :mod:`fastsim_ros.params`
-with its descriptor and range, builds one :class:`~fastsim_ros.pipeline.Pipeline`
-and wires topics to it: it subscribes to every input of the pipeline's one
+Topics, frames and parameters: docs/guide_node.md.  The node declares every
+parameter of :mod:`fastsim_ros.params` with its descriptor and range,
+builds one :class:`~fastsim_ros.pipeline.Pipeline` and wires topics to it:
+it subscribes to every input of the pipeline's one
 table (:meth:`~fastsim_ros.pipeline.Pipeline.inputs`: a topic, its type and
 its handler; a new input is added there) and publishes the outcomes each
 handler returns.  The hot path is lean on purpose: inputs arrive raw (CDR
@@ -821,10 +822,10 @@ def _run_node(make: Callable[..., Node], program: str, args: Sequence[str] | Non
     finally:
         if executor is not None:
             # the node's entities out of the executor, and it shut down, before they go:
-            # the events executor aborted the process ("Destroying callback manager with
-            # callbacks remaining", exit -6) when a SIGTERM just after start-up left it to
-            # the garbage collector with the node's callbacks still registered (1 stop
-            # in 40 at about 1.1 s)
+            # the events executor aborts the process ("Destroying callback manager with
+            # callbacks remaining", exit -6) when a SIGTERM just after start-up leaves it
+            # to the garbage collector with the node's callbacks still registered
+            # (test_node.py: test_sigterm_and_sigint_end_cleanly)
             if node is not None:
                 with contextlib.suppress(Exception):
                     executor.remove_node(node)

@@ -162,7 +162,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_decay", "double", 0.0,
                   "B (s/m) of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
                   low=0.0, high=1.0e4, dynamic=True),
-    # --- online friction estimation (issue 28; fastsim_ros/estimation/ekf.py)
+    # --- online friction estimation (fastsim_ros/estimation/ekf.py)
     ParameterSpec("friction_estimation", "string", "off",
                   "estimate mu_s online from wheelset/measured_wrench (force.x, wheelset "
                   "frame) with an extended Kalman filter whose measurement model is the "

@@ -368,7 +368,7 @@ def _builder(cls: type) -> Callable[..., Any]:
     """
     names = [f.name for f in fields(cls)]
     assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
-    # a field with a plain default may be left out (Outcome.friction, added later)
+    # a field with a plain default may be left out (Outcome.friction: only when estimating)
     defaults = {f.name: f.default for f in fields(cls) if f.default is not MISSING}
     args = ", ".join(f"{n}=default_{n}" if n in defaults else n for n in names)
     body = "".join(f"    set_{n}(o, {n})\n" for n in names)
@@ -482,7 +482,7 @@ class Pipeline:
     def _use_mu(self, mu: float, config: PipelineConfig) -> None:
         """Solve with the static coefficient ``mu`` (the parameter's, or the estimate)."""
         self._mu = mu
-        # None: constant friction, the call of old (speed unused); else the law, run at |V|
+        # None: constant friction (Coulomb's law, speed unused); else the law, run at |V|
         law = friction_law(str(config["friction_law"]), self._mu,
                            limit_ratio=float(config["friction_limit_ratio"]),
                            decay=float(config["friction_decay"]))

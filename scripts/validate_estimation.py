@@ -1,4 +1,4 @@
-"""Validation of online friction estimation (issue 28): a rig run from the exact theory.
+"""Validation of online friction estimation: a rig run from the exact theory.
 
 A rig's run, synthesised: a Hertzian ellipse (a = 6 mm, b = 4 mm, N = 50 kN,
 20 x 20 cells), rolling speed 20 m/s, 200 Hz for 6 s; the true friction

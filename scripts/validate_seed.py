@@ -2,7 +2,7 @@
 """The seed paper's comparison redone: DLM (Table 1, Figures 4-5) and ASM (Table 2, Figure 6).
 
 Writes ``docs/data/validation_seed.json``, ``docs/figures/seed_*.png`` and
-``docs/validation_seed.md`` (issue 22, parts 1-3): Kalker's deformation
+``docs/validation_seed.md``: Kalker's deformation
 levelling method (:mod:`fastsim_ros.contact.dlm`) and Knothe and Hung's
 asymptotic strip method (:mod:`fastsim_ros.contact.asm`) beside the paper's
 numbers (Tables 1 and 2 read from ``shared/reference/seed_tables_1_2.md``),
@@ -352,7 +352,7 @@ def candidates_part() -> dict[str, Any]:
 
 
 def _meets(n: str, got: float, printed: float) -> bool:
-    """Return whether ``got`` meets the issue's target against a printed ASM value."""
+    """Return whether ``got`` meets the target against a printed ASM value."""
     e = abs(got / printed - 1.0)
     return e <= 0.02 if n != "C23" else (e <= 0.03 or abs(got - printed) <= 0.02)
 

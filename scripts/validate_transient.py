@@ -13,7 +13,7 @@ the converged one), is sampled at the fast methods' steps.  The table gives,
 per step response, the largest gap between a fast method's ``F/(mu N)`` and
 the exact transient one over the steps, beside the same method's steady
 error (its steady answer against the exact steady one, converged alike), and
-the criterion of issue 29: the transient gap within the steady error plus
+the criterion: the transient gap within the steady error plus
 0.02.
 """
 

@@ -2,12 +2,12 @@
 """Wider validation: exact vs the calibrated and the paper's MAE, FaStrip and the ellipse.
 
 Writes ``docs/data/validation_wider.json``, ``docs/figures/wider_*.png`` and
-``docs/validation_wider.md`` (issue 12, first part; issue 22).  The areas: the nine of
+``docs/validation_wider.md``.  The areas: the nine of
 ``scripts/validate.py`` (the Hertzian ellipse, FastSim's own floor, and the
 eight non-elliptical ones), the new ones of :mod:`fastsim_ros.contact.samples`:
 a long narrow patch, a crescent, an egg and normal-solver patches on a
 profile gap at three lateral shifts from the tread to the flange root, and
-issue 22's nine beyond the calibrated MAE's selection (``BEYOND``: eggs,
+nine areas beyond the calibrated MAE's selection (``BEYOND``: eggs,
 crescents, asymmetric lobes, flat bands).  Methods: the calibrated MAE, the
 paper's MAE, FaStrip, the equivalent ellipse, DLM and ASM; the calibrated MAE
 also without each of its rules (the leave-one-out check).
@@ -97,7 +97,7 @@ BASELINES = ("mae", "fastrip", "ellipse")
 #: bar offsets of the methods in the figures
 BAR = 0.13
 NEW = ("long narrow", "crescent", "egg")
-#: issue 22's areas beyond the calibrated MAE's selection (made after its rules were fixed,
+#: the areas beyond the calibrated MAE's selection (made after its rules were fixed,
 #: never looked at while choosing them): eggs with the longer half trailing and leading,
 #: crescents of other bends and widths (horns leading and trailing), asymmetric lobes, flat
 #: bands.  Name -> (maker of the unit-area shape, keywords)
@@ -309,8 +309,8 @@ def ablation_on(entry: dict[str, Any], ar: areas.GridArea) -> None:
                 p["without_" + rule] = [r.fx, r.fy, r.mz]
 
 
-#: the areas rule 4's second form was chosen on (issue 22: an egg whose longer half trails
-#: was 26% high in C~23 with the first form); none of them is a validation area
+#: the areas rule 4's second form was chosen on (an egg whose longer half trails
+#: is 26% high in C~23 with the first form); none of them is a validation area
 BEND_SELECTION: dict[str, tuple[Callable[..., areas.GridArea], dict[str, Any]]] = {
     **{f"egg {r:g}": (samples.egg_patch, {"lead_over_trail": r}) for r in (0.5, 0.7, 1.4, 2.5)},
     **{f"egg {r:g} a/b {g:g}": (samples.egg_patch, {"lead_over_trail": r, "a_over_b": g})
@@ -328,7 +328,7 @@ BEND_SELECTION: dict[str, tuple[Callable[..., areas.GridArea], dict[str, Any]]] 
 
 def _first_form_offset(area: areas.GridArea, geometry: Any, zone: Any, rows: Any,
                        c: dict[str, float]) -> dict[str, float]:
-    """Rule 4's first form (issue 12): every strip offset counted, each strip once."""
+    """Rule 4's first form: every strip offset counted, each strip once."""
     count, first, last = calibrated_module.row_extents(area.mask & rows[:, None])
     used = count > 0
     centres = 0.5 * (area.x[first[used]] + area.x[last[used]])
@@ -670,7 +670,7 @@ def report(res: dict[str, Any]) -> None:
     add("## 4. Where the paper's MAE falls short, and what the calibrated MAE does there\n")
     _causes(add, d)
     _selection(add, res)
-    # ------------------------------------------------------------------ issue 22
+    # ------------------------------------------------------- beyond the selection
     _beyond(add, res)
     # ------------------------------------------------------------------ curves figures
     add("## 5. Curves of the new areas\n")
@@ -893,7 +893,7 @@ def _coef_dev(e: dict[str, Any], m: str, key: str) -> float:
 
 
 def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
-    """Write section 0: the calibrated MAE's rules and the issue's targets, met or missed."""
+    """Write section 0: the calibrated MAE's rules and the targets, met or missed."""
     d = res["areas"]
     m = "mae_calibrated"
     add("## 0. The calibrated MAE and its targets\n")
@@ -1060,7 +1060,7 @@ def _pc(v: float) -> str:
 
 
 def _causes(add: Callable[[str], None], d: dict[str, Any]) -> None:
-    """Write the three causes of issue 12 with the numbers that show them."""
+    """Write the three causes of the paper's MAE's errors with the numbers that show them."""
     def dev(name: str, m: str, key: str) -> float:
         co = d[name]["coefficients"]
         return float(co[m][key] / co["exact"][key] - 1)

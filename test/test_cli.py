@@ -29,7 +29,7 @@ def write_patch(path, area, *, extra_rows=()):
 
 
 def test_circle_exact_coefficients_match_kalker(capsys):
-    # The acceptance command.
+    # The command of the guide's quick start.
     rc, out, err = run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "1",
                        "--nu", "0.25", "--method", "exact", "--json")
     assert rc == 0 and err == ""

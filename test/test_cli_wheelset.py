@@ -27,7 +27,7 @@ def run(capsys, *argv):
 
 @pytest.fixture(scope="module")
 def done_when(tmp_path_factory):
-    """Run the issue's command: both wheels' patches and forces, the roll solved."""
+    """Run the documented command: both wheels' patches and forces, the roll solved."""
     import io
     import contextlib
     out = io.StringIO()

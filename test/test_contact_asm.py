@@ -132,7 +132,7 @@ def _table2_rows() -> list:
 
 
 def _meets_issue_target(name: str, got: float, printed: float) -> bool:
-    # issue 30: within 2%; C23 within 3% or 0.02
+    # the target: within 2%; C23 within 3% or 0.02
     err = abs(got / printed - 1.0)
     return err <= 0.02 if name != "C23" else (err <= 0.03 or abs(got - printed) <= 0.02)
 

@@ -115,7 +115,7 @@ def _table1_rows() -> list:
 @pytest.mark.parametrize("row", _table1_rows(),
                          ids=lambda r: "absent" if r is None else f"a/b={r.a_over_b:g}")
 def test_table_1_dlm_values_as_printed(row):
-    # Table 1 read from the reference file: DLM's C11 and C22 within 3% (issue 30)
+    # Table 1 read from the reference file: DLM's C11 and C22 within 3% (the target)
     if row is None:
         pytest.skip("shared/reference is not beside this checkout")
     c = dlm_coefficients(ellipse(row.a_over_b, 60), nu=NU)

@@ -320,9 +320,9 @@ def test_an_ellipse_on_an_odd_number_of_strips_has_no_spin_coupling(cells, ratio
     """docs/guide_physics.md: on an ellipse ``C~13 = 0``, pure spin gives no ``Fx``, on any grid.
 
     With an odd number of strips the centre line runs through the middle
-    strip; either face alone as the split gave ``C~13`` = -0.03 (a/b = 3, 31
+    strip; either face alone as the split gives ``C~13`` = -0.03 (a/b = 3, 31
     strips) and ``Fx`` of +159 N under pure spin (a yaw moment from nothing
-    on a centred wheelset).  The two faces' flexibilities are now averaged.
+    on a centred wheelset), so the two faces' flexibilities are averaged.
     """
     from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
     from fastsim_ros.contact.mae import mae_area_coefficients, split_tie

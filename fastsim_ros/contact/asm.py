@@ -4,7 +4,7 @@ One of the ways, before MAE, to give FastSim flexibilities on a
 non-elliptical area (the seed paper, Alonso & Giménez 2007, section 2 and
 Table 2; Knothe and Le The Hung): solve the linear (full-adhesion) rolling
 problem approximately, strip by strip, and take the creep coefficients from
-it.  As the issue reads the paper (the paper's own text was not at hand):
+it.  As the package reads the method from its published descriptions:
 
 - the area is cut into strips along the rolling direction (the grid's rows;
   a row with a gap holds one strip per segment), each of its own width;

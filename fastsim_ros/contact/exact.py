@@ -442,8 +442,8 @@ EXTRAPOLATION_GRIDS = (0.4, 0.6, 0.8, 1.0)
 def extrapolation_grids(finest: int) -> list[int]:
     """Return the even cell counts of an extrapolation up to ``finest`` cells across.
 
-    None above ``finest`` (an odd count rounded up to the next even one
-    before, ``--cells 7`` solved on 8); fewer than two for ``finest`` below
+    None above ``finest`` (an odd count is not rounded up to the next even
+    one: ``--cells 7`` solves on at most 6); fewer than two for ``finest`` below
     6, where no line can be fitted: :func:`extrapolated_coefficients` then
     refuses.
     """
