@@ -433,7 +433,7 @@ def _report_exact(add: Callable[[str], None]) -> None:
     add("Shipped table `fastsim_ros/data/kalker_coefficients.csv` (made by "
         "`scripts/make_coefficient_tables.py`: n x n grids, n = 40..160, first-order fit in"
         " the cell size over n >= 60, error = spread over other fit ranges) against Kalker's"
-        " Table E.3 (`shared/reference/kalker_coefficients.csv`, 3 digits).\n")
+        " Table E.3 (3 digits).\n")
     worst = []
     for e in entries:
         for k in ("C11", "C22", "C23"):

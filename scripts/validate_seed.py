@@ -5,7 +5,7 @@ Writes ``docs/data/validation_seed.json``, ``docs/figures/seed_*.png`` and
 ``docs/validation_seed.md``: Kalker's deformation
 levelling method (:mod:`fastsim_ros.contact.dlm`) and Knothe and Hung's
 asymptotic strip method (:mod:`fastsim_ros.contact.asm`) beside the paper's
-numbers (Tables 1 and 2 read from ``shared/reference/seed_tables_1_2.md``),
+numbers (Tables 1 and 2 read from the printed tables, when present),
 the readings of DLM that were tried and why the one in the package was kept,
 ASM's collocation fit (``--fit-asm``) and its check on the rows and Poisson
 ratios it was not fitted on, and the readings of Knothe and Hung's method
@@ -49,7 +49,7 @@ import asm_candidates  # noqa: E402
 DOCS = ROOT / "docs"
 DATA = DOCS / "data" / "validation_seed.json"
 FIG = DOCS / "figures"
-#: Kalker's published table (3 digits: ``shared/reference`` beside the checkout, or where
+#: Kalker's published table (3 digits: the reference directory beside the checkout, or where
 #: ``$SHARED_REFERENCE`` says); without it, the package's own (the exact solver's, within 1%
 #: of it: docs/validation.md), and the report says so
 PUBLISHED = Path(os.environ.get("SHARED_REFERENCE", ROOT.parent / "shared" / "reference")
@@ -671,7 +671,7 @@ def report(res: dict[str, Any]) -> None:
             + ". **Not reproduced.**\n")
         _report_candidates(add, res.get("candidates") or {}, printed)
     else:
-        add("(`shared/reference/seed_tables_1_2.md` is not beside this checkout: Table 2 as"
+        add("(The printed tables are not beside this checkout: Table 2 as"
             " printed is not shown.)\n")
     _figure_coefficients("seed_fig6_asm.png", "ASM against Kalker, nu = 0.25",
                          {float(g): v for g, v in rows.items()}, NU, marks={})

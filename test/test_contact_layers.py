@@ -1,8 +1,8 @@
 """The physics core's dependencies point down (docs/guide_physics.md: what may import what).
 
 Each module's imports (top-level and inside functions) are read from its source
-and compared with the table the guide gives (checked equal to ``ALLOWED``); and the compiled fast path is
-imported and run with SciPy made unimportable.
+and compared with ``ALLOWED``, the table the guide gives (checked equal); and
+the compiled fast path is imported and run with SciPy made unimportable.
 """
 
 import ast

@@ -72,12 +72,14 @@ def test_nothing_cites_a_file_outside_the_repository() -> None:
                            check=True).stdout.split()
     if not files:
         pytest.skip("not a git checkout")
-    this = Path(__file__).resolve()
+    # this test and the README's test name the files they look for
+    checkers = {Path(__file__).resolve(), Path(__file__).resolve().with_name("test_readme.py")}
     found = []
     for name in files:
         path = ROOT / name
-        if path.resolve() == this or path.suffix not in (".py", ".md", ".rst", ".yaml", ".txt",
-                                                         ".sh", ".cfg", ".xml", ".ini", ""):
+        text_file = path.suffix in (".py", ".md", ".rst", ".yaml", ".txt", ".sh", ".cfg", ".xml",
+                                    ".ini", "")
+        if path.resolve() in checkers or not text_file:
             continue
         try:
             text = path.read_text(encoding="utf-8")
