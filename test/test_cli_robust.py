@@ -512,7 +512,7 @@ def test_dlm_on_a_patch_too_thin_to_level_is_bad_input(capsys, tmp_path, command
 
 
 def test_cells_beside_a_patch_and_a_over_b_beside_forces_are_refused(capsys):
-    """Flags dropped without a word before: each is named."""
+    """Flags that a parser could drop without a word: each is named."""
     assert_refused(*run(capsys, "coefficients", "--patch", EXAMPLE, "--cells", "20",
                         "--method", "mae"), "--cells sets a shape's grid")
     assert_refused(*run(capsys, "forces", *ELLIPSE, "--a-over-b", "2", *CREEP),
