@@ -159,11 +159,15 @@ def test_a_block_runs_as_written(line: int, text: str, tmp_path: Path) -> None:
                 if "--plot" in argv:
                     assert (out / f"{name}.png").stat().st_size > 0
         if argv[:2] == ["fastsim_contact", "estimate"]:
-            fitted = float(re.search(r"mu_s = ([0-9.]+)", done.stdout)[1])
+            found = re.search(r"mu_s = ([0-9.]+)", done.stdout)
+            assert found, done.stdout
+            fitted = float(found[1])
             # the model (the calibrated MAE with the knee factor) is not the exact theory
             # that made the curve: the fit is held to 2% of the true mu_s
             assert fitted == pytest.approx(README_CURVE_MU, rel=0.02), done.stdout
         if argv[:2] == ["fastsim_contact", "forces"]:
-            fx = float(re.search(r"Fx = (-?[0-9.e+-]+) N", done.stdout)[1])
+            found = re.search(r"Fx = (-?[0-9.e+-]+) N", done.stdout)
+            assert found, done.stdout
+            fx = float(found[1])
             # a positive xi (the wheel faster than the rail) gives a braking creep force
             assert fx < 0, done.stdout
