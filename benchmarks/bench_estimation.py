@@ -102,7 +102,7 @@ def cycle_runner(estimation: str, differenced: bool = False, cycles: int = 100_0
     """Return a function that runs the next rig cycle through a pipeline, and the pipeline.
 
     ``differenced``: the estimator's slope a forward difference (a second
-    solve per contact), as before the march's derivative.
+    solve per contact), beside the march's own derivative.
     """
     pipe = Pipeline(PipelineConfig.from_values(
         {"contacts": ["left", "right"], "friction_estimation": estimation}))

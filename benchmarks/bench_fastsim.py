@@ -17,9 +17,9 @@ each call, after a warm-up; the three compiled calls interleaved in blocks):
 - the numpy reference ``mae_fastsim`` (with its traction bound; fewer calls),
 - ``EquivalentEllipseSolver.solve`` (the baseline, same patch),
 - ``CalibratedMaeSolver.solve`` (the second MAE method, same patch; the
-  target is at most 1.5x ``MaeSolver.solve``, TARGETS.md),
+  target is at most 1.5x ``MaeSolver.solve``),
 - ``TransientSolver.step`` on the calibrated MAE (transient rolling: the
-  traction carried from the last step, which rolled two cells; the issue's
+  traction carried from the last step, which rolled two cells; the
   target is at most 1.5x the steady ``CalibratedMaeSolver.solve``),
 - the same step on the 30 x 30 patches at several distances rolled ``V
   dt`` (half a cell to 4.3 cells), with the creepages unchanged and with
@@ -203,7 +203,7 @@ def transient_table(calls: int, cells: int = 30) -> None:
                   f"{t['constant'][0] / base:>7.2f}  {t['noise'][0]:>6.1f} /{t['noise'][1]:>5.1f}"
                   f"{t['noise'][0] / base:>7.2f}")
     print("\ntimes in us, median / p99; ratio: the median over the steady median "
-          "(the issue's target: 1.5).\n")
+          "(the target: 1.5).\n")
 
 
 def main() -> None:

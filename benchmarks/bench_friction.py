@@ -1,6 +1,6 @@
 """Compiled MAE + FastSim, one 30x30 patch: falling friction against constant, same run.
 
-TARGETS.md: a solve with a slip-dependent law costs at most 2x one with
+the target: a solve with a slip-dependent law costs at most 2x one with
 constant friction.  Times one ``MaeSolver.solve_arrays`` call (the node's
 hot path) on the flange-root patch (30 cells across), constant friction
 ``mu = 0.4`` against the exponential law ``mu_s = 0.4``, ``A = 0.4``, ``B =

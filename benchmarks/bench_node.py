@@ -294,8 +294,8 @@ def run(contacts: int, rate: float, seconds: float, soak: float, executor: str,
         # (measured: a fresh clone whose cache was filled elsewhere gave up at 30 s)
         if time.monotonic() - start > START_TIMEOUT or proc.poll() is not None:
             status = proc.poll()
-            # stop it before giving up: a target left running kept its DDS domain busy
-            # (a test run that drew the same domain later saw its /diagnostics publisher)
+            # stop it before giving up: a target left running keeps its DDS domain busy
+            # (a test run that draws the same domain later sees its /diagnostics publisher)
             proc.terminate()
             try:
                 proc.wait(10)
@@ -388,7 +388,7 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
                   node_args: list[str], bound: bool = False) -> None:
     """Run the node and the floor alternately ``rounds`` times; print medians and ratios.
 
-    TARGETS.md (4 x 1 kHz): received share within 0.2 points of the floor's,
+    The target (4 x 1 kHz): received share within 0.2 points of the floor's,
     p99 at most 2x the floor's, CPU at most 1.5x the floor's.  ``bound``:
     the floor that also solves a fixed patch per patch (``dds_floor.py
     --solve``) runs in the rotation too: what the solve alone adds.

@@ -1,6 +1,6 @@
 """``bench_node.py --profiles``: the node in profiles mode over DDS, beside topics mode.
 
-TARGETS.md: the node in profiles mode, one wheelset, poses and twists at 1
+the target: the node in profiles mode, one wheelset, poses and twists at 1
 kHz: no drop, at most one core.  The node runs from its installed console
 script with ``config/profiles_track_table.yaml`` (the contact table, read
 from its cache: ``scripts/validate_table.py`` or a first start builds it) in
@@ -149,4 +149,4 @@ def side_by_side(bench: Any, rate: float, seconds: float, rounds: int,
                                                                   "cpu")}
         print(f"  {mode:8s} received {med['received']:.2f}%, latency p50 {med['p50']:.3f} ms, "
               f"p99 {med['p99']:.3f} ms, CPU {med['cpu']:.0f}% of one core", flush=True)
-    print("  TARGETS.md, profiles mode: no drop, at most one core (100%)")
+    print("  the target, profiles mode: no drop, at most one core (100%)")

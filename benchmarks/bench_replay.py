@@ -14,8 +14,8 @@ Prints, with the machine line:
    patch messages per second and the multiple of real time (log duration /
    wall time) of the replay (the chunked, batched path ``fastsim_replay``
    takes) and, beside it, of the per-message reference path (rosbags'
-   reader and writer, one pipeline call per message: the replay before
-   issue 23); then the batch solver's own rate on the same patches in the
+   reader and writer, one pipeline call per message: the path of inputs
+   the batch replay does not take); then the batch solver's own rate on the same patches in the
    same run (``solve_batch`` of the bag's method, one call per patch shape,
    best of 3) and the replay's share of it;
 2. where the batched replay's time goes (its best run): reading (chunk
@@ -29,10 +29,10 @@ Prints, with the machine line:
 3. many bags: ``K`` copies of each bag that uses the default contacts,
    replayed through ``fastsim_replay.main`` with ``--jobs 1`` and
    ``--jobs 2``: patches per second and the speed-up;
-4. the MCAP layer before and after issue 30, side by side in this run:
-   the batched replay of each bag with the hand-written MCAP module of
-   ``--mcap-before`` (its ``fastsim_ros/replay/mcap.py``, loaded from git)
-   and with today's (the ``mcap`` library's records and reader), in
+4. the MCAP layer against a hand-written one, side by side in this run:
+   the batched replay of each bag with the hand-written MCAP module of the
+   revision ``--mcap-before`` (its ``fastsim_ros/replay/mcap.py``, loaded
+   from git) and with the package's (the ``mcap`` library's records and reader), in
    alternating order, ``--rounds`` times each: median patches per second
    and the ratio (``--mcap-only``: this section alone).
 

@@ -8,7 +8,7 @@ memory); the resets stay on the Python path.  Three pipelines, two contacts
 (``left``, ``right``) of the 30-cell flange-root patch, the default method, a
 1 kHz rig at 2 m/s (2 mm rolled a cycle), ``xi = 2e-3``: steady rolling,
 transient on the compiled path, transient on the Python path alone (the
-pipeline before the compiled transient path); then steady and transient
+pipeline's fallback for resets and jumps); then steady and transient
 (compiled) with the creepage's noise of a measured rig (``1e-3`` relative,
 each cycle: the far field's fixed point follows a change of force every
 cycle, where the noiseless cycles settle to one sweep), the ratio to the

@@ -75,10 +75,10 @@ if "NUMBA_CACHE_DIR" not in os.environ or (
         os.environ["NUMBA_CACHE_DIR"] = os.environ[_CHOSEN] = _cache
         if "numba.core.config" in sys.modules:
             # numba read its settings when it was imported (a script that imports numba
-            # before this package): its cache stayed in __pycache__, keyed on each file's
-            # own time stamp, and a kernel compiled in from another file (rolling_sweep
-            # into transient.py's solves) loaded stale machine code.  Only the cache's
-            # directory is set: reload_config() would also reset what the script set in
-            # code (numba.config.DISABLE_JIT for a coverage run)
+            # before this package): its cache would stay in __pycache__, keyed on each
+            # file's own time stamp, and a kernel compiled in from another file
+            # (rolling_sweep into transient.py's solves) would load stale machine code.
+            # Only the cache's directory is set: reload_config() would also reset what
+            # the script set in code (numba.config.DISABLE_JIT for a coverage run)
             _config: Any = sys.modules["numba.core.config"]
             _config.CACHE_DIR = _cache

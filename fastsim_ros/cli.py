@@ -1,6 +1,6 @@
 """``fastsim_contact``: one-off contact computations from the command line.
 
-Three commands (INTERFACE.md): ``coefficients`` prints an area's generalised
+Three commands: ``coefficients`` prints an area's generalised
 creepage coefficients, ``forces`` the creep forces at given creepages,
 ``wheelset`` a wheelset's patches and creep forces from wheel and rail profiles
 (:mod:`fastsim_ros.cli_wheelset`), and ``estimate`` fits the friction law to
@@ -247,7 +247,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_allow_implausible(fo)
     from fastsim_ros import cli_wheelset  # the wheelset command lives in its own module
     cli_wheelset.add_parser(sub, _finite)
-    from fastsim_ros import cli_estimate  # the friction fit too (issue 28)
+    from fastsim_ros import cli_estimate  # the friction fit lives in its own module too
     cli_estimate.add_parser(sub, _finite)
     return parser
 
@@ -509,7 +509,7 @@ def coefficients(args: argparse.Namespace) -> dict[str, Any]:
     result: dict[str, Any]
     if args.method == "exact" and args.patch is None:
         finest = args.cells or DEFAULT_CELLS["exact"]
-        # first-order extrapolation to zero cell size (METHOD.md 5)
+        # first-order extrapolation to zero cell size (docs/guide_physics.md "The exact solver")
         ext = exact.extrapolated_coefficients(args.shape, tuple(args.a_over_b), nu=args.nu,
                                               finest=finest)
         result = dict(ext.as_dict())
@@ -588,7 +588,7 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         n = patch.nx
         if args.patch is None and n >= 2 * EXACT_COARSEST:
             # the exact forces converge in the cell at first order (the rigid slip taken at
-            # a cell's end, the upstream difference: METHOD.md 5): on 60 cells an ellipse's
+            # a cell's end, the upstream difference: the physics guide): on 60 cells an ellipse's
             # Fy under spin is 1.7% off its limit, so a shape's forces are extrapolated
             # from n/2 and n cells, F = (n F_n - m F_m) / (n - m)
             m = n // 2

@@ -1,9 +1,9 @@
-"""``fastsim_contact estimate``: fit a friction law to a measured creep curve (issue 28).
+"""``fastsim_contact estimate``: fit a friction law to a measured creep curve.
 
 ``--measured FILE.csv`` (header ``xi,eta,phi,Fx`` or ``xi,eta,phi,Fx,Fy``;
 creepages in 1, 1, 1/m about the area's origin, forces of the rail on the
-wheel in N, METHOD.md's signs) on the area of ``forces`` (``--shape ellipse
---a --b --load`` or ``--patch FILE``, ``--nu``, ``--shear-modulus``,
+wheel in N, signs as in docs/guide_physics.md) on the area of ``forces``
+(``--shape ellipse --a --b --load`` or ``--patch FILE``, ``--nu``, ``--shear-modulus``,
 ``--bound``, ``--cells``): the batch fit of
 :func:`fastsim_ros.estimation.fit.fit_friction` with the solver of
 ``--method`` under ``--friction-law``
@@ -196,8 +196,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         raise InvalidInputError(
             f"{args.measured}: no friction coefficient in [{MU_RANGE[0]:g}, {MU_RANGE[1]:g}] "
             f"fits the samples (best {fit.mu_s:.4g}, worst error "
-            f"{fit.worst_error_percent:.3g}% of mu N): are the forces' sign (METHOD.md: "
-            "opposing the creepage), units (N) and --load those of the patch?")
+            f"{fit.worst_error_percent:.3g}% of mu N): are the forces' sign (opposing the "
+            "creepage), units (N) and --load those of the patch?")
 
     def determined(name: str, value: float) -> float | None:
         # an undetermined parameter stays at its starting value: not an answer either

@@ -1,6 +1,6 @@
 """``fastsim_contact wheelset``: a wheelset on its track, from profiles to creep forces.
 
-INTERFACE.md ("Patches from wheel and rail profiles", the command line):
+docs/guide_profiles.md:
 the wheelset is placed at a pose, each wheel's patches are found and their
 normal problem solved (:mod:`fastsim_ros.geometry`), and the creep forces
 come from the node's own pipeline in profiles mode
@@ -253,7 +253,7 @@ def _refused(cycle: ProfileCycle) -> None:
 
 
 def result_of(cycle: ProfileCycle, pipeline: ProfilePipeline, method: str) -> dict[str, Any]:
-    """Return the JSON object of INTERFACE.md for one solved pose."""
+    """Return the JSON object (docs/guide_cli.md) for one solved pose."""
     contact = cycle.contact
     assert isinstance(contact, WheelsetContact)   # the command line solves each pose
     pose = contact.pose

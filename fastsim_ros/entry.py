@@ -3,9 +3,9 @@
 The node's module imports rclpy, numpy and numba (about half a second, more
 on a cold disk) before :func:`fastsim_ros.node.main` can put its own signal
 handling in place, and a console script imports its target's module before
-calling it: a SIGINT then printed a ``KeyboardInterrupt`` traceback from
-inside an import and a SIGTERM killed the process (exit -15), where
-INTERFACE.md's node stops with exit 0.  So the scripts start here, in a
+calling it: a SIGINT there would print a ``KeyboardInterrupt`` traceback
+from inside an import and a SIGTERM would kill the process (exit -15),
+where the node stops with exit 0.  So the scripts start here, in a
 module that imports nothing heavy: SIGINT and SIGTERM end the process with
 status 0 until the node's module is loaded, then Python's own handlers are
 back for :func:`fastsim_ros.node.main` (which installs the node's).

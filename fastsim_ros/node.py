@@ -1,9 +1,9 @@
 """``fastsim_node``: the ROS 2 node (default name ``fastsim``), a thin front end of the pipeline.
 
-Topics, frames and parameters: INTERFACE.md (and the README's "Running the
-node").  The node declares every parameter of :mod:`fastsim_ros.params`
-with its descriptor and range, builds one :class:`~fastsim_ros.pipeline.Pipeline`
-and wires topics to it: it subscribes to every input of the pipeline's one
+Topics, frames and parameters: docs/guide_node.md.  The node declares every
+parameter of :mod:`fastsim_ros.params` with its descriptor and range,
+builds one :class:`~fastsim_ros.pipeline.Pipeline` and wires topics to it:
+it subscribes to every input of the pipeline's one
 table (:meth:`~fastsim_ros.pipeline.Pipeline.inputs`: a topic, its type and
 its handler; a new input is added there) and publishes the outcomes each
 handler returns.  The hot path is lean on purpose: inputs arrive raw (CDR
@@ -186,7 +186,7 @@ class _FrontEnd:
 
         rclpy refuses a value of another type before any callback of ours
         runs, with "Wrong parameter type, expected ... got ..." alone;
-        INTERFACE.md wants every refusal to name the parameter and its range.
+        every refusal names the parameter and its range (docs/guide_node.md).
         The reason keeps rclpy's words first (rclpy maps them to its type
         exception) and adds the parameter's name and what it takes.
         """
@@ -232,7 +232,7 @@ class _FrontEnd:
                     continue
                 default: Any = spec.default
                 if spec.name == "contacts":
-                    # INTERFACE.md: in profiles mode the contacts are fixed per wheel, so
+                    # in profiles mode the contacts are fixed per wheel, so
                     # they are the default there and any other value is refused
                     default = list(parameters.PROFILE_CONTACTS if source == "profiles"
                                    else spec.default)
@@ -330,7 +330,7 @@ class _FrontEnd:
             outputs[FRICTION_ESTIMATE_TOPIC] = Vector3Stamped
         if isinstance(self.pipeline, ProfilePipeline):
             # profiles mode computes the patches and publishes them, so that a recording
-            # replays in either mode (INTERFACE.md)
+            # replays in either mode
             outputs.update({patch_topic(c): PointCloud2 for c in config.contacts})
         for topic, msgtype in outputs.items():
             self._pubs[topic] = node.create_publisher(
@@ -582,7 +582,7 @@ def _destroyed_on_failure(node: Node) -> Iterator[None]:
 
 
 class FastsimNode(_FrontEnd, Node):
-    """Creep forces for every contact patch received (INTERFACE.md).
+    """Creep forces for every contact patch received.
 
     ``argv``: the process's arguments, whose ``--params-file`` files are
     checked for sections and names the node does not take (a warning).
@@ -819,10 +819,10 @@ def _run_node(make: Callable[..., Node], program: str, args: Sequence[str] | Non
     finally:
         if executor is not None:
             # the node's entities out of the executor, and it shut down, before they go:
-            # the events executor aborted the process ("Destroying callback manager with
-            # callbacks remaining", exit -6) when a SIGTERM just after start-up left it to
-            # the garbage collector with the node's callbacks still registered (1 stop
-            # in 40 at about 1.1 s)
+            # the events executor aborts the process ("Destroying callback manager with
+            # callbacks remaining", exit -6) when a SIGTERM just after start-up leaves it
+            # to the garbage collector with the node's callbacks still registered
+            # (test_node.py: test_sigterm_and_sigint_end_cleanly)
             if node is not None:
                 with contextlib.suppress(Exception):
                     executor.remove_node(node)

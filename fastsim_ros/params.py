@@ -3,7 +3,7 @@
 The node declares its ROS parameters from :data:`PARAMETERS` (descriptor,
 range, read-only flag), and the offline replay checks a params file against
 the same table, so a value the node refuses the replay refuses too, with the
-same message.  INTERFACE.md ("Executables and parameters") fixes the names.
+same message.  docs/guide_node.md fixes the names.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import yaml
 
 from fastsim_ros.errors import ParameterError
 
-#: the methods of the library the node offers (INTERFACE.md: ``method``): the paper's
+#: the methods of the library the node offers (docs/guide_node.md): the paper's
 #: MAE, the calibrated MAE (the default since docs/validation_wider.md shows it better
 #: than the paper's on every validation area) and FastSim on the equivalent ellipse
 METHODS = ("mae", "mae_calibrated", "fastsim_ellipse")
@@ -160,7 +160,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_decay", "double", 0.0,
                   "B (s/m) of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
                   low=0.0, high=1.0e4, dynamic=True),
-    # --- online friction estimation (issue 28; fastsim_ros/estimation/ekf.py)
+    # --- online friction estimation (fastsim_ros/estimation/ekf.py)
     ParameterSpec("friction_estimation", "string", "off",
                   "estimate mu_s online from wheelset/measured_wrench (force.x, wheelset "
                   "frame) with an extended Kalman filter whose measurement model is the "
@@ -216,7 +216,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "publisher", low=1, high=10000),
     ParameterSpec("diagnostics_period", "double", 1.0,
                   "seconds between /diagnostics messages", low=0.01, high=60.0),
-    # --- the patch source (INTERFACE.md "Patches from wheel and rail profiles")
+    # --- the patch source (docs/guide_profiles.md)
     ParameterSpec("patch_source", "string", "topics",
                   "where patches come from: topics (contact/<name>/patch) or profiles "
                   "(computed each cycle from wheelset/pose, wheelset/load and the profiles; "

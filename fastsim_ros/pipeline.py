@@ -4,7 +4,7 @@
 the latest kinematics; :meth:`Pipeline.on_patch` turns one patch (a decoded
 :class:`~msg_adapters.cdr.Cloud`) into an :class:`Outcome`: the solved
 contact (frame, creepages, forces) and, once per rig cycle, the wheelset
-wrench, or a rejection with its reason key (INTERFACE.md).  It never reads
+wrench, or a rejection with its reason key.  It never reads
 a clock for anything it outputs: stamps come from the messages, so a replay
 is deterministic (only the solve-time statistics use ``perf_counter``).
 No ``rclpy.node`` here: the node and ``fastsim_replay`` are thin front ends.
@@ -14,7 +14,7 @@ creepages, the MAE solve and the wheelset wrench in one call, equal to the
 bit to the Python path, which decides every rejection); its solve time is
 that call's.
 
-Physics (INTERFACE.md "Creepages", METHOD.md 1): the solvers roll towards
+Physics (docs/guide_physics.md, its conventions and creepages): the solvers roll towards
 ``+x``; when the rolling speed ``V`` is negative (reverse running) the patch
 is turned by 180 degrees about the contact normal (``x, y -> -x, -y``), solved
 with ``(xi, eta, -phi)``, and ``(-Fx', -Fy', Mz')`` is reported in the
@@ -111,7 +111,7 @@ def _on_patch_cells(f: ContactForces, patch: ContactPatch) -> ContactForces:
     """Return ``f`` with its tractions moved from the solver's own grid to the patch's cells.
 
     The equivalent ellipse solves on an ``n`` x ``n`` grid of its own
-    ellipse; the traction cloud is the patch's cells' (INTERFACE.md
+    ellipse; the traction cloud is the patch's cells' (docs/guide_node.md
     "Outputs"): bilinear (:func:`~fastsim_ros.contact.area.regridded`), the
     slip flag the nearest cell's, both zero outside the patch's cells in
     contact.  The forces stay the solve's: the cloud's sum of ``tau dA``
@@ -133,7 +133,7 @@ def _on_patch_cells(f: ContactForces, patch: ContactPatch) -> ContactForces:
 
 @dataclass(frozen=True)
 class PipelineConfig:
-    """The checked parameters of INTERFACE.md (see :mod:`fastsim_ros.params`)."""
+    """The checked parameters (see :mod:`fastsim_ros.params`)."""
 
     values: Mapping[str, Any]
 
@@ -369,7 +369,7 @@ def _builder(cls: type) -> Callable[..., Any]:
     """
     names = [f.name for f in fields(cls)]
     assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
-    # a field with a plain default may be left out (Outcome.friction, added later)
+    # a field with a plain default may be left out (Outcome.friction: only when estimating)
     defaults = {f.name: f.default for f in fields(cls) if f.default is not MISSING}
     args = ", ".join(f"{n}=default_{n}" if n in defaults else n for n in names)
     body = "".join(f"    set_{n}(o, {n})\n" for n in names)
@@ -409,7 +409,7 @@ def _newest_before(history: deque[StampedTwist], stamp_ns: int) -> StampedTwist 
 
 
 class Pipeline:
-    """Patches + kinematics -> creep forces, with the node's rules (INTERFACE.md).
+    """Patches + kinematics -> creep forces, with the node's rules.
 
     Build it from a :class:`PipelineConfig`; feed it :meth:`on_wheel_twist`,
     :meth:`on_rail_twist` and :meth:`on_patch` in arrival (log-time) order;
@@ -483,7 +483,7 @@ class Pipeline:
     def _use_mu(self, mu: float, config: PipelineConfig) -> None:
         """Solve with the static coefficient ``mu`` (the parameter's, or the estimate)."""
         self._mu = mu
-        # None: constant friction, the call of old (speed unused); else the law, run at |V|
+        # None: constant friction (Coulomb's law, speed unused); else the law, run at |V|
         law = friction_law(str(config["friction_law"]), self._mu,
                            limit_ratio=float(config["friction_limit_ratio"]),
                            decay=float(config["friction_decay"]))
@@ -1094,7 +1094,7 @@ class Pipeline:
                     torque: tuple[float, float, float]) -> WheelsetWrench | None:
         """Keep the contact's wrench; return the wheelset wrench if it completes a rig cycle.
 
-        INTERFACE.md's rule by the stamps: every contact has a wrench newer
+        the node's rule by the stamps: every contact has a wrench newer
         than those of the last sum, i.e. stamped after the last sum's stamp
         (the newest of its wrenches).  A flag per contact instead paired,
         after one rejected patch of the contact that arrives first, every
@@ -1135,7 +1135,7 @@ class Pipeline:
                  wanted: Container[str] | None = None) -> list[tuple[str, Any]]:
         """Return the ``(topic, message)`` pairs to publish for an outcome, in order.
 
-        Each as CDR bytes (INTERFACE.md "Outputs"): the contact's wrench and
+        Each as CDR bytes (docs/guide_node.md): the contact's wrench and
         creepage, its frame when it moved, its traction cloud when asked
         for, its marker when due, and the wheelset wrench when the rig cycle
         is complete.  ``wanted``: if given, only these topics are encoded
@@ -1223,7 +1223,7 @@ class Pipeline:
     def republish_frame(self, contact: str) -> None:
         """Have the contact's next solve publish its frame, moved or not.
 
-        The frame is published when it changes (INTERFACE.md), to whoever
+        The frame is published when it changes, to whoever
         subscribes then: on a steady rig a subscriber that joins later (a
         viewer started after the node) never got one.  The node calls this
         when the frame's topic gains a subscriber.

@@ -1,6 +1,6 @@
 """The pipeline in profiles mode: wheelset poses (and loads) in, patches and creep forces out.
 
-INTERFACE.md ("Patches from wheel and rail profiles"): a rig knows its
+docs/guide_profiles.md: a rig knows its
 profiles and measures the wheelset's pose and loads.  :class:`ProfilePipeline`
 wraps the :class:`~fastsim_ros.pipeline.Pipeline` of the patch topics: for
 each ``wheelset/pose`` it places the wheelset
@@ -222,7 +222,7 @@ class TableContact:
 
 
 class ProfilePipeline:
-    """Poses + loads + twists -> patches -> the pipeline's outputs (INTERFACE.md)."""
+    """Poses + loads + twists -> patches -> the pipeline's outputs."""
 
     def __init__(self, config: PipelineConfig, *, solve_roll: bool = False,
                  solver: Any = None, log: Callable[[str], None] | None = None) -> None:

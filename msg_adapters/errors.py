@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-#: every reason a patch can be dropped for (INTERFACE.md, "Outputs", /diagnostics);
+#: every reason a patch can be dropped for (docs/guide_node.md, /diagnostics);
 #: ``derailment``: in profiles mode, a pose past the flange or off the rail head
 REJECTION_REASONS = (
     "nonfinite", "negative_pressure", "irregular_grid", "missing_field", "wrong_frame",

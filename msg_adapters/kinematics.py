@@ -1,4 +1,4 @@
-"""Twists -> creepages: the general rigid-body form of INTERFACE.md.
+"""Twists -> creepages: the general rigid-body form (docs/guide_physics.md).
 
 Wheel twist ``(v, w)`` and rail twist ``(v_r, w_r)``, both about the
 wheelset frame's origin and relative to the ground; contact origin ``p`` and

@@ -7,7 +7,7 @@ built once per frame id and contact where only the stamp and the numbers
 change: the node publishes them raw and the replay writes them to bags as
 they are.  Diagnostics (once a second) are a message object;
 ``rclpy.serialization.serialize_message`` turns it into bytes.  Frames
-(INTERFACE.md "Outputs"): a contact's wrench and creepage in
+(docs/guide_node.md): a contact's wrench and creepage in
 ``<name>_contact``; frame, markers, traction cloud and the wheelset wrench
 in the wheelset frame.
 """

@@ -1,6 +1,6 @@
 """PointCloud2 -> contact patch: the contact frame, the in-plane grid, the pressure.
 
-INTERFACE.md ("Inputs"): the cloud is organised, each row one lateral strip
+docs/guide_node.md: the cloud is organised, each row one lateral strip
 whose points run along the rolling direction; fields ``x y z`` (cell centre
 on the contact surface, m, in the wheelset frame), ``normal_x normal_y
 normal_z`` (surface normal pointing into the wheel) and ``pressure`` (Pa,
@@ -41,7 +41,7 @@ GRID_TOLERANCE = 0.02
 #: cells smaller than this (m) describe no wheel-rail contact (and 1e-200 m
 #: cells would underflow the cell area)
 MIN_CELL_SIZE = 1e-9
-#: fewer cells in contact than this are `degenerate` (INTERFACE.md)
+#: fewer cells in contact than this are `degenerate`
 MIN_CONTACT_CELLS = 4
 
 
@@ -219,7 +219,7 @@ Axes = tuple[tuple[float, float, float], tuple[float, float, float],
 
 
 def contact_axes(normal: tuple[float, float, float]) -> Axes:
-    """Return ``(e_x, e_y, e_z)`` of INTERFACE.md's contact frame for a normal (any length).
+    """Return ``(e_x, e_y, e_z)`` of the contact frame for a normal (any length).
 
     ``e_z`` along the normal, ``e_x`` the wheelset's ``x`` projected on the
     contact plane, ``e_y = e_z x e_x``.  Raises ``degenerate`` for a zero
@@ -263,7 +263,7 @@ def patch_from_cloud(cloud: Cloud, *, max_cells: int) -> ContactPatch | None:
 
     ``max_cells``: the largest grid (``height * width``) accepted; larger is
     ``too_large``, checked before anything is read or allocated.  Raises
-    :class:`RejectedInput` with the reason key of INTERFACE.md otherwise.
+    :class:`RejectedInput` with its reason key (docs/guide_node.md) otherwise.
     """
     ny, nx = cloud.height, cloud.width
     if ny * nx > max_cells:
@@ -348,13 +348,13 @@ def planar_points(origin: tuple[float, float, float], axes: ContactFrame | None,
 
 
 def frame_from_normal(normal: tuple[float, float, float]) -> ContactFrame:
-    """Return the contact frame of INTERFACE.md for a ``normal`` (origin at 0)."""
+    """Return the contact frame for a ``normal`` (origin at 0)."""
     return ContactFrame((0.0, 0.0, 0.0), contact_axes(normal))
 
 
 def cloud_bytes(points: FloatArray, normals: FloatArray, pressure: FloatArray, *,
                 dtype: str = "<f4") -> tuple[list[tuple[str, int]], int, bytes]:
-    """Return ``(fields, point_step, data)`` of a patch cloud in INTERFACE.md's layout.
+    """Return ``(fields, point_step, data)`` of a patch cloud in the node's input layout.
 
     ``points``, ``normals``: ``(ny, nx, 3)`` (a normal may be given once,
     shape ``(3,)``); ``pressure``: ``(ny, nx)`` (Pa); fields ``x y z

@@ -94,7 +94,7 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
         return
     o0, o1, o2 = s0 / p_sum, s1 / p_sum, s2 / p_sum
     out[ORIGIN], out[ORIGIN + 1], out[ORIGIN + 2] = o0, o1, o2
-    # the contact frame of INTERFACE.md (patch.contact_axes, the same operations)
+    # the contact frame (patch.contact_axes, the same operations)
     norm = math.sqrt(s3 * s3 + s4 * s4 + s5 * s5)
     if not norm > 0.0:
         out[STATUS] = ZERO_NORMAL

@@ -1,6 +1,6 @@
 """Messages of the profiles patch source: poses and loads in, patch clouds out.
 
-INTERFACE.md ("Patches from wheel and rail profiles"): ``wheelset/pose`` is
+docs/guide_profiles.md: ``wheelset/pose`` is
 a ``geometry_msgs/PoseStamped`` in the track frame (the wheelset frame's
 origin and orientation), ``wheelset/load`` a ``geometry_msgs/WrenchStamped``
 in the wheelset frame (``force.z`` the total vertical load, ``torque.x`` the

@@ -3,7 +3,7 @@
 
 Each bag is a rosbag2 directory (``metadata.yaml`` version 9 and one
 ``.mcap`` with zstd chunk compression, CDR, ``ros2msg`` schemas) with the
-wheelset twist and the contact patches of ``../shared/INTERFACE.md``, and a
+wheelset twist and the contact patches of docs/guide_node.md, and a
 parameter file ``bags/<name>.params.yaml`` for the node ``fastsim``.  The
 bad-input bag also gets ``bags/bad_inputs.expected.yaml``: the outcome of
 every patch by contact, computed by reading the written bag back and
@@ -565,7 +565,7 @@ def bad_patch(kind: str, ns: int, prev_ns: int, good: np.ndarray, area: GridArea
 def classify_bag(path: Path, params: dict[str, Any]) -> list[tuple[str, str, int]]:
     """Return ``(contact, outcome, log ns)`` of every patch of a bag, read back from disk.
 
-    The rules of INTERFACE.md, in this order: the size bound, frame, fields,
+    The node's rules (docs/guide_node.md), in this order: the size bound, frame, fields,
     non-finite values, negative pressure, grid regularity, stamp order, empty
     (``no_contact``), fewer than 4 cells (``degenerate``), kinematics
     (``no_kinematics``, ``stale_kinematics``), ``standstill``, a likely unit

@@ -5,14 +5,14 @@ For each ``a/b`` and ``nu`` the ellipse ``a b = 1/pi`` is solved in full
 adhesion (unit ``xi``, ``eta``, ``phi``) on grids of ``n x n`` cells over its
 bounding box; each coefficient is extrapolated to zero cell size with a
 first-order fit ``C(h) = C0 + k h`` (``h = 1/n``) over the grids ``n >= 60``
-(METHOD.md section 5: convergence is first order, and the staircase noise
-of the boundary defeats free-order Richardson on few grids).  The error
+(docs/guide_physics.md, "The exact solver": convergence is first order, and
+the staircase noise of the boundary defeats free-order Richardson on few grids).  The error
 estimate of an entry is the largest change of ``C0`` when the fit is made
 over the other grid ranges listed in ``FIT_RANGES``.
 
 Writes ``fastsim_ros/data/kalker_coefficients.csv`` (C11, C22, C23, C33 of
 Kalker's linear theory), ``fastsim_ros/data/half_ellipse_coefficients.csv``
-(c11 ... c23 of the upper half, METHOD.md section 3.4) and the raw per-grid
+(c11 ... c23 of the upper half, docs/guide_physics.md "MAE") and the raw per-grid
 values to ``docs/data/coefficient_grids.csv``.
 
 Usage: ``python scripts/make_coefficient_tables.py [--quick]``.  The full run
@@ -76,7 +76,7 @@ def solve_grid(g: float, nu: float, n: int, shape: float = 1.0) -> dict[str, flo
 
     (fx1, fy1), (fx2, fy2), (fx3, fy3) = (half(s) for s in sols)
     out = {k: getattr(full, k) for k in FULL_KEYS}
-    # METHOD.md 3.4: Fx+ = -G ab c11 xi - G ab c12 eta + G (ab)^1.5 c13 phi,
+    # docs/guide_physics.md "MAE": Fx+ = -G ab c11 xi - G ab c12 eta + G (ab)^1.5 c13 phi,
     #                Fy+ = -G ab c21 xi - G ab c22 eta - G (ab)^1.5 c23 phi   (G = 1).
     out.update(c11=-fx1 / c**2, c12=-fx2 / c**2, c13=fx3 / c**3,
                c21=-fy1 / c**2, c22=-fy2 / c**2, c23=-fy3 / c**3)
@@ -169,7 +169,8 @@ def main() -> int:
         " Mz = G (ab)^1.5 C23 eta - G (ab)^2 C33 phi."],
         ["a_over_b", "nu"] + [s for k in FULL_KEYS[:4] for s in (k, k + "_err")], full_rows)
     _write(out_dir / "half_ellipse_coefficients.csv", provenance + [
-        "# Upper half (y > 0) of the ellipse (METHOD.md 3.4): Fx+ = -G ab c11 xi - G ab c12 eta"
+        "# Upper half (y > 0) of the ellipse (docs/guide_physics.md, MAE):"
+        " Fx+ = -G ab c11 xi - G ab c12 eta"
         " + G (ab)^1.5 c13 phi; Fy+ = -G ab c21 xi - G ab c22 eta - G (ab)^1.5 c23 phi."],
         ["a_over_b", "nu"] + [s for k in HALF_KEYS for s in (k, k + "_err")], half_rows)
     keys = list(raw_rows[0].keys()) if raw_rows else []
@@ -184,7 +185,7 @@ def main() -> int:
 
 
 def cell_shape_check(ratios: list[float]) -> int:
-    """Converge C11, C22, C23 on two cell shapes (METHOD.md section 6, long end)."""
+    """Converge C11, C22, C23 on two cell shapes (the exactness checks' long end)."""
     path = ROOT / "docs" / "data" / "cell_shape_check.csv"
     rows = []
     for g in ratios:

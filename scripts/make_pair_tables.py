@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Tabulate the elastic interaction of two joined semi-ellipses with the exact solver.
 
-MAE (METHOD.md 3) gives each zone the coefficients of a lone half ellipse:
+MAE (docs/guide_physics.md "MAE") gives each zone the coefficients of a lone half ellipse:
 the two halves of a joined pair are taken as independent.  They are not: in
 the exact theory the traction on one half is changed by the other half's
 (the half-space couples them), and on the 5/1 semi-ellipses the sum of
@@ -9,7 +9,7 @@ independent halves is 26% low in C~23 (docs/validation_wider.md).  This
 script measures, for the family of ``area.semi_ellipses(g_lower, g_upper)``
 (two semi-ellipses joined along ``y = 0``, ``a_i b_i = 1/pi``), each half's
 share of the exact full-adhesion forces, in the half-ellipse normalisation
-of METHOD.md 3.4 (upper half: ``Fx+ = -G ab c11 xi + G (ab)^1.5 c13 phi``,
+of docs/guide_physics.md "MAE" (upper half: ``Fx+ = -G ab c11 xi + G (ab)^1.5 c13 phi``,
 ``Fy+ = -G ab c22 eta - G (ab)^1.5 c23 phi``, ``ab = 1/pi``; the lower half
 mirrored), and writes it as the *pair factor*
 
@@ -24,7 +24,7 @@ error of the extrapolation and of the tables together).
 Grids: ``cells`` cells across the wider half along ``x`` and about as many
 along ``y`` (``area.semi_ellipses``), n in GRIDS; each pair coefficient is
 extrapolated to zero cell size by a first-order fit ``C0 + k/n`` over all
-of them (METHOD.md 5), the error estimate being the change of ``C0`` when
+of them (docs/guide_physics.md), the error estimate being the change of ``C0`` when
 the coarsest grid is left out; ``k_err`` is that error over the lone half's
 coefficient.
 
@@ -66,7 +66,7 @@ OUT = ROOT / "fastsim_ros" / "data" / "semi_ellipse_pair_factors.csv"
 
 
 def halves(g_lower: float, g_upper: float, nu: float, n: int) -> dict[str, float]:
-    """Both halves' coefficients (METHOD.md 3.4 normalisation) of one pair on ``n`` cells."""
+    """Both halves' coefficients (the physics guide normalisation) of one pair on ``n`` cells."""
     ar = areas.semi_ellipses(g_lower, g_upper, cells=n)
     sols = exact.unit_solutions(ar, nu=nu)
     c = math.sqrt(ar.area / math.pi)

@@ -171,7 +171,8 @@ def _as_dict(c: CreepCoefficients) -> dict[str, float]:
 def _notch_carry_over() -> dict[str, float]:
     """C11 of the notched ellipse: exact, FastSim restarting behind the notch, and carrying on.
 
-    METHOD.md 2 pins the restart (each strip segment starts from zero traction);
+    FastSim's fixed discretisation (docs/guide_physics.md) has the restart (each strip
+    segment starts from zero traction);
     the variant keeps integrating the adhesion traction across the notch to
     show how much of MAE + FastSim's shortfall there the restart accounts for.
     """
@@ -365,7 +366,7 @@ def _report_summary(add: Callable[[str], None]) -> None:
         + ", ".join(f"{_pct(v[1])}" for v in c23.values())
         + "; with `centroid` "
         + ", ".join(f"{_pct(v[2])}" for v in c23.values())
-        + ". As METHOD.md 4 warns, MAE's C~23 is off by up to about 25% on strongly"
+        + ". As expected of the method, MAE's C~23 is off by up to about 25% on strongly"
         " asymmetric areas: that is the method.")
     add(f"- Force-creepage curves, largest error in % of mu N where the exact force exceeds 5%"
         f" of mu N: FastSim on a Hertzian ellipse (its own floor) {100 * floor:.1f};"
@@ -386,7 +387,7 @@ def _report_summary(add: Callable[[str], None]) -> None:
                      for c in CURVES for k in ("Fx", "Fy")))
         return f"{area} ({worst[2]} under {worst[1]}, {100 * worst[0]:.1f})"
 
-    add("- Target (TARGETS.md: within 10% of mu N): MAE + FastSim meets it on every area"
+    add("- Target (within 10% of mu N): MAE + FastSim meets it on every area"
         + (" except " + ", ".join(where(n) for n in over) if over else "")
         + ". The notch's shortfall is FastSim's restart behind the notch (section 3); the"
         " truncated ellipse's is Fx under spin, where the flat band beyond the split is"
@@ -432,7 +433,7 @@ def _report_exact(add: Callable[[str], None]) -> None:
     add("Shipped table `fastsim_ros/data/kalker_coefficients.csv` (made by "
         "`scripts/make_coefficient_tables.py`: n x n grids, n = 40..160, first-order fit in"
         " the cell size over n >= 60, error = spread over other fit ranges) against Kalker's"
-        " Table E.3 (`shared/reference/kalker_coefficients.csv`, 3 digits).\n")
+        " Table E.3 (3 digits).\n")
     worst = []
     for e in entries:
         for k in ("C11", "C22", "C23"):
@@ -453,7 +454,7 @@ def _report_exact(add: Callable[[str], None]) -> None:
                 for p in pairs.values() for k in ("C11", "C22", "C23"))
     add("- Entries outside 1%: " + (", ".join(
         f"a/b = {w[1]:g}, nu = {w[2]:g}, {w[3]} {_pct(w[0])}" for w in misses) or "none")
-        + ". These are the long end that METHOD.md section 6 flags: "
+        + ". These are the long end, where the published values themselves may be about 1% low: "
         "`docs/data/cell_shape_check.csv` converges them on a second cell shape "
         f"(2n x n/2 cells, 4x longer in x per y) and both shapes agree within"
         f" {100 * agree:.2f}%, so the "
@@ -605,7 +606,8 @@ def _report_coefficients(add: Callable[[str], None]) -> None:
     if notch:
         add("The notched ellipse is where MAE + FastSim falls short although MAE's own"
             " coefficients are right: FastSim restarts each strip segment from zero traction"
-            " behind the notch (METHOD.md 2 pins this). On the same 60-cell grid C11 is"
+            " behind the notch (FastSim's fixed discretisation: each segment starts from its"
+            " own leading edge). On the same 60-cell grid C11 is"
             f" {notch['exact_same_grid']:.3f} exact, {notch['restart']:.3f} with the restart"
             f" ({_pct(notch['restart'] / notch['exact_same_grid'] - 1)}) and"
             f" {notch['carry_over']:.3f} if the adhesion traction carried on across the notch"

@@ -59,7 +59,7 @@ Patch = tuple[GridArea, tuple[float, float, float], float]
 
 
 def axle_spin(xi: float | None) -> float:
-    """Return the axle spin (rad/s) of the issue's sweep (None) or of a creepage ``xi`` at R0."""
+    """Return the axle spin (rad/s) of the default sweep (None) or of a creepage ``xi`` at R0."""
     if xi is None:
         return 4.3438
     # xi = (v0 - omega R) / V, V = (v0 + omega R) / 2 at the nominal radius

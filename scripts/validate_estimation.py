@@ -1,4 +1,4 @@
-"""Validation of online friction estimation (issue 28): a rig run from the exact theory.
+"""Validation of online friction estimation: a rig run from the exact theory.
 
 A rig's run, synthesised: a Hertzian ellipse (a = 6 mm, b = 4 mm, N = 50 kN,
 20 x 20 cells), rolling speed 20 m/s, 200 Hz for 6 s; the true friction
@@ -332,9 +332,9 @@ def main() -> None:
           f"{defaults['friction_min_sensitivity']:g}, model error share "
           f"{defaults['friction_model_error']:g}), its model the method times the knee "
           "factor (`fastsim_ros/contact/knee.py`, the default) or the method's own force "
-          "(the estimator before the factor), on the exact theory's forces and on the "
+          "(the estimator without the factor), on the exact theory's forces and on the "
           "model's own, each with the model error carried (the default) and without it "
-          "(share 0: the filter before the model error was carried).\n")
+          "(share 0: the filter without the model error).\n")
     cause()
     share = defaults["friction_model_error"]
     exact_cycles = rig("exact")

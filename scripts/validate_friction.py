@@ -1,4 +1,4 @@
-"""Validation of slip-dependent friction (issue 13): creep curves Fx(xi) for several B.
+"""Validation of slip-dependent friction: creep curves Fx(xi) for several B.
 
 Exact solver (Kalker's theory, slip-dependent Coulomb projection) against
 FastSim on a Hertzian ellipse (Kalker's FastSim with the parabolic bound,

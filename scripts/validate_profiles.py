@@ -208,7 +208,7 @@ def report(results: dict[str, Any]) -> str:
                 for k, ck in (("cxi", "xi"), ("ceta", "eta"), ("cphi", "phi")):
                     if not _creep_ok(mine[k], getattr(theirs, ck)):
                         cr_miss.append(f"{side} {ref.number} {ck}")
-    add("## Targets (TARGETS.md)")
+    add("## Targets")
     add("")
     add("| what | target | measured | met |")
     add("| --- | --- | --- | --- |")

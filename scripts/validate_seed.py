@@ -2,10 +2,10 @@
 """The seed paper's comparison redone: DLM (Table 1, Figures 4-5) and ASM (Table 2, Figure 6).
 
 Writes ``docs/data/validation_seed.json``, ``docs/figures/seed_*.png`` and
-``docs/validation_seed.md`` (issue 22, parts 1-3): Kalker's deformation
+``docs/validation_seed.md``: Kalker's deformation
 levelling method (:mod:`fastsim_ros.contact.dlm`) and Knothe and Hung's
 asymptotic strip method (:mod:`fastsim_ros.contact.asm`) beside the paper's
-numbers (Tables 1 and 2 read from ``shared/reference/seed_tables_1_2.md``),
+numbers (Tables 1 and 2 read from the printed tables, when present),
 the readings of DLM that were tried and why the one in the package was kept,
 ASM's collocation fit (``--fit-asm``) and its check on the rows and Poisson
 ratios it was not fitted on, and the readings of Knothe and Hung's method
@@ -49,7 +49,7 @@ import asm_candidates  # noqa: E402
 DOCS = ROOT / "docs"
 DATA = DOCS / "data" / "validation_seed.json"
 FIG = DOCS / "figures"
-#: Kalker's published table (3 digits: ``shared/reference`` beside the checkout, or where
+#: Kalker's published table (3 digits: the reference directory beside the checkout, or where
 #: ``$SHARED_REFERENCE`` says); without it, the package's own (the exact solver's, within 1%
 #: of it: docs/validation.md), and the report says so
 PUBLISHED = Path(os.environ.get("SHARED_REFERENCE", ROOT.parent / "shared" / "reference")
@@ -352,7 +352,7 @@ def candidates_part() -> dict[str, Any]:
 
 
 def _meets(n: str, got: float, printed: float) -> bool:
-    """Return whether ``got`` meets the issue's target against a printed ASM value."""
+    """Return whether ``got`` meets the target against a printed ASM value."""
     e = abs(got / printed - 1.0)
     return e <= 0.02 if n != "C23" else (e <= 0.03 or abs(got - printed) <= 0.02)
 
@@ -431,7 +431,7 @@ def _report_candidates(add: Callable[[str], None], cand: dict[str, Any],
         " quadratic shape at the Gauss-Chebyshev points of the 2-D shape's weight (a"
         " placement defined by its own rule, not fitted) is the nearest of the natural"
         " placements, and it lies beside the least-squares fit of two points to the printed"
-        " column (s = 0.097, 0.667, rms 3.5%: exploration of the last session); but it"
+        " column (s = 0.097, 0.667, rms 3.5%: an earlier exploration); but it"
         " misses C11 and C22 by up to 4% and C23 by 17% at a/b = 0.1. (3) The one-term"
         " 2-D shape collocated once per strip, near the strip's middle, follows the printed"
         " C11 and C22 closely (the trend, exact at a/b = 0.1 and increasingly below Kalker"
@@ -471,7 +471,7 @@ def report(res: dict[str, Any]) -> None:
         f" on {res['machine']}; the run took {res['seconds']:.0f} s.\n")
     published = res.get("kalker") == "published"
     add("Kalker's coefficients: " + (
-        "his published table E.3 (`shared/reference/kalker_coefficients.csv`, 3 digits)."
+        "his published table E.3 (3 digits)."
         if published else "the package's own table (`fastsim_ros/data/kalker_coefficients"
         ".csv`, the exact solver's; the published one was not beside the checkout).") + "\n")
     add("Before proposing MAE, Alonso & Giménez (VSD 45(4), 2007) compare the ways FastSim's"
@@ -479,7 +479,7 @@ def report(res: dict[str, Any]) -> None:
         " method (DLM: their Table 1, Figures 4 and 5) and Knothe and Hung's asymptotic strip"
         " method (ASM: Table 2, Figure 6); Kalker's variational method is what the package's"
         " exact solver goes beyond. The paper's text itself was not at hand: the methods are"
-        " built from the issue's description of them (issue 22) and METHOD.md, and where a"
+        " built from the published descriptions of them, and where a"
         " choice was open it was settled by the evidence below. The paper's figures could not"
         " be seen either: Figures 4 to 6 below redraw what the tables compare (each method's"
         " coefficients over a/b against Kalker's) and what each method does (DLM's levelling,"
@@ -514,7 +514,7 @@ def report(res: dict[str, Any]) -> None:
     add("")
     misses = [(g, n, pk[str(g)][n] / TABLE1[(g, n)][1] - 1) for g in TABLE1_RATIOS
               for n in ("C11", "C22") if abs(pk[str(g)][n] / TABLE1[(g, n)][1] - 1) > 0.03]
-    add("Target (TARGETS.md): C11 and C22 within 3% of Table 1's DLM. "
+    add("Target: C11 and C22 within 3% of Table 1's DLM. "
         + ("Met." if not misses else "Met at a/b = 1 and 10; missed at " + ", ".join(
             f"a/b = {g:g} {n} {_pct(e)}" for g, n, e in misses) + "."))
     add("")
@@ -535,7 +535,7 @@ def report(res: dict[str, Any]) -> None:
         " traction alone (the iteration's first step) falls 20 to 50% short at a/b = 0.1 and"
         " 1;"
         " weighting the least squares by the traction fits a/b = 0.1's C11 but is 25-40% high"
-        " at a/b = 1 and 10. Of the readings the last session tried, the package's was the only"
+        " at a/b = 1 and 10. Of the readings tried, the package's was the only"
         " one within 2% of C11 and C22 at a/b = 1 and 10 (the chord-weighted one is new: see"
         " below). The"
         " iteration from the full-slip traction converges after one step, because the"
@@ -551,7 +551,7 @@ def report(res: dict[str, Any]) -> None:
         + f"{_grid_spread(d, 0.1):.1f}% between 40 and 160 cells; an exploration with square"
         " cells, 4 to 20 along x, moved them by up to 6%, downwards); neither is nu (an"
         " exploration over nu = 0..0.5: no single nu fits the three ratios). What is left is"
-        " what the issue's description of the method does not fix: the weights of its least"
+        " what the published description of the method does not fix: the weights of its least"
         " squares (and the paper's mesh, which amounts to weights). Table 1's a/b = 0.1 values"
         " lie between the unweighted levelling and the one weighted by the local traction (the"
         " table above), which weighs each strip's trailing part, where the traction is large,"
@@ -630,7 +630,7 @@ def report(res: dict[str, Any]) -> None:
     by_ratio = {round(float(g), 6): v for g, v in (a.get("cli") or rows).items()}
     if SEED_TABLES.exists():
         printed = read_table2(SEED_TABLES)
-        add("Table 2 as printed (`shared/reference/seed_tables_1_2.md`), both columns: the"
+        add("Table 2 as printed, both columns: the"
             " paper's ASM and Kalker's asymptotic method (AMK). **Mapping:** the printed"
             " labels of the two blocks are swapped; the first block (`b<a`, g = 0.1..0.9) is"
             " at a/b = g, the second (`b>a`, g = 1..0.1) at a/b = 1/g (`a` along the rolling"
@@ -665,13 +665,13 @@ def report(res: dict[str, Any]) -> None:
             label = f"{r.a_over_b:.4g} ({r.block}, {r.g:g})"
             add(f"| {'**' + label + '**' if fit else label} | " + " | ".join(cells) + " |")
         add("")
-        add("Target (the issue, TARGETS.md): the printed ASM columns within 2% (C23 within 3%"
+        add("Target: the printed ASM columns within 2% (C23 within 3%"
             f" or 0.02). {within} of {len(printed)} rows meet it; the worst deviations are "
             + ", ".join(f"{n} {_pct(e)} (a/b = {g:.3g})" for n, (g, e) in worst.items())
             + ". **Not reproduced.**\n")
         _report_candidates(add, res.get("candidates") or {}, printed)
     else:
-        add("(`shared/reference/seed_tables_1_2.md` is not beside this checkout: Table 2 as"
+        add("(The printed tables are not beside this checkout: Table 2 as"
             " printed is not shown.)\n")
     _figure_coefficients("seed_fig6_asm.png", "ASM against Kalker, nu = 0.25",
                          {float(g): v for g, v in rows.items()}, NU, marks={})

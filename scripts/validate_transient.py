@@ -13,7 +13,7 @@ the converged one), is sampled at the fast methods' steps.  The table gives,
 per step response, the largest gap between a fast method's ``F/(mu N)`` and
 the exact transient one over the steps, beside the same method's steady
 error (its steady answer against the exact steady one, converged alike), and
-the criterion of issue 29: the transient gap within the steady error plus
+the criterion: the transient gap within the steady error plus
 0.02.
 """
 
@@ -329,7 +329,7 @@ def main() -> None:
              "`fastsim_ros/contact/transient.py` on each method's patch. Forces as F/(mu N) "
              "(Fx for the xi step, Fy for eta and phi). gap: the largest |fast - exact| "
              "over the steps; steady error: |fast steady - exact steady| at the step's "
-             "creepage; ok: gap <= steady error + 0.02 (issue 29). levels: the largest "
+             "creepage; ok: gap <= steady error + 0.02. levels: the largest "
              "steady error at the creepages the response passes through on its way (the "
              f"step's creepage times {LEVELS[0]:g} to 1 in steps of {LEVELS[1] - LEVELS[0]:g}"
              ", and the step's own), the steady method's own error over the levels of "

@@ -2,12 +2,12 @@
 """Wider validation: exact vs the calibrated and the paper's MAE, FaStrip and the ellipse.
 
 Writes ``docs/data/validation_wider.json``, ``docs/figures/wider_*.png`` and
-``docs/validation_wider.md`` (issue 12, first part; issue 22).  The areas: the nine of
+``docs/validation_wider.md``.  The areas: the nine of
 ``scripts/validate.py`` (the Hertzian ellipse, FastSim's own floor, and the
 eight non-elliptical ones), the new ones of :mod:`fastsim_ros.contact.samples`:
 a long narrow patch, a crescent, an egg and normal-solver patches on a
 profile gap at three lateral shifts from the tread to the flange root, and
-issue 22's nine beyond the calibrated MAE's selection (``BEYOND``: eggs,
+nine areas beyond the calibrated MAE's selection (``BEYOND``: eggs,
 crescents, asymmetric lobes, flat bands).  Methods: the calibrated MAE, the
 paper's MAE, FaStrip, the equivalent ellipse, DLM and ASM; the calibrated MAE
 also without each of its rules (the leave-one-out check).
@@ -16,7 +16,7 @@ For each area: force-creepage curves under ``xi``, ``eta``, ``phi`` and
 combined (the levels of ``scripts/validate.py``) from the exact theory
 (Coulomb friction, given pressure) and the four online methods on one
 grid; the linear-range ``C~11, C~22, C~23`` (exact: extrapolated over four
-grids, METHOD.md 5; the methods on 60 cells); the cost per solve; and a grid
+grids, docs/guide_physics.md; the methods on 60 cells); the cost per solve; and a grid
 check of the curves on a finer grid for two areas.  Besides, the selection
 areas (pairs of semi-ellipses other than the validation's and two
 notches: neither validation areas nor the pair-factor table's own) on which the calibrated MAE's
@@ -97,7 +97,7 @@ BASELINES = ("mae", "fastrip", "ellipse")
 #: bar offsets of the methods in the figures
 BAR = 0.13
 NEW = ("long narrow", "crescent", "egg")
-#: issue 22's areas beyond the calibrated MAE's selection (made after its rules were fixed,
+#: the areas beyond the calibrated MAE's selection (made after its rules were fixed,
 #: never looked at while choosing them): eggs with the longer half trailing and leading,
 #: crescents of other bends and widths (horns leading and trailing), asymmetric lobes, flat
 #: bands.  Name -> (maker of the unit-area shape, keywords)
@@ -236,7 +236,7 @@ def coefficients_of(make: AreaMaker) -> dict[str, Any]:
     out: dict[str, Any] = {"exact": _extrapolated(make)}
     calibrated: Callable[[Any, Any], Any] = (
         lambda a, tab: mae_calibrated_coefficients(a, tab, pairs))
-    # MAE's own coefficients (METHOD.md 3.5, eq. 7 with the zones' semi-ellipses, no FastSim):
+    # MAE's own coefficients (the physics guide, eq. 7 with the zones' semi-ellipses, no FastSim):
     # what the calibrated method's rules 2 and 3 leave as they are
     own: Callable[[Any, Any], Any] = lambda a, tab: mae_coefficients(mae_geometry(a), tab)
     for m, f in (("mae_calibrated", calibrated), ("mae", mae_fastsim_coefficients),
@@ -309,8 +309,8 @@ def ablation_on(entry: dict[str, Any], ar: areas.GridArea) -> None:
                 p["without_" + rule] = [r.fx, r.fy, r.mz]
 
 
-#: the areas rule 4's second form was chosen on (issue 22: an egg whose longer half trails
-#: was 26% high in C~23 with the first form); none of them is a validation area
+#: the areas rule 4's second form was chosen on (an egg whose longer half trails
+#: is 26% high in C~23 with the first form); none of them is a validation area
 BEND_SELECTION: dict[str, tuple[Callable[..., areas.GridArea], dict[str, Any]]] = {
     **{f"egg {r:g}": (samples.egg_patch, {"lead_over_trail": r}) for r in (0.5, 0.7, 1.4, 2.5)},
     **{f"egg {r:g} a/b {g:g}": (samples.egg_patch, {"lead_over_trail": r, "a_over_b": g})
@@ -328,7 +328,7 @@ BEND_SELECTION: dict[str, tuple[Callable[..., areas.GridArea], dict[str, Any]]] 
 
 def _first_form_offset(area: areas.GridArea, geometry: Any, zone: Any, rows: Any,
                        c: dict[str, float]) -> dict[str, float]:
-    """Rule 4's first form (issue 12): every strip offset counted, each strip once."""
+    """Rule 4's first form: every strip offset counted, each strip once."""
     count, first, last = calibrated_module.row_extents(area.mask & rows[:, None])
     used = count > 0
     centres = 0.5 * (area.x[first[used]] + area.x[last[used]])
@@ -394,7 +394,7 @@ def coefficient_grid_check(names: list[str]) -> dict[str, Any]:
 
 
 def cost_ratio(calls: int = 3000) -> dict[str, Any]:
-    """Time the calibrated and the paper's MAE side by side on 30x30 patches (TARGETS.md).
+    """Time the calibrated and the paper's MAE side by side on 30x30 patches.
 
     ``benchmarks/bench_fastsim.py``'s patches (two semi-ellipses 0.5/2 of 1 cm^2 and a
     Hertzian 6 x 4 mm ellipse, 50 kN), creepages and interleaved timing (``per_call``);
@@ -591,7 +591,7 @@ def report(res: dict[str, Any]) -> None:
     # ------------------------------------------------------------------ coefficients
     add("## 2. Linear-range coefficients\n")
     add(f"nu = {NU}, about each area's origin. Exact: full adhesion extrapolated to zero cell"
-        f" size over n = {EXACT_GRIDS} (fit C0 + k/n, METHOD.md 5; error = change without the"
+        f" size over n = {EXACT_GRIDS} (fit C0 + k/n; error = change without the"
         f" coarsest grid). Methods at vanishing creepage on {ONLINE_CELLS} cells: MAE +"
         " FastSim, FaStrip and equivalent-ellipse FastSim. Deviation from exact in %; C13 (a"
         " coupling that crosses zero) in % of C11.\n")
@@ -670,7 +670,7 @@ def report(res: dict[str, Any]) -> None:
     add("## 4. Where the paper's MAE falls short, and what the calibrated MAE does there\n")
     _causes(add, d)
     _selection(add, res)
-    # ------------------------------------------------------------------ issue 22
+    # ------------------------------------------------------- beyond the selection
     _beyond(add, res)
     # ------------------------------------------------------------------ curves figures
     add("## 5. Curves of the new areas\n")
@@ -707,10 +707,10 @@ def _curve_excess(e: dict[str, Any], m: str, base: str) -> tuple[float, str]:
 
 
 def _beyond(add: Callable[[str], None], res: dict[str, Any]) -> None:
-    """Write section 6: the calibrated MAE on areas outside its selection (issue 22)."""
+    """Write section 6: the calibrated MAE on areas outside its selection."""
     d = res["areas"]
     m = "mae_calibrated"
-    add("## 6. The calibrated MAE beyond its selection (issue 22)\n")
+    add("## 6. The calibrated MAE beyond its selection\n")
     fresh = [n for n in BEYOND if n not in SEEN]
     add(f"{len(BEYOND)} areas made after the calibrated MAE's rules were fixed (`BEYOND` in"
         " the script): eggs with the longer half trailing and leading, crescents of other"
@@ -723,7 +723,7 @@ def _beyond(add: Callable[[str], None], res: dict[str, Any]) -> None:
         " a bend only where its horns lead, and two more crescents with trailing horns were"
         " made after the change to check it: that one area is the change's fit data, the"
         f" other {len(fresh)} were never looked at while choosing any rule. Targets"
-        " (issue 22, TARGETS.md): curves within 10% of mu N where the exact force exceeds 5%"
+        ": curves within 10% of mu N where the exact force exceeds 5%"
         " of mu N; C~23 within 5% of exact, or 0.05 where it is near zero (below 1); no curve"
         " worse than the paper's MAE's by more than 1 point of mu N.\n")
     add("| area | worst curve, calibrated / paper's MAE | largest excess over the paper's MAE"
@@ -893,11 +893,11 @@ def _coef_dev(e: dict[str, Any], m: str, key: str) -> float:
 
 
 def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
-    """Write section 0: the calibrated MAE's rules and the issue's targets, met or missed."""
+    """Write section 0: the calibrated MAE's rules and the targets, met or missed."""
     d = res["areas"]
     m = "mae_calibrated"
     add("## 0. The calibrated MAE and its targets\n")
-    add("The paper's MAE (METHOD.md 3) stays as it is (`mae`); the calibrated MAE keeps its"
+    add("The paper's MAE stays as it is (`mae`); the calibrated MAE keeps its"
         " steps 1-3 (centroid, split, each zone likened to a semi-ellipse) and changes what"
         " the validation below shows off, each by a rule from the exact theory"
         " (`fastsim_ros/contact/mae_calibrated.py` states each with its evidence):\n")
@@ -921,7 +921,7 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
         " centroid (the strips' centres fitted as `alpha + beta l + kappa l^2` in the"
         " half-chord `l`, the `kappa` part counted: a crescent's offsets count, an egg's,"
         " proportional to the chord, do not; no parameter fitted). The first form (every"
-        " offset counted) was 26% high in C~23 on an egg whose longer half trails (issue 22);"
+        " offset counted) was 26% high in C~23 on an egg whose longer half trails;"
         " section 6 shows the selection of the second form and the rules' check beyond their"
         " selection.\n")
     non_ell = [n for n in d if not n.startswith("ellipse")]
@@ -937,7 +937,7 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
                               - (curve_error(d[hertz], c, "mae") or 0.0)), c) for c in CURVES)
     worst_coef = max(((abs(_c_error(d[n], m, key)), n, key) for n in d
                       for key in ("C11", "C22", "C23")))
-    add("| target (issue 12, TARGETS.md) | measured | |")
+    add("| target | measured | |")
     add("| --- | --- | --- |")
     add(f"| force-creepage curves within 10% of mu N where the exact force exceeds 5% of mu N,"
         f" every area | worst {100 * worst[m][0]:.1f}% ({worst[m][1]}) |"
@@ -990,11 +990,10 @@ def _targets(add: Callable[[str], None], res: dict[str, Any]) -> None:
         + (" (every one)" if len(better) == len(d) else
            f" (not on {', '.join(n for n in d if n not in better)})")
         + ", and smaller than every other method's worst case over all areas: so"
-        + (" `mae_calibrated` is the default of the node (and of `fastsim_contact wheelset`;"
-           " `fastsim_contact forces` keeps the paper's `mae`, the default INTERFACE.md fixes"
-           " for that command)"
-           " (INTERFACE.md: the default changes when the report shows another method better"
-           " on every area)." if len(better) == len(d) else " the default stays `mae`.")
+        + (" `mae_calibrated` is the default of the node and of `fastsim_contact forces` and"
+           " `wheelset` (a method becomes the default when this report shows it better than"
+           " the paper's MAE on every area)." if len(better) == len(d)
+           else " the default stays `mae`.")
         + " The table that decides it (worst curve error per area, % of mu N):\n")
     add("| area | " + " | ".join(LABELS[k] for k in METHODS) + " |")
     add("| --- | " + " | ".join("---" for _ in METHODS) + " |")
@@ -1061,7 +1060,7 @@ def _pc(v: float) -> str:
 
 
 def _causes(add: Callable[[str], None], d: dict[str, Any]) -> None:
-    """Write the three causes of issue 12 with the numbers that show them."""
+    """Write the three causes of the paper's MAE's errors with the numbers that show them."""
     def dev(name: str, m: str, key: str) -> float:
         co = d[name]["coefficients"]
         return float(co[m][key] / co["exact"][key] - 1)

@@ -31,7 +31,7 @@ def contact_normal(gamma: float, side: str = "left") -> tuple[float, float, floa
 def cloud_msg(area: GridArea, *, origin=LEFT, normal=(0.0, 0.0, 1.0), stamp_ns=0,
               frame_id="wheelset", dtype="<f4", field_order=None, pad=0,
               reverse_rows=False, reverse_columns=False, pressure=None) -> PointCloud2:
-    """Return an organised patch cloud of ``area`` (INTERFACE.md layout).
+    """Return an organised patch cloud of ``area`` (the node's input layout).
 
     ``field_order``: names in the order to pack (default PATCH_FIELDS);
     ``pad``: extra bytes after each point; ``reverse_*``: points run the
@@ -89,7 +89,7 @@ def rolling_twist(xi: float, *, speed: float = 20.0, radius: float = WHEEL_RADIU
     """Return the twist of a wheelset on track at ``speed`` (m/s) with creepage ``xi``.
 
     ``omega R = v0 (1 - xi/2) / (1 + xi/2)`` gives ``xi = (v0 - omega R)/V``
-    with ``V = (v0 + omega R)/2`` (INTERFACE.md).
+    with ``V = (v0 + omega R)/2``.
     """
     omega = speed * (1.0 - xi / 2.0) / (1.0 + xi / 2.0) / radius
     return twist_msg((speed, 0.0, 0.0), (0.0, omega, 0.0), stamp_ns=stamp_ns)

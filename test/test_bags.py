@@ -1,4 +1,4 @@
-"""The bundled bags: readable, small, reproducible, with patches of the interface's layout."""
+"""The bundled bags: readable, small, reproducible, with patches of the node's input layout."""
 
 from dataclasses import fields, is_dataclass
 import importlib.util

@@ -29,7 +29,7 @@ def write_patch(path, area, *, extra_rows=()):
 
 
 def test_circle_exact_coefficients_match_kalker(capsys):
-    # The issue's acceptance command.
+    # The command of the guide's quick start.
     rc, out, err = run(capsys, "coefficients", "--shape", "ellipse", "--a-over-b", "1",
                        "--nu", "0.25", "--method", "exact", "--json")
     assert rc == 0 and err == ""
@@ -49,7 +49,7 @@ def test_patch_coefficients_refer_to_the_file_origin(tmp_path, capsys):
     c0 = json.loads(run(capsys, "coefficients", "--patch", str(base), "--json")[1])
     c1 = json.loads(run(capsys, "coefficients", "--patch", str(moved), "--json")[1])
     assert c1["C11"] == pytest.approx(c0["C11"], rel=1e-9)
-    # the area moved by +0.1 in y: the origin lies 0.1 below it (METHOD.md 3.5)
+    # the area moved by +0.1 in y: the origin lies 0.1 below it (docs/guide_physics.md "MAE")
     shift = (c0["C11"] * -0.1) / math.sqrt(c0["area"] / math.pi)
     assert c1["C13"] == pytest.approx(c0["C13"] + shift, rel=1e-8)
 
@@ -237,7 +237,7 @@ def test_bad_friction_flags_one_line_exit_2(capsys, extra, match):
 
 
 def test_forces_default_method_is_the_nodes(capsys):
-    """No --method: the node's default method, the calibrated MAE (INTERFACE.md)."""
+    """No --method: the node's default method, the calibrated MAE."""
     from pathlib import Path
     patch = Path(__file__).resolve().parents[1] / "fastsim_ros" / "data" / "example_patch.csv"
     argv = ["forces", "--patch", str(patch), "--xi", "1e-3", "--eta", "-5e-4", "--phi", "0.5",

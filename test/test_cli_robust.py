@@ -1,4 +1,4 @@
-"""``fastsim_contact`` on any file and any flag (INTERFACE.md "Bad input", TARGETS.md robustness).
+"""``fastsim_contact`` on any file and any flag (docs/guide_node.md, robustness).
 
 The contract: a right answer, or one line on stderr naming the problem and exit
 status 2; never a traceback, never a non-finite number printed, no warning on
@@ -232,8 +232,8 @@ def test_unreadable_patch_files(tmp_path, capsys, monkeypatch):
 
 
 @pytest.mark.parametrize("stray", [
-    "1000.0,0.0,1e6",           # 1 km away along x (used to take 6 s and 0.5 GB)
-    "2.0,1.5,1e6",              # a few metres away on both axes (used to need 48 GiB)
+    "1000.0,0.0,1e6",           # 1 km away along x (a grid to it: 6 s and 0.5 GB)
+    "2.0,1.5,1e6",              # a few metres away on both axes (a grid: 48 GiB)
     "0.0,1e5,1e6",              # 100 km away along y
 ])
 def test_a_stray_cell_far_away_is_refused_by_the_grid_bound(tmp_path, capsys, monkeypatch,
@@ -437,9 +437,9 @@ def test_coordinates_written_with_few_digits_are_the_grid_they_round(tmp_path, c
                                                                      regular):
     """A 70 x 70 ellipse written to 5 or 4 significant digits, or to the micrometre.
 
-    The spacing was the median of the rounded gaps (1.7140e-4 m for
-    1.7142857e-4): its error grew along a row to 2e-6 m and the file was
-    refused as irregular.  The grid is now fitted through every coordinate;
+    The median of the rounded gaps as the spacing (1.7140e-4 m for
+    1.7142857e-4) would err by up to 2e-6 m along a row and refuse the file
+    as irregular, so the grid is fitted through every coordinate;
     a centre more than a hundredth of a cell off it is still irregular (3
     digits: a third of a cell).
     """
@@ -478,7 +478,7 @@ def test_estimate_names_its_measured_file_in_read_errors(tmp_path, capsys):
     assert_refused(rc, out, err, f"cannot read measured file {tmp_path / 'none.csv'}")
 
 
-# ------------------------------------------------------ from an audit of the contract (stop 41)
+# ------------------------------------------------------ the command line's documented edges
 
 @pytest.mark.parametrize("cells", ["4", "5"])
 def test_an_extrapolation_of_one_grid_is_refused(capsys, cells):
@@ -512,7 +512,7 @@ def test_dlm_on_a_patch_too_thin_to_level_is_bad_input(capsys, tmp_path, command
 
 
 def test_cells_beside_a_patch_and_a_over_b_beside_forces_are_refused(capsys):
-    """Flags dropped without a word before: each is named."""
+    """Flags that a parser could drop without a word: each is named."""
     assert_refused(*run(capsys, "coefficients", "--patch", EXAMPLE, "--cells", "20",
                         "--method", "mae"), "--cells sets a shape's grid")
     assert_refused(*run(capsys, "forces", *ELLIPSE, "--a-over-b", "2", *CREEP),
@@ -548,7 +548,7 @@ def test_an_answer_that_cannot_be_written_is_one_line(tmp_path):
 
 
 def test_exact_forces_on_a_shape_are_extrapolated_within_one_percent(capsys):
-    """INTERFACE.md: exact's default grid converged within 1%; on 60 cells alone Fy was 1.7% off.
+    """Exact's default grid converges within 1%; on 60 cells alone Fy is 1.7% off.
 
     An ellipse under spin (the audit's case): the default answer, extrapolated
     from 30 and 60 cells, against the extrapolation from 60 and 120.

@@ -27,7 +27,7 @@ def run(capsys, *argv):
 
 @pytest.fixture(scope="module")
 def done_when(tmp_path_factory):
-    """Run the issue's command: both wheels' patches and forces, the roll solved."""
+    """Run the documented command: both wheels' patches and forces, the roll solved."""
     import io
     import contextlib
     out = io.StringIO()
@@ -63,7 +63,7 @@ def test_the_json_has_both_wheels_with_their_patches_and_track_forces(done_when)
 
 def test_the_pipeline_given_that_roll_answers_with_the_same_numbers(done_when):
     # what the node does with a pose and a load message: the command line's numbers
-    # within INTERFACE.md's 1e-9 (the pose's quaternion rounds roll and yaw by 1e-16,
+    # within the documented 1e-9 (the pose's quaternion rounds roll and yaw by 1e-16,
     # which the iterative solves carry to about 4e-12 here)
     r = done_when
     config = PipelineConfig.from_values({"patch_source": "profiles", "wheel_load": 0.0})

@@ -106,7 +106,7 @@ def test_table2_reading_maps_its_amk_columns_onto_kalkers_table():
     # the printed labels of the two blocks are swapped: the AMK columns are Kalker's at a/b = g
     # (first block) and 1/g (second), to the 3-digit rounding, but for the one misprint
     if not SEED_TABLES.exists():
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     from fastsim_ros.contact.seed_tables import read_table2
     published = {}
     for line in (SEED_TABLES.parent / "kalker_coefficients.csv").read_text().splitlines():
@@ -132,7 +132,7 @@ def _table2_rows() -> list:
 
 
 def _meets_issue_target(name: str, got: float, printed: float) -> bool:
-    # issue 30: within 2%; C23 within 3% or 0.02
+    # the target: within 2%; C23 within 3% or 0.02
     err = abs(got / printed - 1.0)
     return err <= 0.02 if name != "C23" else (err <= 0.03 or abs(got - printed) <= 0.02)
 
@@ -146,7 +146,7 @@ def test_table2_asm_columns_as_printed(row):
     # each row of Table 2 (a/b mapped as the reference file states) at the package's ASM, as
     # `fastsim_contact coefficients --shape ellipse --method asm --nu 0.25` reports it
     if row is None:
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     c = ellipse_coefficients(row.a_over_b, nu=NU, strips=60)
     misses = [(name, got, printed) for name, got, printed in
               zip(("C11", "C22", "C23"), (c.C11, c.C22, c.C23), row.asm)

@@ -365,7 +365,7 @@ def test_vanishing_creepage_is_linear(case, solver_type):
 
 
 def test_vanishing_creepage_gives_kalker_on_ellipse(mae, baseline, table):
-    # FastSim with the pinned discretisation is within 0.1% of Kalker at 60x60 (METHOD.md 2)
+    # FastSim with the pinned discretisation is within 0.1% of Kalker at 60x60 (the physics guide)
     a, b = 6e-3, 4e-3
     ar = areas.ellipse(a, b, nx=60, load=5e4)
     c11, c22, _ = table.kalker(a / b)

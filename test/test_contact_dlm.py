@@ -115,9 +115,9 @@ def _table1_rows() -> list:
 @pytest.mark.parametrize("row", _table1_rows(),
                          ids=lambda r: "absent" if r is None else f"a/b={r.a_over_b:g}")
 def test_table_1_dlm_values_as_printed(row):
-    # Table 1 read from the reference file: DLM's C11 and C22 within 3% (issue 30)
+    # Table 1 read from the reference file: DLM's C11 and C22 within 3% (the target)
     if row is None:
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     c = dlm_coefficients(ellipse(row.a_over_b, 60), nu=NU)
     assert c.C11 == pytest.approx(row.dlm[0], rel=0.03)
     assert c.C22 == pytest.approx(row.dlm[1], rel=0.03)
@@ -128,7 +128,7 @@ def test_table_1_dlm_values_as_printed(row):
 def test_chord_weighted_levelling_reproduces_table_1(row):
     # the named option: every cell weighted by its strip's length (docs/validation_seed.md, 1)
     if row is None:
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     c = DLM_CHORD_FASTSIM.coefficients(ellipse(row.a_over_b, 60), nu=NU)
     assert c.C11 == pytest.approx(row.dlm[0], rel=0.03)
     assert c.C22 == pytest.approx(row.dlm[1], rel=0.03)
@@ -136,7 +136,7 @@ def test_chord_weighted_levelling_reproduces_table_1(row):
 
 def test_table_1_reading_gives_kalkers_values_as_its_amk_numbers():
     if not SEED_TABLES.exists():
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     from fastsim_ros.contact.seed_tables import read_table1
     rows = read_table1(SEED_TABLES)
     assert [r.a_over_b for r in rows] == [0.1, 1.0, 10.0]

@@ -39,7 +39,7 @@ def test_fft_solver_equals_dense_reference(make):
 @pytest.mark.parametrize("g", [0.2, 1.0, 5.0])
 @pytest.mark.parametrize("n", [16, 23])
 def test_eta_coefficient_of_mz_equals_c23_on_every_grid(g, n):
-    # With the upstream difference and w at cell centres, C32 = C23 exactly (METHOD.md 5).
+    # With the upstream difference and w at cell centres, C32 = C23 exactly (the physics guide).
     a, b = areas.semi_ellipse_axes(g)
     c = exact.creep_coefficients(areas.ellipse(a, b, nx=n, ny=n + 3), nu=0.25)
     assert c.C32 == pytest.approx(c.C23, rel=1e-8)
@@ -47,7 +47,7 @@ def test_eta_coefficient_of_mz_equals_c23_on_every_grid(g, n):
 
 
 def test_circle_converges_to_kalker():
-    # First-order extrapolation in the cell size (METHOD.md 5) over four grids, 40 .. 100
+    # First-order extrapolation in the cell size (docs/guide_physics.md) over four grids, 40 .. 100
     # cells across; cached, so the command line's test of the same circle reuses it.
     assert exact.extrapolation_grids(100) == [40, 60, 80, 100]
     c = exact.extrapolated_coefficients("ellipse", (1.0,), nu=0.25)

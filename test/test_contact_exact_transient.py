@@ -140,8 +140,8 @@ def test_a_step_whose_newton_cycles_from_the_last_state_still_converges() -> Non
     """An eta step on an ellipse a/b = 0.5: Newton from the previous tractions cycles at step 5.
 
     The step restarts from full adhesion then (``transient_step``); the
-    answer rises monotonically to the steady one (the fifth step used to
-    raise ConvergenceError).
+    answer rises monotonically to the steady one (Newton from the last state
+    alone raises ConvergenceError at the fifth step).
     """
     from fastsim_ros.contact import area as areas
     nu, g, mu, load = 0.28, 8e10, 0.3, 4e4

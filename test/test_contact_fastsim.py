@@ -35,7 +35,7 @@ def unit_coefficients(ar, flex, a, b):
 @pytest.mark.parametrize("g", RATIOS)
 @pytest.mark.parametrize("n, tol", [(30, 0.03), (60, 0.0015)])
 def test_vanishing_creepage_reproduces_kalker(g, nu, n, tol):
-    # METHOD.md 2: the pinned discretisation is within +2.0% (C11, C22) and +2.8% (C23) of
+    # the physics guide: the pinned discretisation is within +2.0% (C11, C22) and +2.8% (C23) of
     # Kalker at 30x30 cells (nominal area) and within 0.1% at 60x60.
     a, b = areas.semi_ellipse_axes(g)
     ar = areas.ellipse(a, b, nx=n, ny=n)

@@ -1,4 +1,4 @@
-"""Slip-dependent friction (issue 13): the laws, FastSim, MAE, the ellipse, the exact solver.
+"""Slip-dependent friction: the laws, FastSim, MAE, the ellipse, the exact solver.
 
 Physics asserted: A = 1 or B = 0 is constant friction bit for bit; in every
 slipping cell the traction equals mu(v) p with v the slip velocity that the

@@ -1,11 +1,12 @@
-"""The physics core's dependencies point down (README "The physics core": what may import what).
+"""The physics core's dependencies point down (docs/guide_physics.md: what may import what).
 
 Each module's imports (top-level and inside functions) are read from its source
-and compared with the table the README gives; and the compiled fast path is
-imported and run with SciPy made unimportable.
+and compared with ``ALLOWED``, the table the guide gives (checked equal); and
+the compiled fast path is imported and run with SciPy made unimportable.
 """
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -14,7 +15,7 @@ import pytest
 
 CONTACT = Path(__file__).resolve().parents[1] / "fastsim_ros" / "contact"
 
-#: third-party packages and package modules each module may import (the README table)
+#: third-party packages and package modules each module may import (the guide's table)
 ALLOWED = {
     "errors": set(),
     "checks": {"errors"},
@@ -76,6 +77,22 @@ def imports_of(path):
             elif name.split(".")[0] not in sys.stdlib_module_names and name != "__future__":
                 found.add(name.split(".")[0])
     return found
+
+
+GUIDE = CONTACT.parents[1] / "docs" / "guide_physics.md"
+THIRD_PARTY = ("numpy", "numba", "scipy", "threadpoolctl")
+
+
+def test_the_guide_states_the_table():
+    """The guide's module table names every module with the imports ``ALLOWED`` gives it."""
+    rows = {}
+    for line in GUIDE.read_text(encoding="utf-8").splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3 and re.fullmatch(r"`\w+\.py`", cells[0]):
+            uses = cells[2].split("(")[0]
+            rows[cells[0][1:-4]] = (set(re.findall(r"`(\w+)`", uses))
+                                    | {w for w in THIRD_PARTY if re.search(rf"\b{w}\b", uses)})
+    assert rows == ALLOWED
 
 
 def test_every_module_is_in_the_table():

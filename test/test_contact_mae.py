@@ -1,4 +1,4 @@
-"""MAE (numpy reference): the exactness checks of METHOD.md section 6."""
+"""MAE (numpy reference): the exactness checks of docs/guide_physics.md "Exactness checks"."""
 
 import math
 
@@ -104,7 +104,7 @@ def test_semi_ellipses_widest_strip_recovers_the_halves(g1):
     t = coefficient_table(0.25)
     c = mae_coefficients(geo, t)
     h1, h2 = t.half(g1), t.half(1.0)
-    # METHOD.md 3.5 with equal halves: C~ij = c_ij(g1) + c_ij(g2), C~13 = c13(g1) - c13(g2)
+    # docs/guide_physics.md with equal halves: C~ij = c_ij(g1) + c_ij(g2), C~13 = c13(g1) - c13(g2)
     assert c.C11 == pytest.approx(h1["c11"] + h2["c11"], rel=0.01)
     assert c.C22 == pytest.approx(h1["c22"] + h2["c22"], rel=0.01)
     assert c.C23 == pytest.approx(h1["c23"] + h2["c23"], rel=0.01)
@@ -317,12 +317,12 @@ def test_compiled_mae_forces_of_a_mirror_image_are_mirrored(method):
 @pytest.mark.parametrize("cells", [21, 31, 45])
 @pytest.mark.parametrize("ratio", [1.2, 3.0])
 def test_an_ellipse_on_an_odd_number_of_strips_has_no_spin_coupling(cells, ratio):
-    """METHOD.md 6: on an ellipse ``C~13 = 0``, pure spin gives no ``Fx``, on any grid.
+    """docs/guide_physics.md: on an ellipse ``C~13 = 0``, pure spin gives no ``Fx``, on any grid.
 
     With an odd number of strips the centre line runs through the middle
-    strip; either face alone as the split gave ``C~13`` = -0.03 (a/b = 3, 31
+    strip; either face alone as the split gives ``C~13`` = -0.03 (a/b = 3, 31
     strips) and ``Fx`` of +159 N under pure spin (a yaw moment from nothing
-    on a centred wheelset).  The two faces' flexibilities are now averaged.
+    on a centred wheelset), so the two faces' flexibilities are averaged.
     """
     from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
     from fastsim_ros.contact.mae import mae_area_coefficients, split_tie

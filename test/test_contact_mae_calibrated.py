@@ -153,7 +153,7 @@ def _zone_sums(ar, table, pairs):
 @pytest.mark.parametrize("cells", [12, 20, 41])
 def test_fastsim_gives_the_zone_coefficients_on_any_grid(table, pairs, cells):
     # the paper's flexibilities reproduce a zone's coefficients on the continuous
-    # semi-ellipse only (+2% at 30 cells, METHOD.md 2); calibrated on the cells, FastSim
+    # semi-ellipse only (+2% at 30 cells, docs/guide_physics.md); calibrated on the cells, FastSim
     # gives them on any grid (an ellipse centred on x = 0: C~23 about S is about the origin)
     ar = areas.ellipse(6e-3, 4e-3, nx=cells, ny=cells + 3)
     c = mae_calibrated_coefficients(ar, table, pairs)

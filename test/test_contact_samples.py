@@ -55,7 +55,7 @@ def test_semi_ellipses_patch_keeps_the_shape_and_its_join_line(g1):
     # the Hertz-like pressure is positive on every cell of the two halves, and on no other
     np.testing.assert_array_equal(ar.mask, shape.mask)
     assert ar.area == pytest.approx(1e-4, rel=0.05)
-    # joined along y = 0: MAE's widest_strip split finds the join line (METHOD.md 6)
+    # joined along y = 0: MAE's widest_strip split finds the join line (docs/guide_physics.md)
     assert mae_geometry(ar, "widest_strip").y_s == pytest.approx(0.0, abs=1e-12)
 
 

@@ -25,7 +25,7 @@ def read_csv(path):
 def published():
     path = REFERENCE / "kalker_coefficients.csv"
     if not path.exists():
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     return read_csv(path)
 
 
@@ -59,7 +59,7 @@ def test_every_published_entry_within_one_percent_or_shown_converged():
             if abs(mine - pub) <= max(0.01 * pub, rounding(pub)):
                 continue
             misses.append((key, name, pub, mine))
-            # METHOD.md 6: at the long end the published values may be ~1% low; such an
+            # docs/guide_physics.md: at the long end the published values may be ~1% low; such an
             # entry must be converged on two cell shapes that agree with each other.
             shapes = checked.get((float(row["a_over_b"]), float(row["nu"])))
             assert shapes is not None and len(shapes) == 2, (key, name, pub, mine)
@@ -85,7 +85,7 @@ def test_half_table_is_half_of_kalker_where_symmetry_says_so():
 def test_half_table_matches_the_independent_reference():
     path = REFERENCE / "half_ellipse_coefficients_nu025.csv"
     if not path.exists():
-        pytest.skip("shared/reference is not beside this checkout")
+        pytest.skip("the published reference tables are not beside this checkout")
     half = shipped("half_ellipse_coefficients.csv")
     for row in read_csv(path):
         mine = half[(round(float(row["a_over_b"]), 4), 0.25)]

@@ -319,7 +319,7 @@ def test_steps_of_whole_cells_reach_the_steady_state_under_spin(solver_cls, cell
 
 @pytest.mark.parametrize("kind", ["xi", "phi"])
 def test_step_response_follows_the_exact_transient_solver(kind: str) -> None:
-    """A creepage step at V dt / a = 0.3: within the steady error plus 2 % of mu N (issue 29)."""
+    """A creepage step at V dt / a = 0.3: within the steady error plus 2 % of mu N."""
     a, n, load = 6e-3, 20, 4e4
     ar = areas.ellipse(a, a, nx=n, ny=n, load=load)
     creep = (1.5e-3, 0.0, 0.0) if kind == "xi" else (0.0, 0.0, 3.0)

@@ -260,9 +260,9 @@ def test_save_and_read_round_trip(table, wheelset, grid, tmp_path):
 def test_a_damaged_table_file_is_a_table_error(table, wheelset, grid, tmp_path):
     """Empty, truncated, bit-flipped, a plain array, NaN pressures: TableError, never another.
 
-    The cache then rebuilds (cached_table catches TableError); before, an
-    EOFError, BadZipFile, TypeError or ValueError ended the node's start with
-    a traceback, and the lifecycle node's configure failed without a word.
+    The cache then rebuilds (cached_table catches TableError), where an
+    EOFError, BadZipFile, TypeError or ValueError would end the node's start
+    with a traceback and fail the lifecycle node's configure without a word.
     """
     key = table_key(wheelset, grid, LOAD)
     good = tmp_path / "t.npz"

@@ -1,4 +1,4 @@
-"""Creepages from twists: the general rigid-body form of INTERFACE.md on the cases a rig has."""
+"""Creepages from twists: the general rigid-body form (docs/guide_physics.md) on a rig's cases."""
 
 import math
 
@@ -58,7 +58,7 @@ def test_yawed_wheelset_has_eta_minus_yaw(yaw):
 def test_wheel_on_a_roller_gives_the_speed_mismatch():
     # wheel centre at rest, spinning at omega_w; roller of radius Rr below it,
     # centre c_r = (0, y, -(R + Rr)), turning at w_r = (0, -omega_r, 0):
-    # v_r = w_r x (0 - c_r) (INTERFACE.md "rail/twist")
+    # v_r = w_r x (0 - c_r) (docs/guide_node.md)
     rr, y = 0.7, 0.0
     omega_w = 15.0 / R
     omega_r = 15.03 / rr

@@ -1,7 +1,7 @@
 """fastsim_node over real DDS on loopback: started from its installed script, driven by a client.
 
-Wrenches must equal the library's for the same inputs; every bad input of
-INTERFACE.md gives no wrench, a diagnostic naming its reason, and the next
+Wrenches must equal the library's for the same inputs; every bad input
+(docs/guide_node.md) gives no wrench, a diagnostic naming its reason, and the next
 good input is served; refused parameters leave the node running; SIGTERM
 ends it cleanly.
 """
@@ -171,7 +171,7 @@ def test_roller_rig_config(run_node):
 
 
 def bad_inputs():
-    """Return (reason, patch message builder) for every bad input of INTERFACE.md."""
+    """Return (reason, patch message builder) for every bad input the node rejects."""
     area = egg()
 
     def values(msg):

@@ -4,7 +4,7 @@ The node is started from its installed script with ``config/profiles_track.yaml`
 (the Manchester benchmark's S1002 on UIC60, 10 kN per wheel); a client
 publishes twists and poses and reads the four contacts' wrenches.  They must
 equal ``fastsim_contact wheelset --json`` for the same pose within 1e-9
-(INTERFACE.md); a lifted wheelset gives zero wrenches; a pose past the flange
+(docs/guide_node.md); a lifted wheelset gives zero wrenches; a pose past the flange
 is counted as a derailment and the next pose is served; a missing or bad
 profile stops the node at start with one line and exit 2.
 """
@@ -110,7 +110,7 @@ def test_a_pose_gives_the_command_lines_wrenches(node):
 
 
 def test_the_first_start_needs_neither_contacts_nor_profile_paths(tmp_path):
-    # INTERFACE.md's profiles mode as a new user starts it (issue 27): no params file, the
+    # profiles mode as a new user starts it: no params file, the
     # shipped profiles by their bare names, the contacts the mode's own four by default
     expected = _cli("--wheel", "S1002.prw", "--rail", "UIC60.prr", "--dy", "5e-3",
                     "--yaw", "12e-3", "--load", "1e4", "--speed", "2")

@@ -1,6 +1,6 @@
 """Every bad start of the installed ``fastsim_node``: one line naming the parameter, exit 2.
 
-Table-driven over :data:`fastsim_ros.params.PARAMETERS` (issue 27): each
+Table-driven over :data:`fastsim_ros.params.PARAMETERS`: each
 parameter with a value out of its range or its choices, each kind with a
 value of the wrong type, every profile parameter with a missing file and an
 unreadable one, and the combinations the table cannot state alone
@@ -257,10 +257,10 @@ def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
 
 
 def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range():
-    """INTERFACE.md: a bad value is refused naming the parameter and the allowed range.
+    """A bad value is refused naming the parameter and the allowed range.
 
     rclpy refuses a value of another type before the node's callbacks see
-    it, with "Wrong parameter type ..." alone; the reason now goes on with
+    it, with "Wrong parameter type ..." alone; the node's reason goes on with
     the parameter's name and what it takes (rclpy's words first: it maps them
     to its type exception).  An out-of-range value names both already.
     """

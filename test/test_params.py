@@ -7,9 +7,9 @@ from fastsim_ros.params import SPECS, ParameterError, load_params_file
 from ros_harness import PACKAGE_ROOT
 
 CONFIG = PACKAGE_ROOT / "config"
-# INTERFACE.md's defaults; method: the calibrated MAE, the default since the validation
+# the documented defaults; method: the calibrated MAE, the default since the validation
 # report (docs/validation_wider.md) shows it better than the paper's MAE on every area
-INTERFACE_DEFAULTS = {
+DOCUMENTED_DEFAULTS = {
     "contacts": ("left", "right"), "wheelset_frame": "wheelset", "shear_modulus": 8.0e10,
     "poisson_ratio": 0.28, "friction_coefficient": 0.3, "method": "mae_calibrated",
     "traction_bound": "given", "min_rolling_speed": 0.1, "max_kinematics_age": 0.05,
@@ -20,7 +20,7 @@ INTERFACE_DEFAULTS = {
 
 def test_defaults_are_interface_md():
     d = params.defaults()
-    for name, value in INTERFACE_DEFAULTS.items():
+    for name, value in DOCUMENTED_DEFAULTS.items():
         assert d[name] == value, name
     assert d["max_patch_cells"] >= 30 * 30
 

@@ -113,7 +113,7 @@ def test_reverse_running_solves_the_turned_patch_and_opposes_the_slip(method):
     out = solve(pipe, fore_aft_egg(), normal=contact_normal(gamma, "left"))
     c = out.creepage
     assert c.speed < 0 and c.xi > 0
-    # INTERFACE.md: solve on the turned cells with (xi, eta, -phi); report (-Fx', -Fy', Mz')
+    # solve on the turned cells with (xi, eta, -phi); report (-Fx', -Fy', Mz')
     a = in_plane_area(fore_aft_egg())
     solver = solver_of(method)
     t = turned(a)
@@ -155,7 +155,7 @@ def test_reverse_running_traction_integrates_to_the_force():
 @pytest.mark.parametrize("rolling", ["steady", "transient"])
 @pytest.mark.parametrize("shape, share", [("hertz", 0.015), ("fore_aft_egg", 0.03)])
 def test_the_equivalent_ellipse_traction_lies_on_the_patch_cells(speed, rolling, shape, share):
-    """INTERFACE.md: the traction cloud is on the patch cells, the ellipse's own grid moved there.
+    """The traction cloud is on the patch cells, the ellipse's own grid moved there.
 
     The equivalent ellipse solves on an n x n grid of its own; the cloud
     takes the patch's grid and shape, zero traction and no slip off its
@@ -417,7 +417,7 @@ def test_the_wheelset_wrench_stays_one_cycles_after_a_rejected_patch(failing):
     The contacts arrive left, then right, each cycle.  With a flag per
     contact, one rejected left patch paired every later sum with the right
     wrench of the cycle before (stamped with the left one's), for good.  By
-    the stamps (INTERFACE.md: every contact's wrench newer than those of the
+    the stamps (every contact's wrench newer than those of the
     last sum) that pairing is made once, in the cycle after the rejection.
     """
     pipe = make(contacts=["left", "right"])

@@ -141,8 +141,8 @@ def test_the_reset_keys_are_there_from_the_start_and_survive_a_new_gap_rule() ->
     """/diagnostics lists every transient/<reason> from the start (0 before any patch).
 
     A run-time transient_max_gap applies to the running memory from the next
-    patch: its state and counts carry on (before, the memories were dropped:
-    the keys vanished and the counts restarted).  An empty patch followed by
+    patch: its state and counts carry on (the memories are not dropped, the
+    keys stay and the counts go on).  An empty patch followed by
     nothing for longer than the gap is a stamp gap (the history is unknown),
     not a start.
     """

@@ -707,9 +707,9 @@ def test_bad_inputs_exit_2_and_leave_nothing_while_a_good_one_completes(tmp_path
 def test_a_topic_without_a_usable_definition_is_one_line_naming_the_bag(tmp_path, capsys):
     """A custom type whose definition the bag garbles: exit 2, the bag's path on its line.
 
-    The problem is found at a topic, below the file's level; before, its line
-    named the topic and the type but not the bag, so among several inputs
-    nobody could tell which one failed.
+    The problem is found at a topic, below the file's level; its line names
+    the bag as well as the topic and the type, so that among several inputs
+    the one that failed is known.
     """
     bag = tmp_path / "custom"
     with Writer(bag, version=9, storage_plugin=StoragePlugin.MCAP) as w:

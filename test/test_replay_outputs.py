@@ -282,7 +282,7 @@ def test_patch_topics_of_contacts_not_configured_are_named(tmp_path, path):
     assert [t for t, _, _ in result.unused] == [
         "/wheelset/load", "/wheelset/pose", "/contact/left_flange/patch",
         "/contact/right_flange/patch"]
-    # the contacts the parameter lists are replayed as before
+    # the contacts the parameter lists are replayed as usual
     assert "  left: 400 patches, 400 wrenches" in text and "  right: 400 patches" in text
 
 

@@ -5,7 +5,7 @@ MAE: cell centres ``x[i]`` (rolling direction, leading edge at larger ``x``)
 and ``y[j]`` (lateral), arrays indexed ``[j, i]`` so that each row is one
 lateral strip marched along ``x`` (the layout of the node's organised point
 clouds), and the normal pressure on each cell.  A cell is in contact where
-its pressure is positive (METHOD.md section 2).
+its pressure is positive (docs/guide_physics.md "FastSim").
 """
 
 from __future__ import annotations
@@ -136,7 +136,7 @@ def turned_grid(pressure: FloatArray, x0: float, y0: float, dx: float,
                 dy: float) -> tuple[FloatArray, float, float]:
     """Return ``(pressure, x0, y0)`` of the grid turned by 180 degrees about ``z``.
 
-    Reverse running (INTERFACE.md "Creepages", rolling speed ``V < 0``) is
+    Reverse running (docs/guide_physics.md, rolling speed ``V < 0``) is
     solved on the patch turned so that its leading edge is at ``+x``: cell
     ``[j, i]`` goes to ``[ny - 1 - j, nx - 1 - i]`` (a view, not a copy) and
     cell ``[0, 0]``'s centre to minus the old last cell's.  The spin changes

@@ -4,7 +4,7 @@ One of the ways, before MAE, to give FastSim flexibilities on a
 non-elliptical area (the seed paper, Alonso & Giménez 2007, section 2 and
 Table 2; Knothe and Le The Hung): solve the linear (full-adhesion) rolling
 problem approximately, strip by strip, and take the creep coefficients from
-it.  As the issue reads the paper (the paper's own text was not at hand):
+it.  As the package reads the method from its published descriptions:
 
 - the area is cut into strips along the rolling direction (the grid's rows;
   a row with a gap holds one strip per segment), each of its own width;
@@ -15,7 +15,7 @@ it.  As the issue reads the paper (the paper's own text was not at hand):
 - full adhesion is imposed at two points per strip on its centre line, at
   ``s = ASM_COLLOCATION`` (fractions of its length from the leading edge):
   ``du/dx = w`` for both components, the displacement difference of the
-  Boussinesq-Cerruti half-spaces (as the exact theory's, METHOD.md 5) of all
+  Boussinesq-Cerruti half-spaces (as the exact theory's, docs/guide_physics.md) of all
   strips' tractions; four equations per strip, one dense linear system;
 - the two points are placed to minimise the error on ellipses (against
   Kalker's coefficients, nu = 0.25; ``scripts/validate_seed.py`` fits them on

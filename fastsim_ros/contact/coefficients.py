@@ -1,6 +1,6 @@
 """Generalised creepage coefficients: the result type every method reports them in.
 
-METHOD.md section 1 (paper eq. 3).  The exact solver, MAE's own
+docs/guide_physics.md "Conventions" (paper eq. 3).  The exact solver, MAE's own
 coefficients, MAE + FastSim and the equivalent ellipse all fill a
 :class:`CreepCoefficients`, directly or from their forces at the unit
 creepages (:func:`coefficients_from_unit_solutions`, or
@@ -18,7 +18,7 @@ from typing import Protocol
 
 @dataclass(frozen=True)
 class CreepCoefficients:
-    """Generalised creepage coefficients of an area (METHOD.md section 1, paper eq. 3).
+    """Generalised creepage coefficients of an area (docs/guide_physics.md, paper eq. 3).
 
     ``Fx = -G (A/pi) C11 xi - G (A/pi) C12 eta - G (A/pi)^1.5 C13 phi``,
     ``Fy = -G (A/pi) C21 xi - G (A/pi) C22 eta - G (A/pi)^1.5 C23 phi``,

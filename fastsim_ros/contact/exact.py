@@ -12,7 +12,7 @@ slip ``w = (xi - phi y, eta + phi x)``.  It is discretised at cell centres
 with the *upstream* difference ``du/dx ~ (u(x + dx) - u(x))/dx``; the upstream
 point may lie outside the area, where the displacement is still the elastic
 field of the tractions inside.  With that difference the coefficient of
-``eta`` in ``Mz`` equals ``C23`` on every grid (METHOD.md section 5).
+``eta`` in ``Mz`` equals ``C23`` on every grid (docs/guide_physics.md "The exact solver").
 
 Tractions ``tau`` are those of the rail on the wheel.  ``tau -> du/dx`` is
 the :class:`~fastsim_ros.contact.rolling.SteadyRollingOperator`, a
@@ -428,22 +428,22 @@ def creep_coefficients(area: GridArea, *, nu: float,
     """Generalised coefficients ``C~ij`` of an area from the exact theory on its grid.
 
     Normalised with the discrete area (cells times cell area), which removes
-    most of the staircase noise of the boundary (METHOD.md section 5).
+    most of the staircase noise of the boundary (docs/guide_physics.md "The exact solver").
     """
     sols = unit_solutions(area, nu=nu, reference=reference, solver=solver)
     return coefficients_from_unit_solutions(
         area.area, tuple((s.fx, s.fy, s.mz) for s in sols), reference=reference)
 
 
-#: the grids of an extrapolation, as fractions of the finest (METHOD.md 5: at least four)
+#: the grids of an extrapolation, as fractions of the finest (docs/guide_physics.md: at least four)
 EXTRAPOLATION_GRIDS = (0.4, 0.6, 0.8, 1.0)
 
 
 def extrapolation_grids(finest: int) -> list[int]:
     """Return the even cell counts of an extrapolation up to ``finest`` cells across.
 
-    None above ``finest`` (an odd count rounded up to the next even one
-    before, ``--cells 7`` solved on 8); fewer than two for ``finest`` below
+    None above ``finest`` (an odd count is not rounded up to the next even
+    one: ``--cells 7`` solves on at most 6); fewer than two for ``finest`` below
     6, where no line can be fitted: :func:`extrapolated_coefficients` then
     refuses.
     """
@@ -459,7 +459,7 @@ def extrapolated_coefficients(shape: ShapeName, ratios: tuple[float, ...], *, nu
     (``ratios = (a1/b1, a2/b2)``), area 1 m^2, about the centre (the join
     line's middle); solved on :func:`extrapolation_grids` ``(finest)`` cells
     across and fitted by ``C(h) = C0 + k h`` in the cell size ``h = 1/n``
-    (first-order convergence, METHOD.md 5); ``area`` is 1.  Cached: the
+    (first-order convergence, docs/guide_physics.md); ``area`` is 1.  Cached: the
     extrapolation takes seconds and its result is immutable.
     """
     # one cache key however the call spells its arguments

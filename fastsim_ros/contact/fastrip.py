@@ -43,7 +43,7 @@ Per strip segment ``j`` (cells of one row in contact without a gap):
      vector is ``nu_j = q_j / mu`` with
      ``q_x = a_j^2 (xi_c/L1 - phi (y_j - y_c)/L3) / P_j``,
      ``q_y = a_j^2 (eta_c/L2 + phi (x_j - x_c)/L3) / P_j``,
-     ``L1..L3`` Kalker's flexibilities (METHOD.md 2) of the patch's
+     ``L1..L3`` Kalker's flexibilities (docs/guide_physics.md "FastSim") of the patch's
      equivalent ellipse (:func:`~fastsim_ros.contact.equivalent.equivalent_ellipse`:
      area, centroid ``(x_c, y_c)``, second-moment ratio; Kalker's C from the
      package's tables), creepages moved to the centroid by the rigid-slip
@@ -185,7 +185,7 @@ def _combine(area: GridArea, carter: FloatArray, ux: FloatArray, uy: FloatArray,
     in the simplified theory's direction: each strip marched from its
     leading edge, the trial traction ``tau_prev - (xi_c/L1 - phi (y -
     y_c)/L3, eta_c/L2 + phi (x - x_c)/L3) h`` (first step ``h = dx/2``, then
-    ``dx``; ``phi x`` at the middle of the step, METHOD.md 2).
+    ``dx``; ``phi x`` at the middle of the step, docs/guide_physics.md "FastSim").
     """
     x_c, y_c = centroid
     ny, nx = carter.shape
@@ -250,7 +250,7 @@ def fastrip(area: GridArea, xi: float, eta: float, phi: float, *, mu: float,
     ell, flex = fastrip_flexibility(area, table, shear_modulus)
     x_c, y_c = ell.x_c, ell.y_c
     xp, yp = reference
-    # creepages at the centroid (the rigid-slip identity, METHOD.md 3.2)
+    # creepages at the centroid (the rigid-slip identity, docs/guide_physics.md "MAE")
     xi_c = xi + phi * (yp - y_c)
     eta_c = eta - phi * (xp - x_c)
     seg = strip_segments(area)

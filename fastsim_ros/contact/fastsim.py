@@ -4,7 +4,7 @@ Assumption of the simplified theory: the surface displacement is proportional
 to the local traction, ``u_i = L_i tau_i``; in the steady state a particle's
 traction then grows, while it adheres, by the rigid slip times ``1/L`` per
 unit rolling distance, and is capped by the traction bound ``g = mu p``
-where it slips (Kalker 1982; METHOD.md section 2).
+where it slips (Kalker 1982; docs/guide_physics.md "FastSim").
 
 The sweep here is general enough for plain FastSim and for MAE: each strip
 ``j`` has its own flexibilities, and the slip increments per unit rolling
@@ -14,9 +14,9 @@ distance are
     d tau_y = -(eta/L2_j + phi (x - x_c)/L3_j)
 
 with ``Ls = L3`` and ``(x_c, y_s)`` the reference point in plain FastSim,
-and ``Ls = L4`` about the split point ``S`` in MAE (METHOD.md section 3.7).
+and ``Ls = L4`` about the split point ``S`` in MAE (docs/guide_physics.md "MAE").
 
-Discretisation (pinned by METHOD.md section 2): a cell is in contact where its
+Discretisation (pinned by docs/guide_physics.md "FastSim"): a cell is in contact where its
 pressure is positive; each segment of a strip starts from zero traction at the
 front face of its first cell; tractions live at cell centres, so the first
 step is ``dx/2`` and every later one ``dx``; ``phi x`` is taken at the middle
@@ -112,7 +112,7 @@ def slip_ratio(m: FloatArray, level: FloatArray, q: FloatArray,
     radial return onto ``k g_s``, whose slip per unit rolling distance
     follows from the traction increment, ``s = w + L (tau_k - tau_prev)/h =
     L (tau_k - t*)/h`` (componentwise ``L = (L1, L2)``), ``|s| = (m - k g_s)
-    |L t*| / (m h)``, so the slip velocity is
+    |L t*| / (m h)``, so the slip velocity is::
 
         v = |V| |s| = q (m - k g_s),    q = |V| |L t*| / (m h)  (m/(s Pa)),
 

@@ -9,7 +9,7 @@ moments from exact integer index sums; the ellipse's pressure computed on
 one quadrant and mirrored; ``sqrt(tau_x^2 + tau_y^2)`` for ``hypot`` away
 from the traction bound), so the two agree to a few ulps.  No ROS import.
 
-Conventions (METHOD.md 1-3): pressure ``p[j, i]`` (Pa) on a regular grid,
+Conventions (docs/guide_physics.md "Conventions"): pressure ``p[j, i]`` (Pa) on a regular grid,
 row ``j`` = lateral strip at ``y0 + j dy``, column ``i`` at ``x0 + i dx``
 (m), leading edge at the larger ``x``; a cell is in contact where ``p > 0``.
 

@@ -11,7 +11,7 @@ up to 1.6% of ``mu N`` above the exact one in the early partial slip and
 up to 6.6% below it at the knee (``docs/validation_estimation.md``).
 
 Both curves are functions of one variable on an ellipse: the creepage
-normalised by its saturation value,
+normalised by its saturation value::
 
     s = |F_lin| / (mu_s N),
 
@@ -20,7 +20,7 @@ FastSim's flexibilities reproduce: :func:`linear_force`), ``mu_s`` the static
 coefficient, ``N`` the load.  FastSim's curve ``|F| / (mu N)`` against ``s``
 is the same on every ellipse (its flexibilities make it so); the exact one
 moves with the ellipse's ``a/b``, the creepage's direction and ``nu`` by
-about a point of ``mu N`` at the knee.  So the *knee factor*
+about a point of ``mu N`` at the knee.  So the *knee factor*::
 
     kappa(s, a/b, direction, nu) = |F_exact| / |F_fastsim|   at the same s
 
@@ -92,7 +92,7 @@ def linear_force(a: float, b: float, l1: float, l2: float, l3: float, xi: float,
     """Return ``(F_x, F_y)`` (N): Kalker's linear force with the creepages' sign.
 
     An ellipse of semi-axes ``a`` (along x), ``b`` (m) with Kalker's
-    flexibilities ``l1, l2, l3`` (m/Pa, METHOD.md 2: ``L1 = 8 a / (3 G
+    flexibilities ``l1, l2, l3`` (m/Pa, docs/guide_physics.md "FastSim": ``L1 = 8 a / (3 G
     C11)``, ``L2 = 8 a / (3 G C22)``, ``L3 = pi a sqrt(a/b) / (4 G C23)``)
     under ``xi``, ``eta`` (1) at its centre and spin ``phi`` (1/m):
     ``G a b (C11 xi, C22 eta) + G (ab)^1.5 C23 (0, phi)`` (Kalker's

@@ -1,7 +1,7 @@
 """MAE: assimilation of a non-elliptical contact area to two semi-ellipses.
 
 Alonso & Giménez, Vehicle System Dynamics 45(4):341-357, 2007, as fixed by
-METHOD.md section 3.  Assumptions: the area's principal axes are ``x`` and
+docs/guide_physics.md "MAE".  Assumptions: the area's principal axes are ``x`` and
 ``y`` (wheel-rail contact); each of the two zones on either side of a
 lateral split line behaves, in the tangential problem, like the semi-ellipse
 with the same mean-square edge coordinates and the same area; the coupling
@@ -281,7 +281,7 @@ def mae_coefficients(geometry: MaeGeometry, table: CoefficientTable,
     About ``S``: ``C~11 = sum w_i c11(g_i)``, ``C~22`` likewise,
     ``C~23 = sum w_i^1.5 c23(g_i)``, ``C~13 = w1^1.5 c13(g1) - w2^1.5 c13(g2)``,
     ``C~12 = w2 c12(g2) - w1 c12(g1)`` (and ``C~21``), from the mirror signs
-    of METHOD.md 3.4; then moved to ``reference`` by the rigid-slip identity.
+    of docs/guide_physics.md "MAE"; then moved to ``reference`` by the rigid-slip identity.
     ``C~3j`` are not given by MAE: reported as ``nan``.
     """
     w = geometry.weights
@@ -308,7 +308,7 @@ def mae_coefficients(geometry: MaeGeometry, table: CoefficientTable,
 
 @dataclass(frozen=True)
 class ZoneFlexibility:
-    """Flexibilities ``L1 .. L4`` (m/Pa) of one zone (METHOD.md 3.6); ``L4`` may be ``inf``."""
+    """Flexibilities ``L1 .. L4`` (m/Pa) of one zone (the physics guide); ``L4`` may be ``inf``."""
 
     l1: float
     l2: float

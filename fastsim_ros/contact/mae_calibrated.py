@@ -1,6 +1,6 @@
 """Calibrated MAE: the paper's assimilation, with three rules from the exact theory.
 
-The second MAE method (issue 12; METHOD.md 3 stays the paper's, as
+The second MAE method (the paper's method, docs/guide_physics.md "MAE", stays as
 :mod:`~fastsim_ros.contact.mae` implements it).  It keeps MAE's steps 1-3
 (centroid, split, each zone likened to a semi-ellipse) and changes three
 things and adds one, each where the validation against the exact solver

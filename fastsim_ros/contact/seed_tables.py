@@ -1,4 +1,4 @@
-"""The seed paper's Tables 1 and 2 as printed (``shared/reference/seed_tables_1_2.md``).
+"""The seed paper's Tables 1 and 2 as printed (a reference file the package does not ship).
 
 Alonso & Giménez (2007), Table 2: ASM (Knothe & Hung) beside Kalker's
 asymptotic method (AMK), nu = 0.25, printed in two blocks whose labels are

@@ -1,6 +1,6 @@
 """Creepage-coefficient tables of the package, and their interpolation.
 
-One source (METHOD.md section 2): the tables shipped in ``fastsim_ros/data``,
+One source (docs/guide_physics.md "FastSim"): the tables shipped in ``fastsim_ros/data``,
 computed by ``scripts/make_coefficient_tables.py`` with the package's exact
 solver.  Kalker's ``C11, C22, C23, C33`` of full ellipses come from
 ``kalker_coefficients.csv``; the half-ellipse ``c11, c22, c23`` are *defined*
@@ -184,7 +184,7 @@ class CoefficientTable:
         return self._at("C11", t), self._at("C22", t), self._at("C23", t)
 
     def half(self, a_over_b: float) -> dict[str, float]:
-        """Return the half-ellipse ``c11 ... c23`` (METHOD.md section 3.4)."""
+        """Return the half-ellipse ``c11 ... c23`` (docs/guide_physics.md "MAE")."""
         t = self._log_ratio(a_over_b)
         return {n: self._at(n, t) for n in HALF_NAMES}
 

@@ -39,7 +39,7 @@ def rigid_slip(area: GridArea, xi: float, eta: float, phi: float,
                reference: tuple[float, float] = (0.0, 0.0)) -> tuple[FloatArray, FloatArray]:
     """Return the rigid slip ``(w_x, w_y)`` at the cell centres, creepages about ``reference`` (m).
 
-    ``w_x = xi - phi (y - y_P)``, ``w_y = eta + phi (x - x_P)`` (METHOD.md 1).
+    ``w_x = xi - phi (y - y_P)``, ``w_y = eta + phi (x - x_P)`` (docs/guide_physics.md).
     """
     x = area.x[None, :] - reference[0]
     y = area.y[:, None] - reference[1]

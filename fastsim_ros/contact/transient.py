@@ -409,8 +409,8 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
         prm, speed, out_x, out_y, slip, True, rigid, prev_x, prev_y, rolled, 0.0, 0.0, 1.0, 1.0)
     if (not with_far_field or not rolled < math.inf
             or abs(fx - f_old_x) + abs(fy - f_old_y) <= FAR_FIELD_STEADY * bound_total):
-        # no far field, the steady state, or no change of force: no shift (elastic_sweep's
-        # own tests, made before the far field's scan)
+        # no far field, the steady state, or no change of force: no shift (elastic_sweep
+        # alone, as its own tests hold it)
         return fx, fy, mz, nslip, ncontact
     m_x, m_y, k_x, k_y, l_x, l_y, length = far_field(far_shape, env, flex, dx, dy, a, b, nu,
                                                      shear_modulus)
@@ -435,7 +435,7 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     whole = (fx, fy, mz)
     whole_nslip = nslip
     fade = (length - rolled) / ((1.0 - FADE_START) * length)
-    fade = 1.0 if fade > 1.0 - 1e-9 else fade   # up to FADE_START: as before, to the bit
+    fade = 1.0 if fade > 1.0 - 1e-9 else fade   # up to FADE_START: 1, exactly
     h = rolled / nsub
     state_x = prev_x
     state_y = prev_y
@@ -564,7 +564,7 @@ def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic
     if rolled >= longest_segment(p, dx):
         # a step over the whole patch is the steady state (the rule of every method): the
         # ellipse's own grid is longer than the patch (its area is the staircase's), and a
-        # step between the two lengths kept a memory the patch no longer has
+        # step between the two lengths would keep a memory the patch does not have
         rolled = math.inf
     fx, fy, mz, nslip, ncontact = elastic_steps(
         shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi, flex, x_c, y_c, xp, yp,

@@ -1,4 +1,4 @@
-"""Friction estimation: the friction coefficient from measured creep forces (issue 28).
+"""Friction estimation: the friction coefficient from measured creep forces.
 
 Pure (numpy and :mod:`fastsim_ros.contact`; SciPy only in the batch fit),
 no ROS.  Two estimators share one measurement model, the package's own

@@ -17,7 +17,7 @@ forces are that solve).
 Observability.  With constant friction FastSim's forces are homogeneous,
 ``F(mu, c) = mu F(1, c/mu)``, so ``dF/dmu = (F - c . dF/dc)/mu``: zero in
 full adhesion (``F`` linear in the creepages ``c``), ``F/mu = N``-sized in
-full slip.  The dimensionless sensitivity
+full slip.  The dimensionless sensitivity::
 
     r = |H| / N     (N the cycle's total normal load)
 

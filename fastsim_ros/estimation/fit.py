@@ -1,8 +1,8 @@
 """Batch fit of a friction law to a measured creep curve (``fastsim_contact estimate``).
 
 The measured samples (creepages ``xi, eta`` (1), ``phi`` (1/m); forces
-``Fx`` and optionally ``Fy`` (N), contact frame, METHOD.md's signs) on one
-patch are fitted by the package's solver (compiled, one batch per
+``Fx`` and optionally ``Fy`` (N), contact frame, signs as in
+docs/guide_physics.md) on one patch are fitted by the package's solver (compiled, one batch per
 evaluation) under the friction law: ``mu_s`` for constant friction, ``mu_s``,
 the limit ratio ``A`` and the decay ``B`` (s/m) for the exponential law
 ``mu(v) = mu_s ((1 - A) exp(-B v) + A)``.  Least squares over the residuals

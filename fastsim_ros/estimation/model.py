@@ -41,7 +41,7 @@ off.  Not with the parabolic bound (another knee, not tabulated) nor where
 the equivalent ellipse is outside Kalker's tables (factor 1).
 
 Reverse running (rolling speed ``V < 0``) is solved as the pipeline solves
-it (INTERFACE.md "Creepages"): the patch turned by 180 degrees about ``z``,
+it (docs/guide_physics.md): the patch turned by 180 degrees about ``z``,
 spin negated, ``(-Fx', -Fy')`` reported, so the model's forces are the
 published ones bit for bit.
 """

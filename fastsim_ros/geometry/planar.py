@@ -4,7 +4,7 @@ CONTACT's planar contact approach (DISCNS D = 2; its ``set_planar_potcon``
 and ``wr_ud_planar``): the contact plane passes through the region's
 reference point, its normal ``n`` turned by the contact angle from the
 track's vertical (pointing into the wheel).  One difference of axes: the
-grid's ``x`` is the wheelset's ``x`` projected on the plane (INTERFACE.md's
+grid's ``x`` is the wheelset's ``x`` projected on the plane (the node's
 contact frame, so that the node's patch adapter finds a regular grid), not
 the track's; the two differ by the yaw angle.  The lateral axis is ``e_s =
 n x e_x`` (towards the field side).  Cells are centred at multiples of the

@@ -2,7 +2,7 @@
 
 The per-pose path (:class:`~fastsim_ros.geometry.wheelset.Wheelset`) solves
 the contact search and the non-Hertzian normal problem for every pose: 20 to
-200 ms, far beyond a 1 kHz loop (TARGETS.md: a pose at most 1 ms median).
+200 ms, far beyond a 1 kHz loop (the target: a pose at most 1 ms median).
 A rig's wheelset moves over a few millimetres and milliradians, so the
 patches are solved once on a grid of nodes ``(dy, yaw)`` and interpolated:
 what multibody codes do with their contact tables (CONTACT's own module 1

@@ -14,7 +14,7 @@ That component includes the creep forces' (on a flange, inclined 60-70
 degrees, a creep force of 0.3 N moves the balance by a third), so the
 caller passes ``tangential``: a function that returns each patch's creep
 force in the track frame.  The geometry computes no creepage itself: the
-pipeline's rigid-body formula does (INTERFACE.md).
+pipeline's rigid-body formula does.
 
 Without a given roll, the roll is solved so that both wheels carry their
 loads at one vertical position of the wheelset centre (a rigid wheelset);
@@ -108,7 +108,7 @@ class WheelPatch:
     def cloud_arrays(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """Return ``points, normal, pressure`` of the patch cloud, rows along the frame's ``y``.
 
-        The contact frame's ``y = z x x`` (INTERFACE.md); on the right wheel
+        The contact frame's ``y = z x x``; on the right wheel
         the side frame's lateral axis runs the other way, so its rows are
         turned round: the node's patches all run like a rig's.
         """

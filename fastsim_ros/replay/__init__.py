@@ -1,6 +1,6 @@
 """``fastsim_replay``: replay recorded bags offline through the node's pipeline.
 
-Usage (INTERFACE.md, "The offline replay fastsim_replay")::
+Usage (docs/guide_replay.md)::
 
     fastsim_replay IN [IN ...] -o OUT [--params FILE] [--namespace NS] [--plot] [--csv]
                    [--overwrite] [--jobs N | --scheduler ADDRESS]

@@ -20,7 +20,7 @@ per-message rules (:meth:`fastsim_ros.pipeline.Pipeline.on_patch`,
 4. kinematics by stamp, vectorised: the newest twist taken before the patch
    arrived (at most ``TWIST_HISTORY`` back) whose stamp is not after the
    patch's, and not more than ``max_kinematics_age`` older;
-5. creepages (INTERFACE.md's rigid-body formula, term for term as
+5. creepages (the rigid-body formula of docs/guide_physics.md, term for term as
    :func:`msg_adapters.kinematics.creepages`) and ``standstill``;
 6. the solves in one compiled loop over the compiled solver's own per-patch
    solve (:func:`~fastsim_ros.replay.kernels.solve_mae`), patches running

@@ -307,7 +307,7 @@ def _run_local(task: Task, profile: bool) -> Result:
         if task.retry:
             faults.pause("committed")
     except BadInput as e:
-        # one line naming the file (INTERFACE.md): a problem found below the file's level
+        # one line naming the file: a problem found below the file's level
         # (a topic's definition) names only what it saw
         error = str(e)
         result.status = 2
