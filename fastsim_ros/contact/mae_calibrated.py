@@ -63,8 +63,10 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import SplitRule
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
+from fastsim_ros.contact.equivalent import equivalent_ellipse
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
+from fastsim_ros.contact.knee import KneeFactors, interpolate
 from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone,
                                      ZoneFlexibility, ZonePair, blended_flexibility,
                                      row_extents, split_geometries,
@@ -72,6 +74,7 @@ from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
 from fastsim_ros.contact.rules import chord_bend_offset
 from fastsim_ros.contact.tables import CoefficientTable
+from fastsim_ros.contact.traction import Tractions, resultants
 
 FloatArray = NDArray[np.float64]
 
@@ -256,13 +259,15 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
                            shear_modulus: float, reference: tuple[float, float] = (0.0, 0.0),
                            rule: SplitRule = DEFAULT_SPLIT, friction: FrictionLaw | None = None,
                            speed: float | None = None, share: PairShare = "shared",
-                           without: tuple[str, ...] = ()) -> MaeResult:
+                           without: tuple[str, ...] = (),
+                           knee: KneeFactors | None = None) -> MaeResult:
     """Solve the calibrated MAE + FastSim; arguments as :func:`.mae.mae_fastsim`.
 
     ``pairs``: the pair factors at the table's ``nu``
     (:func:`~fastsim_ros.contact.pairs.pair_factors`); ``share``:
     :func:`zone_coefficients`'; ``without``: rules left out (:data:`RULES`;
-    ``"rigid_slip"``: FastSim's radial return).
+    ``"rigid_slip"``: FastSim's radial return); ``knee``: FastSim's knee
+    corrected strip by strip with these factors (:func:`strip_knee`).
     """
     geometries = split_geometries(area, rule)
     zone_pairs = [calibrated_flexibilities(area, g, table, pairs, shear_modulus, share=share,
@@ -273,7 +278,50 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
                   sweep_point=sweep_point(geometries), reference=reference,
                   friction=friction, speed=speed,
                   slip_rule="radial" if "rigid_slip" in without else "rigid_slip")
+    if knee is not None:
+        full_adhesion = fastsim(area, xi, eta, phi, bound=np.where(area.mask, np.inf, 0.0),
+                                flexibility=flex, sweep_point=sweep_point(geometries),
+                                reference=reference)
+        res = strip_knee(area, res, full_adhesion, bound, knee, reference)
     return MaeResult(res.fx, res.fy, res.mz, res, geometries[0][0], zone_pairs[0])
+
+
+def strip_knee(area: GridArea, solved: Tractions, full_adhesion: Tractions, bound: FloatArray,
+               knee: KneeFactors, reference: tuple[float, float]) -> Tractions:
+    """Return ``solved`` with each strip's tractions times its knee factor.
+
+    :mod:`~fastsim_ros.contact.knee` strip by strip: strip ``j`` (a row of
+    cells along the rolling direction) carries in full adhesion the force
+    ``F_lin,j`` (``full_adhesion``: the same march without a bound) and
+    the bound ``mu N_j`` (``bound`` summed), so it stands at ``s_j =
+    |F_lin,j| / (mu N_j)`` of its saturation; its tractions are multiplied by
+    ``kappa(s_j)`` at the patch's equivalent ellipse's ``a/b`` and the
+    share ``F_lin,x^2 / |F_lin|^2``.  On an ellipse every strip stands at
+    the patch's ``s`` (FastSim's strip force in adhesion and the strip's
+    load both go as its chord squared) and the factor is the tabulated one;
+    on another shape (a long narrow tread patch, a flange root) each strip
+    reads the knee at its own ``s_j``: measured against the exact theory,
+    that halves the default method's worst error near zero shift and
+    through the flange (``docs/validation_accuracy.md``).  Assumptions: the
+    ellipse's knee serves every strip (the strips of an ellipse are at one
+    ``s``); the tables hold no spin (spin enters through ``F_lin,j``).
+    The compiled path: :func:`fastsim_ros.contact.kernels.strip_knee`.
+    """
+    ellipse = equivalent_ellipse(area)
+    log_aspect = math.log(ellipse.a / ellipse.b)
+    lin_x = full_adhesion.tau_x.sum(axis=1)
+    lin_y = full_adhesion.tau_y.sum(axis=1)
+    bound_sum = np.where(area.mask, bound, 0.0).sum(axis=1)
+    kappa = np.ones(area.ny)
+    for j in range(area.ny):
+        l2 = lin_x[j] ** 2 + lin_y[j] ** 2
+        if l2 > 0.0 and bound_sum[j] > 0.0:
+            kappa[j] = interpolate(knee.log_aspect, knee.s, knee.kappa,
+                                   math.sqrt(l2) / bound_sum[j], log_aspect,
+                                   lin_x[j] ** 2 / l2)[0]
+    tx = solved.tau_x * kappa[:, None]
+    ty = solved.tau_y * kappa[:, None]
+    return Tractions(tx, ty, solved.slip, *resultants(area, tx, ty, reference))
 
 
 def mae_calibrated_coefficients(area: GridArea, table: CoefficientTable, pairs: PairFactors, *,
