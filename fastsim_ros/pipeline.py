@@ -506,7 +506,7 @@ class Pipeline:
             self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
                               solver._knots, solver._polys, code, prm, mu_s,
                               self._law is not None, solver._calibrated, solver._pair_knots,
-                              solver._pair_values)
+                              solver._pair_values, solver._knee_for(self._bound))
 
     def _apply_estimation(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
         """Start the friction estimator (estimation on), or retune the running one.
@@ -939,7 +939,7 @@ class Pipeline:
             return None
         assert self._compiled is not None
         (rule, parabolic, shear_modulus, knots, polys, law, prm, mu, slip_dependent,
-         calibrated, pair_knots, pair_values) = self._compiled
+         calibrated, pair_knots, pair_values, knee) = self._compiled
         pressure = np.empty((ny, nx))
         frame_out, result = state.frame_out, state.result
         start = time.perf_counter()
@@ -948,7 +948,7 @@ class Pipeline:
             self._twist_array("wheel", wheel), self._twist_array("rail", rail),
             self._min_speed, rule, parabolic, shear_modulus, knots, polys, law, prm, mu,
             slip_dependent, calibrated, pair_knots, pair_values,
-            self._ekf is not None and memory is None, result, mem, *state_arrays)
+            self._ekf is not None and memory is None, result, mem, *state_arrays, knee)
         elapsed = time.perf_counter() - start
         if status != fast.SOLVED:
             return None
@@ -957,7 +957,8 @@ class Pipeline:
             sign = -1.0 if result[fast.SPEED] < 0.0 else 1.0  # the forces of the turned patch
             j_xx, j_xy, j_yx, j_yy = mem[fast.MEM_FAR_SLOPE:fast.MEM_FAR_SLOPE + 4].tolist()
             new = mae_state(tau_x, tau_y, previous.grid, geo,
-                            (sign * float(result[fast.FX]), sign * float(result[fast.FY])),
+                            (sign * float(result[fast.STATE_FX]),
+                             sign * float(result[fast.STATE_FY])),
                             (j_xx, j_xy, j_yx, j_yy))
             (o0, o1, o2, ex0, ex1, ex2, ey0, ey1, ey2) = frame_out[
                 patch_kernels.ORIGIN:patch_kernels.E_Y + 3].tolist()

@@ -31,9 +31,9 @@ from msg_adapters.patch import GRID_TOLERANCE, MIN_CELL_SIZE, MIN_CONTACT_CELLS
 SOLVED, DEFER = 0, 1
 #: the indices of :func:`solve_cloud`'s ``result`` (the frame stays in the adapter's ``out``)
 (X0, Y0, DX, DY, LOAD, CELLS, ROW_ORDER, COLUMN_ORDER, XI, ETA, PHI, SPEED, FX, FY, MZ, N,
- SLIP_FRACTION, FORCE_WS, TORQUE_WS, DFX_DMU, DFY_DMU) = (
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20, 23, 24)
-RESULT_SIZE = 25
+ SLIP_FRACTION, FORCE_WS, TORQUE_WS, DFX_DMU, DFY_DMU, STATE_FX, STATE_FY) = (
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20, 23, 24, 25, 26)
+RESULT_SIZE = 27
 #: the indices of :func:`solve_cloud`'s ``memory`` (transient rolling's carried state):
 #: on (1) or steady (0), the state's grid (turned as the patch is when rolling towards -x),
 #: the time since the last solved patch (ns), the last rolling direction (+-1), the last
@@ -64,7 +64,7 @@ def _grid_axis(first, step, worst, n, result, at):
 def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, min_speed, rule,
                 parabolic, shear_modulus, knots, polys, law, prm, mu, slip_dependent,
                 calibrated, pair_knots, pair_values, slope, result, memory, prev_x, prev_y,
-                out_x, out_y, slip, geo):
+                out_x, out_y, slip, geo, knee=contact.NO_KNEE):
     """Convert one patch cloud, derive its creepages, solve it (MAE + FastSim); no tractions.
 
     ``words .. cols``: the cloud's points as :func:`msg_adapters.patch._words`
@@ -167,30 +167,37 @@ def solve_cloud(words, ny, nx, row, step, cols, pressure, frame, wheel, rail, mi
         v = abs(speed) if slip_dependent else 0.0
         far = memory[MEM_FAR_FIELD] != 0.0
         far_slope = memory[MEM_FAR_SLOPE:MEM_FAR_SLOPE + 4].copy()
-        r = transient.mae_rolling_solve(
+        t = transient.mae_rolling_solve(
             p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule, parabolic, shear_modulus,
             knots, polys, law, prm, v, out_x, out_y, slip, calibrated, pair_knots, pair_values,
             prev_x, prev_y, rolled, geo, memory[MEM_NU], far, memory[MEM_FORCE],
-            memory[MEM_FORCE + 1], far_slope)
+            memory[MEM_FORCE + 1], far_slope, knee)
         memory[MEM_FAR_SLOPE:MEM_FAR_SLOPE + 4] = far_slope
+        r = (t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7])
+        own_x, own_y = t[8], t[9]
     elif slope:
         q = contact.mae_solve_mu_slope(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule,
                                        parabolic, shear_modulus, knots, polys, law, prm,
                                        abs(speed) if slip_dependent else 0.0, calibrated,
-                                       pair_knots, pair_values)
+                                       pair_knots, pair_values, knee)
         r = (q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7])
         dfx, dfy = q[8], q[9]
+        own_x, own_y = q[2], q[3]
     else:
         r = contact.mae_solve(p, sx0, sy0, dx, dy, xi, eta, sphi, mu, 0.0, 0.0, rule, parabolic,
                               shear_modulus, knots, polys, law, prm,
                               abs(speed) if slip_dependent else 0.0, no_float, no_float,
-                              no_bool, False, calibrated, pair_knots, pair_values)
+                              no_bool, False, calibrated, pair_knots, pair_values, knee)
+        own_x, own_y = r[2], r[3]
     if r[0] != contact.OK:
         return DEFER
     fx, fy, mz, n = r[2], r[3], r[4], r[5]
     if reverse:
         fx, fy = -fx, -fy
         dfx, dfy = -dfx, -dfy
+        own_x, own_y = -own_x, -own_y
+    # transient rolling's state keeps FastSim's own force (the far field's)
+    result[STATE_FX], result[STATE_FY] = own_x, own_y
     result[DFX_DMU], result[DFY_DMU] = dfx, dfy
     if not (math.isfinite(fx) and math.isfinite(fy) and math.isfinite(mz)
             and math.isfinite(n)):
@@ -242,4 +249,4 @@ def warm_up() -> None:
                         solver._rule, False, solver.shear_modulus, solver._knots,
                         solver._polys, contact.LAW_CONSTANT, np.zeros(2), 0.3, False, True,
                         solver._pair_knots, solver._pair_values, writeable,
-                        np.empty(RESULT_SIZE), np.zeros(MEMORY_SIZE), *NO_STATE)
+                        np.empty(RESULT_SIZE), np.zeros(MEMORY_SIZE), *NO_STATE, solver._knee)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import math
+from functools import partial
 from importlib import resources
 
 import numpy as np
@@ -86,7 +87,7 @@ def test_nu_outside_the_tables_is_refused():
 def test_a_mu_the_laws_refuse_has_no_factor(mu):
     from fastsim_ros.contact.errors import InvalidInputError
     area = ellipse(6e-3, 4e-3, nx=20, ny=20, load=LOAD)
-    model = CreepModel(CalibratedMaeSolver(0.28, G))
+    model = CreepModel(CalibratedMaeSolver(0.28, G, knee=False))
     s = ContactSample(area.pressure, area.x0, area.y0, area.dx, area.dy, 3e-3, 0.0, 0.0, 20.0,
                       ((1.0, 0.0),))
     with pytest.raises(InvalidInputError, match="mu_s must be finite"):
@@ -98,7 +99,7 @@ def test_the_linear_force_is_fastsims_in_full_adhesion(aspect):
     """``F_lin`` on the equivalent ellipse: the force the method gives at an infinite mu."""
     a = math.sqrt(24e-6 / math.pi * aspect)
     area = ellipse(a, a / aspect, nx=40, ny=40, load=LOAD)
-    solver = CalibratedMaeSolver(0.28, G)
+    solver = CalibratedMaeSolver(0.28, G, knee=False)
     ell = np.empty(k.ELL_SIZE)
     status, _ = k.equivalent_prepare(np.ascontiguousarray(area.pressure), area.x0, area.y0,
                                      area.dx, area.dy, G, solver._knots, solver._polys, ell)
@@ -124,7 +125,8 @@ def model_errors(solver, area, nu, xi, eta, phi, mu=0.3):
     return errors
 
 
-@pytest.mark.parametrize("method", [CalibratedMaeSolver, MaeSolver, EquivalentEllipseSolver])
+@pytest.mark.parametrize("method", [partial(CalibratedMaeSolver, knee=False), MaeSolver,
+                                    EquivalentEllipseSolver])
 @pytest.mark.parametrize("xi, eta", [(2.5e-3, 1.4e-3), (3e-3, 0.0), (4e-3, 2e-3)])
 def test_off_the_nodes_within_half_a_point_of_the_exact_theory(method, xi, eta):
     # a/b 0.6, nu 0.3, oblique creepage: none of them a node of the table (measured: 1.8-2.2%
@@ -139,8 +141,8 @@ def test_off_the_nodes_within_half_a_point_of_the_exact_theory(method, xi, eta):
 def test_on_a_flange_root_patch(xi):
     # not an ellipse: MAE's zones, the factor at the equivalent ellipse's a/b (measured: 0.3-0.7%
     # of mu N with it, 1.9-4.1% without)
-    corrected, plain = model_errors(CalibratedMaeSolver(0.28, G), flange_root_patch(cells=30),
-                                    0.28, xi, 0.0, 0.0)
+    corrected, plain = model_errors(CalibratedMaeSolver(0.28, G, knee=False),
+                                    flange_root_patch(cells=30), 0.28, xi, 0.0, 0.0)
     assert corrected < 0.008 and plain > 2.0 * corrected
 
 
@@ -156,12 +158,12 @@ def test_with_spin_within_the_measured_bounds(eta, phi, bound):
     a = math.sqrt(24e-6 / math.pi * 0.6)
     area = ellipse(a, a / 0.6, nx=40, ny=40, load=LOAD)
     xi = 0.0 if eta else 3e-3
-    corrected, _ = model_errors(CalibratedMaeSolver(0.3, G), area, 0.3, xi, eta, phi)
+    corrected, _ = model_errors(CalibratedMaeSolver(0.3, G, knee=False), area, 0.3, xi, eta, phi)
     assert corrected < bound
 
 
 def test_the_parabolic_bound_is_not_corrected():
-    model = CreepModel(CalibratedMaeSolver(0.28, G), bound="parabolic")
+    model = CreepModel(CalibratedMaeSolver(0.28, G, knee=False), bound="parabolic")
     area = ellipse(6e-3, 4e-3, nx=20, ny=20, load=LOAD)
     s = ContactSample(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, 20.0,
                       ((1.0, 0.0),))
@@ -172,7 +174,7 @@ def test_reverse_running_turns_the_spins_share():
     # V < 0: the solver takes the patch turned by 180 degrees and the spin negated, so the
     # spin's part of F_lin changes sign against the creepage's: another s
     area = flange_root_patch(cells=30)
-    model = CreepModel(CalibratedMaeSolver(0.28, G))
+    model = CreepModel(CalibratedMaeSolver(0.28, G, knee=False))
     forward, reverse = (model.knee_factor(ContactSample(
         area.pressure, area.x0, area.y0, area.dx, area.dy, 0.0, 2e-3, 2.0, v, ((1.0, 0.0),)),
         0.3) for v in (20.0, -20.0))
@@ -200,7 +202,7 @@ def test_the_compiled_factor_is_the_references(xi, eta, phi, speed):
 
     area = flange_root_patch(cells=30)
     mu, nu = 0.3, 0.28
-    model = CreepModel(CalibratedMaeSolver(nu, G))
+    model = CreepModel(CalibratedMaeSolver(nu, G, knee=False))
     sample = ContactSample(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,
                            speed, ((1.0, 0.0),))
     kappa, dkappa = model.knee_factor(sample, mu)
@@ -252,7 +254,7 @@ def test_strip_knee_compiled_is_the_reference():
     from fastsim_ros.contact.tables import coefficient_table
     area = flange_root_patch(cells=30)
     mu, nu = 0.3, 0.28
-    solver = CalibratedMaeSolver(nu, G, knee=True)
+    solver = CalibratedMaeSolver(nu, G)
     for xi, eta, phi in ((1.5e-3, 0.0, 0.0), (1e-3, 5e-4, 2.0), (0.0, 1e-3, -1.0)):
         mine = solver.solve(area, xi, eta, phi, mu=mu, tractions=True)
         ref = mae_calibrated_fastsim(area, xi, eta, phi, bound=traction_bound(area, mu),
@@ -276,9 +278,9 @@ def test_strip_knee_on_an_ellipse_is_the_tabulated_factor(xi):
     """Every strip of an ellipse stands at the patch's ``s``: the factor is the table's."""
     a = math.sqrt(24e-6 / math.pi * 0.6)
     area = ellipse(a, a / 0.6, nx=40, ny=40, load=LOAD)
-    plain = CalibratedMaeSolver(0.3, G).solve(area, xi, 0.0, 0.0, mu=0.3)
-    strips = CalibratedMaeSolver(0.3, G, knee=True).solve(area, xi, 0.0, 0.0, mu=0.3)
-    kappa, _ = CreepModel(CalibratedMaeSolver(0.3, G)).knee_factor_of(
+    plain = CalibratedMaeSolver(0.3, G, knee=False).solve(area, xi, 0.0, 0.0, mu=0.3)
+    strips = CalibratedMaeSolver(0.3, G).solve(area, xi, 0.0, 0.0, mu=0.3)
+    kappa, _ = CreepModel(CalibratedMaeSolver(0.3, G, knee=False)).knee_factor_of(
         area.pressure, area.x0, area.y0, area.dx, area.dy, xi, 0.0, 0.0, 2.0, 0.3)
     # the grid's strips stand at slightly different s (their discrete chords): 0.2 point
     assert abs(strips.fx - kappa * plain.fx) < 0.002 * 0.3 * LOAD
@@ -286,8 +288,8 @@ def test_strip_knee_on_an_ellipse_is_the_tabulated_factor(xi):
 
 def test_strip_knee_keeps_the_linear_theory_and_full_slip():
     area = flange_root_patch(cells=30)
-    plain = CalibratedMaeSolver(0.28, G)
-    strips = CalibratedMaeSolver(0.28, G, knee=True)
+    plain = CalibratedMaeSolver(0.28, G, knee=False)
+    strips = CalibratedMaeSolver(0.28, G)
     for creep in ((1e-11, 0.0, 0.0), (0.0, 1e-11, 1e-9)):
         a, b = plain.solve(area, *creep, mu=0.3), strips.solve(area, *creep, mu=0.3)
         assert (b.fx, b.fy) == pytest.approx((a.fx, a.fy), rel=1e-6)
@@ -315,7 +317,7 @@ def test_strip_knee_against_the_exact_theory_on_tread_patches(wheel, xi, plain_a
     area, creep, n = wheelset_patch(wheel, xi)
     ex = exact.coulomb(area, *creep, mu=0.3, nu=0.28, shear_modulus=G)
     errors = []
-    for solver in (CalibratedMaeSolver(0.28, G), CalibratedMaeSolver(0.28, G, knee=True)):
+    for solver in (CalibratedMaeSolver(0.28, G, knee=False), CalibratedMaeSolver(0.28, G)):
         f = solver.solve(area, *creep, mu=0.3)
         errors.append(max(abs(f.fx - ex.fx), abs(f.fy - ex.fy)) / (0.3 * n))
     assert errors[0] > plain_above and errors[1] < strips_below

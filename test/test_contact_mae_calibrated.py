@@ -10,6 +10,7 @@ import pytest
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import exact, samples
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver, warm_up
+from fastsim_ros.contact.knee import knee_factors
 from fastsim_ros.contact.errors import OutOfTableError
 from fastsim_ros.contact.fastsim import traction_bound
 from fastsim_ros.contact.friction import ExponentialFriction
@@ -205,7 +206,8 @@ def test_compiled_equals_reference(solver, table, pairs, case, creep, bound):
     xi, eta, phi = CREEPAGES[creep]
     ref = mae_calibrated_fastsim(ar, xi, eta, phi, bound=traction_bound(ar, MU, bound=bound),
                                  table=table, pairs=pairs, shear_modulus=G,
-                                 reference=reference)
+                                 reference=reference,
+                                 knee=knee_factors(NU) if bound == "given" else None)
     mine = solver.solve(ar, xi, eta, phi, mu=MU, reference=reference, bound=bound,
                         tractions=True)
     assert_forces(mine, ref.fx, ref.fy, ref.mz, size(ar))
@@ -222,7 +224,8 @@ def test_compiled_equals_reference_with_falling_friction(solver, table, pairs, c
     xi, eta, phi = CREEPAGES[creep]
     ref = mae_calibrated_fastsim(ar, xi, eta, phi, bound=traction_bound(ar, law.mu_s),
                                  table=table, pairs=pairs, shear_modulus=G,
-                                 reference=reference, friction=law, speed=20.0)
+                                 reference=reference, friction=law, speed=20.0,
+                                 knee=knee_factors(NU))
     mine = solver.solve(ar, xi, eta, phi, friction=law, speed=20.0, reference=reference,
                         tractions=True)
     assert_forces(mine, ref.fx, ref.fy, ref.mz, size(ar))
@@ -404,6 +407,6 @@ def test_a_bend_whose_horns_trail_leaves_c23_alone(table, pairs, solver):
     bound = traction_bound(loaded, MU)
     for creep in ((0.0, 0.0, 2.0), (1e-4, 2e-4, 0.5)):
         ref = mae_calibrated_fastsim(loaded, *creep, bound=bound, table=table, pairs=pairs,
-                                     shear_modulus=G)
+                                     shear_modulus=G, knee=knee_factors(NU))
         res = solver.solve(loaded, *creep, mu=MU)
         assert_forces(res, ref.fx, ref.fy, ref.mz, size(loaded))

@@ -317,8 +317,15 @@ def test_steps_of_whole_cells_reach_the_steady_state_under_spin(solver_cls, cell
         assert abs(a - b) <= 1e-6 * scale * (6e-3 if name == "mz" else 1.0), name
 
 
-@pytest.mark.parametrize("kind", ["xi", "phi"])
-def test_step_response_follows_the_exact_transient_solver(kind: str) -> None:
+@pytest.mark.parametrize("kind, knee", [
+    ("xi", False), ("phi", False), ("phi", True),
+    pytest.param("xi", True, marks=pytest.mark.xfail(strict=True, reason=(
+        "FastSim's non-steady march builds the force up faster than the exact transient "
+        "theory: 4-6% of mu N ahead of it over the first patch length after a step in xi "
+        "(measured, either knee); FastSim's own knee (knee=False) is as far behind in the "
+        "steady state (592 N), which hid it; with the knee factors the steady error is "
+        "112 N and the build-up's 564 N shows")))])
+def test_step_response_follows_the_exact_transient_solver(kind: str, knee: bool) -> None:
     """A creepage step at V dt / a = 0.3: within the steady error plus 2 % of mu N."""
     a, n, load = 6e-3, 20, 4e4
     ar = areas.ellipse(a, a, nx=n, ny=n, load=load)
@@ -330,7 +337,7 @@ def test_step_response_follows_the_exact_transient_solver(kind: str) -> None:
         state = rolling_step(ar, ops, *creep, mu=MU, previous=state)
         exact.append(getattr(state, key))
     exact_steady = getattr(coulomb(ar, *creep, mu=MU, nu=NU, shear_modulus=G), key)
-    solver = CalibratedMaeSolver(NU, G)
+    solver = CalibratedMaeSolver(NU, G, knee=knee)
     steady_error = abs(getattr(solver.solve(ar, *creep, mu=MU), key) - exact_steady)
     t = TransientSolver(solver)
     tstate = None

@@ -376,13 +376,18 @@ class CalibratedMaeSolver(MaeSolver):
     ``shear_modulus`` (Pa) and ``rule`` as :class:`MaeSolver`, whose calls
     it has (``flexibility`` gives the calibrated ``L1 .. L4``).
 
-    ``knee``: FastSim's knee corrected strip by strip with the knee factors
-    of :mod:`fastsim_ros.contact.knee` (:func:`~fastsim_ros.contact.kernels.strip_knee`;
-    the given bound only; the steady solves, not the transient ones).
+    ``knee`` (default): FastSim's knee corrected strip by strip with the
+    knee factors of :mod:`fastsim_ros.contact.knee`
+    (:func:`~fastsim_ros.contact.mae_calibrated.strip_knee`; the given
+    bound only): each strip's force times the exact theory's factor at its
+    own share of the saturation.  Measured against the exact theory on the
+    default wheelset's patches (``docs/validation_accuracy.md``) it halves
+    the method's worst error near zero shift and through the flange.
+    ``knee=False``: FastSim's own knee.
     """
 
     def __init__(self, nu: float, shear_modulus: float, *,
-                 rule: Rule = "auto", knee: bool = False) -> None:
+                 rule: Rule = "auto", knee: bool = True) -> None:
         super().__init__(nu, shear_modulus, rule=rule)
         pairs = pair_factors(self.nu)  # refuses nu outside the pair factors' range
         self._calibrated = True

@@ -306,6 +306,8 @@ _NO_STATE = np.zeros((0, 0))
 STRIP_SUMS = 6
 #: no knee table (:func:`mae_sweep`)
 NO_KNEE = np.zeros(0)
+#: a packed knee table of one node (a placeholder where none is read: one type for the arrays)
+_ONE_NODE_KNEE = np.array([1.0, 1.0, 0.0, 0.0, 1.0, 1.0])
 
 
 @njit(cache=True, error_model="numpy")
@@ -828,7 +830,22 @@ def knee_arrays(knee):
 
 
 @njit(cache=True, error_model="numpy")
-def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store):
+def knee_capped(k, sx, sy, bound):
+    """Return the factor ``k`` of a strip whose force sums ``sx``, ``sy`` at most ``bound``.
+
+    A strip carries at most its traction bound summed (``mu N_j``): a
+    factor above 1 on a strip all in slip would exceed it, so the factor is
+    capped there (a strip in full slip keeps FastSim's force, ``mu N_j``,
+    as the exact theory has it).
+    """
+    f2 = sx * sx + sy * sy
+    if k > 1.0 and k * k * f2 > bound * bound:
+        return bound / math.sqrt(f2)
+    return k
+
+
+@njit(cache=True, error_model="numpy")
+def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store, kappa_out=NO_KNEE):
     """Return ``(Fx, Fy, Mz)`` (N, N, N m): each strip's force times its knee factor.
 
     :mod:`fastsim_ros.contact.knee`, applied strip by strip: strip ``j``
@@ -837,12 +854,14 @@ def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store):
     moment (``strip_sums``, :func:`rolling_sweep`) are multiplied by
     ``kappa(s_j, a/b, F_lin,x^2 / |F_lin|^2)`` of the packed table ``knee``
     (:func:`knee_pack`) at ``log(a/b)`` = ``log_aspect`` (the patch's
-    equivalent ellipse).  On an ellipse every strip is at the patch's ``s``
-    (FastSim's strip force and load both go as the chord squared) and this
+    equivalent ellipse), capped at the strip's bound (:func:`knee_capped`).
+    On an ellipse every strip is at the patch's ``s`` (FastSim's strip
+    force and load both go as the chord squared) and this
     is the tabulated factor; on a patch of another shape each strip reads
     the knee at its own share of the saturation.  With ``store`` the
     strip's tractions ``out_x``, ``out_y`` (Pa) are scaled alike, so that
-    they sum to the forces.
+    they sum to the forces; ``kappa_out`` ``(ny,)``, if given, receives the
+    strips' factors.
     """
     la, sn, kap = knee_arrays(knee)
     ny = strip_sums.shape[1]
@@ -857,13 +876,75 @@ def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store):
         if l2 > 0.0 and strip_sums[5, j] > 0.0:
             k, _ = knee_interpolate(la, sn, kap, math.sqrt(l2) / strip_sums[5, j], log_aspect,
                                     lx * lx / l2)
+            k = knee_capped(k, strip_sums[0, j], strip_sums[1, j], strip_sums[5, j])
         fx += k * strip_sums[0, j]
         fy += k * strip_sums[1, j]
         mz += k * strip_sums[2, j]
+        if kappa_out.shape[0] == ny:
+            kappa_out[j] = k
         if store and k != 1.0:
             for i in range(out_x.shape[1]):
                 out_x[j, i] *= k
                 out_y[j, i] *= k
+    return fx * da, fy * da, mz * da
+
+
+@njit(cache=True, error_model="numpy")
+def tractions_knee(out_x, out_y, shape, outer, inner, env, x0, y0, dx, dy, xp, yp, yr, steady,
+                   knee, log_aspect, kappa_out):
+    """Return ``(Fx, Fy, Mz)`` of a transient traction field with each strip's knee factor.
+
+    Transient rolling's new state ``out_x``, ``out_y`` (Pa; it stays as it
+    is) against the steady march's ``steady`` (:func:`rolling_sweep`'s
+    ``strip_sums`` at the same creepages): strip ``j`` takes the factor of
+    its steady state, ``kappa_j`` at the steady ``s_j`` (:func:`strip_knee`),
+    in the share its force has built up towards it, ``w_j = F_j . F_j^st /
+    |F_j^st|^2`` within ``[0, 1]``: ``1 + (kappa_j - 1) w_j``.  The knee
+    factor is a property of the steady saturation; a strip still building
+    up its force after a step is not at its knee (taken at once, the
+    factor overshot the exact transient theory by 5% of mu N during a
+    step's build-up, test_contact_transient), and in the steady state
+    ``w_j = 1`` and the forces are the steady solve's.  ``yr``: the strips'
+    ``y - yp`` (m).  ``kappa_out`` as :func:`strip_knee`'s.
+    """
+    ny, nx = shape.shape
+    sums = np.zeros((STRIP_SUMS, ny))
+    for i in range(nx - 1, -1, -1):
+        xr = x0 + dx * i - xp
+        for j in range(env[0, i], env[1, i]):
+            g = outer * (shape[j, i] * inner)
+            if not g > 0.0:
+                continue
+            t_x = out_x[j, i]
+            t_y = out_y[j, i]
+            sums[0, j] += t_x
+            sums[1, j] += t_y
+            sums[2, j] += xr * t_y - yr[j] * t_x
+    la, sn, kap = knee_arrays(knee)
+    fx = 0.0
+    fy = 0.0
+    mz = 0.0
+    for j in range(ny):
+        k = 1.0
+        lx = steady[3, j]
+        ly = steady[4, j]
+        l2 = lx * lx + ly * ly
+        if l2 > 0.0 and steady[5, j] > 0.0:
+            k, _ = knee_interpolate(la, sn, kap, math.sqrt(l2) / steady[5, j], log_aspect,
+                                    lx * lx / l2)
+            k = knee_capped(k, steady[0, j], steady[1, j], steady[5, j])
+            st2 = steady[0, j] * steady[0, j] + steady[1, j] * steady[1, j]
+            if st2 > 0.0:
+                w = (sums[0, j] * steady[0, j] + sums[1, j] * steady[1, j]) / st2
+                if w < 1.0:  # (the steady state keeps kappa itself, to the bit)
+                    k = 1.0 + (k - 1.0) * max(w, 0.0)
+            k = knee_capped(k, sums[0, j], sums[1, j], steady[5, j])
+        fx += k * sums[0, j]
+        fy += k * sums[1, j]
+        mz += k * sums[2, j]
+        if kappa_out.shape[0] == ny:
+            kappa_out[j] = k
+    da = dx * dy
     return fx * da, fy * da, mz * da
 
 
@@ -915,7 +996,7 @@ def rigid_slip_return_slope(px, py, dpx, dpy, wxh, wyh, l1, l2, g, dg):
 
 @njit(cache=True, error_model="numpy")
 def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s,
-                   xp, yp, law, prm, speed, rigid, mu):
+                   xp, yp, law, prm, speed, rigid, mu, knee=NO_KNEE, log_aspect=0.0):
     """March as the steady :func:`sweep` does, differentiating the forces in ``mu_s``.
 
     Return ``(Fx, Fy, Mz, dFx/dmu_s, dFy/dmu_s, slipping, in contact)``
@@ -937,12 +1018,18 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
     its bound; a central difference of the solve agrees with it to 1e-11 of
     the load (test_estimation).  The steady state only (the transient
     march's state would carry a derivative of its own); ``mu``: the
-    ``mu_s`` of the bound (> 0).
+    ``mu_s`` of the bound (> 0).  ``knee``, ``log_aspect``: the strips'
+    knee factors (:func:`strip_knee`; :data:`NO_KNEE`: none); a strip's
+    ``s_j`` goes as ``1/mu_s`` (its bound as ``mu_s``), so its factor adds
+    ``-F_j (d kappa/d s) s_j / mu_s`` to the derivative.
     """
     ny, nx = shape.shape
     da = dx * dy
     half = 0.5 * dx
     inv_mu = 1.0 / mu
+    record = knee.shape[0] > 0
+    lin = np.zeros((5, ny if record else 1))
+    ulx, uly, slx, sly, sgb = lin[0], lin[1], lin[2], lin[3], lin[4]
     w = np.empty((15, ny))
     tx, ty, dtx, dty, sx, sy, sm, dsx, dsy = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8]
     rate_x, rate_y0, rate_yx, yr, w_x, dlevel = w[9], w[10], w[11], w[12], w[13], w[14]
@@ -964,6 +1051,17 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
             if not g > 0.0:
                 continue
             dg = g * inv_mu
+            if record:
+                # the steady march without a bound (rolling_sweep's strip_sums)
+                s_l = dx if cont[j] == i else half
+                if cont[j] != i:
+                    ulx[j] = 0.0
+                    uly[j] = 0.0
+                ulx[j] = ulx[j] - rate_x[j] * s_l
+                uly[j] = uly[j] - (rate_y0[j] + rate_yx[j] * (x_rel + 0.5 * s_l)) * s_l
+                slx[j] += ulx[j]
+                sly[j] += uly[j]
+                sgb[j] += g
             if cont[j] == i:
                 s = dx
                 t_x = tx[j]
@@ -1100,7 +1198,28 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
     mz = 0.0
     dfx = 0.0
     dfy = 0.0
+    knee_la, knee_s, knee_kappa = knee_arrays(knee if record else _ONE_NODE_KNEE)
     for j in range(ny):
+        if record:
+            lx = slx[j]
+            ly = sly[j]
+            l2 = lx * lx + ly * ly
+            if l2 > 0.0 and sgb[j] > 0.0:
+                s_j = math.sqrt(l2) / sgb[j]
+                k, dk = knee_interpolate(knee_la, knee_s, knee_kappa, s_j, log_aspect,
+                                         lx * lx / l2)
+                ds = -s_j * inv_mu
+                capped = knee_capped(k, sx[j], sy[j], sgb[j])
+                if capped != k:
+                    # mu N_j and the strip's force in full slip both go as mu_s: k is fixed
+                    k = capped
+                    dk = 0.0
+                fx += k * sx[j]
+                fy += k * sy[j]
+                mz += k * sm[j]
+                dfx += k * dsx[j] + dk * ds * sx[j]
+                dfy += k * dsy[j] + dk * ds * sy[j]
+                continue
         fx += sx[j]
         fy += sy[j]
         mz += sm[j]
@@ -1867,14 +1986,14 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
 @njit(cache=True, error_model="numpy")
 def mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                        shear_modulus, knots, polys, law, prm, speed, calibrated, pair_knots,
-                       pair_values):
+                       pair_values, knee=NO_KNEE):
     """:func:`mae_solve` (no tractions) and the forces' derivatives in ``mu_s``, one march.
 
     Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells in
     contact, dFx/dmu_s, dFy/dmu_s)``: the first eight :func:`mae_solve`'s
     to the bit, the derivatives (N) :func:`sweep_mu_slope`'s; the arguments
-    as :func:`mae_solve`'s.  The zones, flexibilities and the point ``S``
-    do not depend on ``mu_s``.
+    as :func:`mae_solve`'s (``knee`` with the given bound only).  The
+    zones, flexibilities and the point ``S`` do not depend on ``mu_s``.
     """
     status, info, geo, env, flex, bound = mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp,
                                                     rule, parabolic, shear_modulus, knots,
@@ -1892,7 +2011,8 @@ def mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabo
     else:
         fx, fy, mz, dfx, dfy, nslip, _ = sweep_mu_slope(
             p, mu, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp, yp, law,
-            prm, speed, calibrated, mu)
+            prm, speed, calibrated, mu, knee,
+            math.log(geo[G_ELLIPSE + 2] / geo[G_ELLIPSE + 3]) if knee.shape[0] > 0 else 0.0)
     return OK, 0.0, fx, fy, mz, geo[G_LOAD], nslip, int(geo[G_NCONTACT]), dfx, dfy
 
 

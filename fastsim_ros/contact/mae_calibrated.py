@@ -296,7 +296,8 @@ def strip_knee(area: GridArea, solved: Tractions, full_adhesion: Tractions, boun
     the bound ``mu N_j`` (``bound`` summed), so it stands at ``s_j =
     |F_lin,j| / (mu N_j)`` of its saturation; its tractions are multiplied by
     ``kappa(s_j)`` at the patch's equivalent ellipse's ``a/b`` and the
-    share ``F_lin,x^2 / |F_lin|^2``.  On an ellipse every strip stands at
+    share ``F_lin,x^2 / |F_lin|^2``, capped so that no strip carries more
+    than its bound (a strip in full slip keeps ``mu N_j``).  On an ellipse every strip stands at
     the patch's ``s`` (FastSim's strip force in adhesion and the strip's
     load both go as its chord squared) and the factor is the tabulated one;
     on another shape (a long narrow tread patch, a flange root) each strip
@@ -312,6 +313,8 @@ def strip_knee(area: GridArea, solved: Tractions, full_adhesion: Tractions, boun
     lin_x = full_adhesion.tau_x.sum(axis=1)
     lin_y = full_adhesion.tau_y.sum(axis=1)
     bound_sum = np.where(area.mask, bound, 0.0).sum(axis=1)
+    own_x = solved.tau_x.sum(axis=1)
+    own_y = solved.tau_y.sum(axis=1)
     kappa = np.ones(area.ny)
     for j in range(area.ny):
         l2 = lin_x[j] ** 2 + lin_y[j] ** 2
@@ -319,6 +322,10 @@ def strip_knee(area: GridArea, solved: Tractions, full_adhesion: Tractions, boun
             kappa[j] = interpolate(knee.log_aspect, knee.s, knee.kappa,
                                    math.sqrt(l2) / bound_sum[j], log_aspect,
                                    lin_x[j] ** 2 / l2)[0]
+            # a strip carries at most its bound summed (mu N_j): in full slip FastSim's force
+            f2 = own_x[j] ** 2 + own_y[j] ** 2
+            if kappa[j] > 1.0 and kappa[j] ** 2 * f2 > bound_sum[j] ** 2:
+                kappa[j] = bound_sum[j] / math.sqrt(f2)
     tx = solved.tau_x * kappa[:, None]
     ty = solved.tau_y * kappa[:, None]
     return Tractions(tx, ty, solved.slip, *resultants(area, tx, ty, reference))

@@ -470,21 +470,32 @@ def elastic_steps(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
 def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                       shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
                       calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo, nu,
-                      with_far_field, f_old_x, f_old_y, slope):
+                      with_far_field, f_old_x, f_old_y, slope, knee=k.NO_KNEE,
+                      kappa_out=k.NO_KNEE):
     """One time step of MAE + FastSim, rolling ``rolled`` (m) from the state ``prev_x, prev_y``.
 
     As :func:`fastsim_ros.contact.kernels.mae_solve` (same arguments and
-    return) with the previous tractions (Pa, the patch's grid) and the new
+    return, then FastSim's own ``Fx``, ``Fy``: the state's force, which
+    the far field compares with the next step's) with the previous
+    tractions (Pa, the patch's grid) and the new
     ones written to ``out_x``, ``out_y`` (always stored: the next state);
     ``geo`` receives the MAE geometry (:data:`~kernels.GEO_SIZE`).  With
     ``with_far_field`` the patch's shift (:func:`far_field`, Mindlin's on the
     equivalent ellipse, Poisson ratio ``nu``) from the previous force
     ``f_old_x``, ``f_old_y`` (N); ``slope`` (4 floats, N/m, in and out): the
     far field's Jacobian carried with the state (:func:`elastic_sweep`).
+    ``knee``: the returned forces carry each strip's knee factor in the
+    share its force has built up towards its steady state
+    (:func:`~fastsim_ros.contact.kernels.tractions_knee`, against one
+    steady march at the step's creepages; the state, the far field's forces
+    and ``out_x``, ``out_y`` stay FastSim's own), so that a steady state
+    gives :func:`mae_solve`'s;
+    ``kappa_out`` ``(ny,)``, if given, receives the strips' factors (1
+    without ``knee``): the published tractions are ``out_x`` times them.
     """
     status = k.check_solve_inputs(xi, eta, phi, mu, xp, yp)
     if status != k.OK:
-        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
+        return status, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, 0.0
     ny, nx = p.shape
     env = np.empty((2, nx), dtype=np.int64)
     strips = np.empty((3, ny), dtype=np.int64)
@@ -493,7 +504,7 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
                                      geo, env, strips, calibrated, pair_knots, pair_values,
                                      flex)
     if status != k.OK:
-        return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
+        return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0, 0.0, 0.0
     # MAE step 7: creepages moved to S = (x_c, y_s) (kernels.mae_sweep)
     x_c = geo[k.G_XC]
     y_s = geo[k.G_YS]
@@ -510,7 +521,24 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
         law, prm, speed, out_x, out_y, slip, calibrated, prev_x, prev_y, rolled, p,
         geo[k.G_ELLIPSE + 2], geo[k.G_ELLIPSE + 3], nu, shear_modulus, with_far_field, f_old_x,
         f_old_y, mu * geo[k.G_LOAD], slope)
-    return k.OK, 0.0, fx, fy, mz, geo[k.G_LOAD], nslip, int(geo[k.G_NCONTACT])
+    own_x, own_y = fx, fy
+    if kappa_out.shape[0] == ny:
+        kappa_out[:] = 1.0
+    if knee.shape[0] > 0 and not parabolic:
+        # the steady march at these creepages: each strip's knee factor and its steady force
+        steady = np.empty((k.STRIP_SUMS, ny))
+        empty = np.empty((0, 0))
+        k.sweep(shape, outer, 1.0, env, x0, y0, dx, dy, xi_s, eta_s, phi, flex, x_c, y_s, xp,
+                yp, law, prm, speed, empty, empty, np.empty((0, 0), dtype=np.bool_), False,
+                calibrated, steady)
+        yr = np.empty(ny)
+        for j in range(ny):
+            yr[j] = y0 + dy * j - yp
+        fx, fy, mz = k.tractions_knee(out_x, out_y, shape, outer, 1.0, env, x0, y0, dx, dy,
+                                      xp, yp, yr, steady, knee,
+                                      math.log(geo[k.G_ELLIPSE + 2] / geo[k.G_ELLIPSE + 3]),
+                                      kappa_out)
+    return k.OK, 0.0, fx, fy, mz, geo[k.G_LOAD], nslip, int(geo[k.G_NCONTACT]), own_x, own_y
 
 
 @njit(cache=True, error_model="numpy")
@@ -689,18 +717,21 @@ class TransientSolver:
         xp, yp = float(reference[0]), float(reference[1])
         f_old = state.force if state is not None else (0.0, 0.0)
         slope = np.array(state.far_slope if state is not None else (math.nan,) * 4)
+        kappa: FloatArray | None = None
         if isinstance(s, MaeSolver):
             grid = (float(x0), float(y0), float(dx), float(dy))
             shape = p.shape
             prev = self._previous(state, grid, shape)
             out = (np.empty(shape), np.empty(shape), np.empty(shape, dtype=np.bool_))
             geo = np.empty(k.GEO_SIZE)
+            kappa = np.ones(shape[0])
             result = mae_rolling_solve(
                 p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta), float(phi),
                 float(mu_s), xp, yp, s._rule, parabolic, s.shear_modulus, s._knots, s._polys,
                 code, prm, v, out[0], out[1], out[2], s._calibrated, s._pair_knots,
                 s._pair_values, prev[0], prev[1], float(rolled), geo, s.nu, self.far_field,
-                f_old[0], f_old[1], slope)
+                f_old[0], f_old[1], slope, s._knee_for("parabolic" if parabolic else "given"),
+                kappa)
             measures = _mae_measures(geo)
         else:
             n = s.cells or k.ellipse_cells(int(np.count_nonzero(p > 0.0)))
@@ -721,10 +752,16 @@ class TransientSolver:
             # the equivalent ellipse has the patch's area and centroid
             measures = (math.pi * float(ell[k.ELL_A] * ell[k.ELL_B]),
                         (float(ell[k.ELL_XC]), float(ell[k.ELL_YC])), float(ell[k.ELL_A]))
-        forces = s._forces(result, grid, out, True)
+        # the published tractions carry the strips' knee factors, the state FastSim's own
+        published = out if kappa is None else (out[0] * kappa[:, None],
+                                               out[1] * kappa[:, None], out[2])
+        forces = s._forces(result[:8], grid, published, True)
         j = slope.tolist()
+        # the state keeps FastSim's own force (the far field's; MAE's knee factors are the
+        # published forces' only)
+        own = (result[8], result[9]) if len(result) > 8 else (result[2], result[3])
         return forces, _made(out[0], out[1], grid, *measures,
-                             (float(result[2]), float(result[3])), (j[0], j[1], j[2], j[3]))
+                             (float(own[0]), float(own[1])), (j[0], j[1], j[2], j[3]))
 
     def _previous(self, state: TractionState | None, grid: tuple[float, float, float, float],
                   shape: tuple[int, ...]) -> tuple[FloatArray, FloatArray]:

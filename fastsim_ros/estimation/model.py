@@ -209,6 +209,7 @@ def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, ...]] 
     rule, shear, knots, polys = solver._rule, solver.shear_modulus, solver._knots, solver._polys
     calibrated, pair_knots, pair_values = (solver._calibrated, solver._pair_knots,
                                            solver._pair_values)
+    knee = solver._knee_for(bound)
     no_float, no_bool = np.empty((0, 0)), np.empty((0, 0), dtype=np.bool_)
 
     def solve(p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
@@ -221,12 +222,13 @@ def _mae_kernel(solver: Solver, bound: str) -> Callable[..., tuple[float, ...]] 
         if slope:
             r = kernels.mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule,
                                            parabolic, shear, knots, polys, code, prm, v,
-                                           calibrated, pair_knots, pair_values)
+                                           calibrated, pair_knots, pair_values, knee)
             d_x, d_y = r[8], r[9]
         else:
             r = kernels.mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, 0.0, 0.0, rule,
                                   parabolic, shear, knots, polys, code, prm, v, no_float,
-                                  no_float, no_bool, False, calibrated, pair_knots, pair_values)
+                                  no_float, no_bool, False, calibrated, pair_knots, pair_values,
+                                  knee)
             d_x = d_y = 0.0
         if r[0]:
             _raise(r[0], r[1], knots)
@@ -267,8 +269,11 @@ class CreepModel:
         object.__setattr__(self, "_marched_slope", self._kernel is not None)  # type: ignore
         # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
         object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
+        # the ellipse's factor on the whole force, unless the solver corrects its knee strip by
+        # strip itself (one correction, the published forces')
         object.__setattr__(self, "_knee", knee_factors(self.solver.nu)
-                           if self.knee and not check_bound(self.bound) else None)
+                           if self.knee and not check_bound(self.bound)
+                           and not getattr(self.solver, "knee", False) else None)
         object.__setattr__(self, "_ell", np.empty(kernels.ELL_SIZE))
 
     @property

@@ -392,7 +392,8 @@ class Batch:
             kernels.solve_mae(ps, x0, y0, dx, dy, creep, self.mu_solve, speed, s._rule,
                               self.parabolic, s.shear_modulus, s._knots, s._polys,
                               self.law_code, self.law_params, s._calibrated, s._pair_knots,
-                              s._pair_values, status, info, out)
+                              s._pair_values, status, info, out,
+                              s._knee_for("parabolic" if self.parabolic else "given"))
         else:
             kernels.solve_equivalent(ps, x0, y0, dx, dy, creep, self.mu_solve, speed,
                                      self.parabolic, s.cells or 0, s.shear_modulus, s._knots,

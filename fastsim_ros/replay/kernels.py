@@ -142,14 +142,16 @@ def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pr
 
 @njit(cache=True)
 def solve_mae(ps, x0, y0, dx, dy, creep, mu, speed, rule, parabolic, shear_modulus, knots,
-              polys, law, prm, calibrated, pair_knots, pair_values, status, info, out):
+              polys, law, prm, calibrated, pair_knots, pair_values, status, info, out,
+              knee=contact.NO_KNEE):
     """Solve each item with the compiled MAE solve the node calls (one per item).
 
     As :func:`fastsim_ros.contact.kernels.mae_batch`, but every item is
     solved whatever the others gave, and its load and slip counts are kept:
     ``status[b]``, ``info[b]`` and ``out[b]`` = ``Fx, Fy, Mz, N, slipping
     cells, cells in contact`` of :func:`~fastsim_ros.contact.kernels.mae_solve`
-    on item ``b`` (``creep[b]``: ``xi, eta, phi``; ``speed[b]``: ``|V|``).
+    on item ``b`` (``creep[b]``: ``xi, eta, phi``; ``speed[b]``: ``|V|``;
+    ``knee``: the solver's, :func:`~fastsim_ros.contact.kernels.mae_sweep`).
     """
     empty_f = np.empty((0, 0))
     empty_b = np.empty((0, 0), dtype=np.bool_)
@@ -157,7 +159,7 @@ def solve_mae(ps, x0, y0, dx, dy, creep, mu, speed, rule, parabolic, shear_modul
         r = contact.mae_solve(ps[b], x0[b], y0[b], dx[b], dy[b], creep[b, 0], creep[b, 1],
                               creep[b, 2], mu, 0.0, 0.0, rule, parabolic, shear_modulus, knots,
                               polys, law, prm, speed[b], empty_f, empty_f, empty_b, False,
-                              calibrated, pair_knots, pair_values)
+                              calibrated, pair_knots, pair_values, knee)
         status[b] = r[0]
         info[b] = r[1]
         out[b, 0] = r[2]
