@@ -77,6 +77,7 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--speed", type=finite, metavar="V",
                    help="rolling speed V (m/s; its magnitude is used), for the exponential law")
     p.add_argument("--load", type=finite, help="normal load N (N)")
+    cli.add_slope_reduction(p, finite)
     cli.add_material(p, finite)
     p.add_argument("--method", choices=METHODS, default="exact",
                    help="the measurement model: exact (default: Kalker's exact theory, the "
@@ -156,6 +157,10 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         if not 0.0 <= args.friction_decay <= 1e4:
             raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
                                     f"{args.friction_decay:g}")
+    reduction = cli.slope_reduction(args)
+    if reduction is not None and args.method == "exact":
+        raise cli.UsageError("--method exact is Kalker's exact theory, its slope in full: "
+                             "the --slope-* reduction needs a fast method")
     creepages, measured = read_measured(args.measured,
                                         allow_implausible=args.allow_implausible)
     patch = cli._force_area(args)
@@ -176,11 +181,14 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     else:
         solver = solver_for(args.method, args.nu, args.shear_modulus)
     correction, note = model_correction(args.method, args.bound, solver)
+    if reduction is not None:
+        correction, note = "none", (f"{args.method} under the slope reduction (the modified "
+                                    "FastSim of Spiryagin et al.), uncorrected")
     # a fast method as the node's estimator takes it: times the knee factor
     fit = fit_friction(solver, patch, creepages, measured, law=args.friction_law,
                        speed=args.speed, bound=args.bound, mu0=args.mu,
                        limit_ratio0=args.friction_limit_ratio, decay0=args.friction_decay,
-                       knee=args.method != "exact")
+                       knee=args.method != "exact", reduction=reduction)
 
     def finite_or_none(v: float) -> float | None:
         return v if math.isfinite(v) else None
@@ -210,6 +218,9 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "sigma_mu_static": finite_or_none(fit.sigmas["mu_s"]),
         "worst_error_percent_mu_N": fit.worst_error_percent,
         "rms_error_percent_mu_N": fit.rms_error_percent, "evaluations": fit.evaluations}
+    if reduction is not None:
+        result.update(slope_reduction={"k0": reduction.k0, "alpha_inf": reduction.alpha_inf,
+                                       "beta": reduction.beta})
     if exponential:
         result.update(friction_limit_ratio=determined("limit_ratio", fit.limit_ratio),
                       friction_decay=determined("decay", fit.decay),

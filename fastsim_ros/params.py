@@ -18,6 +18,8 @@ from typing import Any
 
 import yaml
 
+from fastsim_ros.contact.slope_reduction import SlopeReduction
+
 #: the methods of the library the node offers (INTERFACE.md: ``method``): the paper's
 #: MAE, the calibrated MAE (the default since docs/validation_wider.md shows it better
 #: than the paper's on every validation area) and FastSim on the equivalent ellipse
@@ -162,6 +164,21 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_decay", "double", 0.0,
                   "B (s/m) of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
                   low=0.0, high=1.0e4, dynamic=True),
+    ParameterSpec("slope_reduction_k0", "double", 1.0,
+                  "creep-slope reduction of a contaminated rail (modified FastSim, Spiryagin "
+                  "et al. 2013, as CONTACT): k = k0 [alpha_inf + (1 - alpha_inf)/(1 + beta "
+                  "eps)] divides the flexibilities; k0 is its value at vanishing creepage "
+                  "(1 with alpha_inf 1: the theory's full slope, today's numbers; any other: "
+                  "a slip-dependent law is taken at the rigid slip velocity; "
+                  "docs/guide_real_rails.md)",
+                  low=1.0e-3, high=1.0, dynamic=True),
+    ParameterSpec("slope_reduction_alpha_inf", "double", 1.0,
+                  "alpha_inf = k(inf)/k0 of the creep-slope reduction",
+                  low=0.0, high=1.0, dynamic=True),
+    ParameterSpec("slope_reduction_beta", "double", 0.0,
+                  "beta of the creep-slope reduction: how fast k falls with Polach's eps "
+                  "(the ratio of the slip to the adhesion area)",
+                  low=0.0, high=1.0e6, dynamic=True),
     # --- online friction estimation (issue 28; fastsim_ros/estimation/ekf.py)
     ParameterSpec("friction_estimation", "string", "off",
                   "estimate mu_s online from wheelset/measured_wrench (force.x, wheelset "
@@ -301,6 +318,25 @@ def defaults() -> dict[str, Any]:
     return {spec.name: spec.default for spec in PARAMETERS}
 
 
+def reduces_slope(values: Any) -> bool:
+    """Tell whether the parameters ask for a creep-slope reduction other than ``k = 1``."""
+    return not (values["slope_reduction_k0"] == 1.0
+                and (values["slope_reduction_alpha_inf"] == 1.0
+                     or values["slope_reduction_beta"] == 0.0))
+
+
+def slope_reduction_of(values: Any) -> SlopeReduction | None:
+    """Return the creep-slope reduction the parameters ask for (None: ``k = 1``).
+
+    ``values``: anything indexed by parameter name (a dict, the pipeline's config).
+    """
+    if not reduces_slope(values):
+        return None
+    return SlopeReduction(float(values["slope_reduction_k0"]),
+                          float(values["slope_reduction_alpha_inf"]),
+                          float(values["slope_reduction_beta"]))
+
+
 def checked(values: Mapping[str, Any]) -> dict[str, Any]:
     """Return the defaults updated with ``values``, each checked; raise ParameterError."""
     out = defaults()
@@ -309,6 +345,11 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
         if spec is None:
             raise ParameterError(f"unknown parameter {name!r}")
         out[name] = spec.check(value)
+    if out["rolling"] == "transient" and reduces_slope(out):
+        raise ParameterError("the creep-slope reduction (slope_reduction_k0 < 1, or "
+                             "slope_reduction_alpha_inf < 1 with slope_reduction_beta > 0) "
+                             "applies to steady rolling only: set rolling steady, or k0 1 "
+                             "and alpha_inf 1")
     if out["patch_source"] == "profiles":
         if "contacts" in values and tuple(out["contacts"]) != PROFILE_CONTACTS:
             raise ParameterError("parameter 'contacts': in profiles mode the contacts are "

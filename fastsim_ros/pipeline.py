@@ -34,6 +34,7 @@ import numpy as np
 
 from fastsim_ros import params as parameters
 from fastsim_ros import plausibility
+from fastsim_ros.params import slope_reduction_of
 from fastsim_ros import pipeline_kernels as fast
 from fastsim_ros.contact import compiled
 from fastsim_ros.contact.area import nearest_cells, regridded, turned_grid
@@ -475,7 +476,8 @@ class Pipeline:
         self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
                                        str(config["friction_law"]),
                                        float(config["friction_limit_ratio"]),
-                                       float(config["friction_decay"]), str(self._bound))
+                                       float(config["friction_decay"]), str(self._bound),
+                                       reduction=slope_reduction_of(config))
         mu = self._ekf.mu if self._ekf is not None else float(config["friction_coefficient"])
         self._use_mu(mu, config)
 
@@ -485,8 +487,10 @@ class Pipeline:
         # None: constant friction, the call of old (speed unused); else the law, run at |V|
         law = friction_law(str(config["friction_law"]), self._mu,
                            limit_ratio=float(config["friction_limit_ratio"]),
-                           decay=float(config["friction_decay"]))
-        self._law: FrictionLaw | None = law if law.slip_dependent else None
+                           decay=float(config["friction_decay"]),
+                           reduction=slope_reduction_of(config))
+        self._law: FrictionLaw | None = (law if law.slip_dependent or law.reduces_slope
+                                         else None)
         # the compiled path (pipeline_kernels.solve_cloud): the MAE methods without
         # tractions; the solver's arguments as its solve_arrays passes them
         self._compiled: tuple[Any, ...] | None = None
@@ -500,7 +504,8 @@ class Pipeline:
             self._memory_key = key
         for memory in self._memories.values():
             memory.max_gap = float(config["transient_max_gap"])
-        if isinstance(solver, MaeSolver) and not self._tractions:
+        # the compiled path knows no slope reduction: the solver's solve_arrays applies it
+        if isinstance(solver, MaeSolver) and not self._tractions and not law.reduces_slope:
             code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
             self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
                               solver._knots, solver._polys, code, prm, mu_s,
@@ -749,7 +754,8 @@ class Pipeline:
             if self._law is not None:
                 self._law = friction_law(str(self.config["friction_law"]), self._mu,
                                          limit_ratio=float(self.config["friction_limit_ratio"]),
-                                         decay=float(self.config["friction_decay"]))
+                                         decay=float(self.config["friction_decay"]),
+                                         reduction=slope_reduction_of(self.config))
             c = self._compiled
             if c is not None:  # only mu_s (slot 7) depends on mu
                 self._compiled = c[:7] + (self._mu,) + c[8:]
@@ -1244,6 +1250,9 @@ class Pipeline:
             ("friction_coefficient", f"{self._mu:g}"),
             ("friction_limit_ratio", f"{self.config['friction_limit_ratio']:g}"),
             ("friction_decay", f"{self.config['friction_decay']:g}"),
+            ("slope_reduction", "k0 {:g}, alpha_inf {:g}, beta {:g}".format(
+                self.config["slope_reduction_k0"], self.config["slope_reduction_alpha_inf"],
+                self.config["slope_reduction_beta"])),
             ("traction_bound", self._bound),
             ("solve_time_p50_us", f"{p50:.1f}"),
             ("solve_time_p99_us", f"{p99:.1f}"),

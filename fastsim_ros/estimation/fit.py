@@ -27,6 +27,7 @@ from numpy.typing import ArrayLike, NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import friction_law
+from fastsim_ros.contact.slope_reduction import SlopeReduction
 from fastsim_ros.estimation.model import ExactSolver, Solver
 
 FloatArray = NDArray[np.float64]
@@ -76,7 +77,8 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
                  measured: ArrayLike,
                  *, law: str = "constant", speed: float | None = None, bound: str = "given",
                  mu0: float = 0.3, limit_ratio0: float = 0.5,
-                 decay0: float = 1.0, knee: bool = False) -> FrictionFit:
+                 decay0: float = 1.0, knee: bool = False,
+                 reduction: SlopeReduction | None = None) -> FrictionFit:
     """Fit ``law`` to ``measured`` (``(n,)`` Fx or ``(n, 2)`` Fx, Fy in N) at ``creepages``.
 
     ``creepages``: ``(n, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about the
@@ -85,7 +87,8 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
     starting point.  ``knee``: a fast solver's forces times the knee factor
     at the fitted ``mu_s`` (:meth:`~fastsim_ros.estimation.model.CreepModel.knee_factor`,
     the node's estimator's model; not with the exact solver or the
-    parabolic bound).
+    parabolic bound).  ``reduction``: a known creep-slope reduction the law
+    carries (the modified FastSim; fast solvers only; no knee factor then).
     """
     from scipy.optimize import least_squares
 
@@ -109,6 +112,12 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
     load = float(area.load)
     evaluations = [0]
     corrected = None
+    reduced = reduction is not None and not reduction.identity
+    if reduced and isinstance(solver, ExactSolver):
+        raise InvalidInputError("the exact theory has its full slope: a slope reduction "
+                                "is an option of the fast methods")
+    if reduced:
+        knee = False  # the modified FastSim is the model, not a corrected full-slope one
     if knee and not isinstance(solver, ExactSolver):
         from fastsim_ros.estimation.model import CreepModel
         corrected = CreepModel(solver, bound=bound)
@@ -120,9 +129,10 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
         evaluations[0] += 1
         if exponential:
             f = friction_law("exponential", float(theta[0]), limit_ratio=float(theta[1]),
-                             decay=_decay(float(theta[1]), float(theta[2])))
+                             decay=_decay(float(theta[1]), float(theta[2])),
+                             reduction=reduction)
         else:
-            f = friction_law("constant", float(theta[0]))
+            f = friction_law("constant", float(theta[0]), reduction=reduction)
         out = solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy, cr,
                                  bound=bound, friction=f,  # type: ignore[arg-type]
                                  speed=None if speed is None else abs(speed))
