@@ -80,14 +80,15 @@ DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
                  "dlm": 100, "asm": 100,
                  "exact_forces": 60, "mae_forces": 60, "mae_calibrated_forces": 60,
                  "fastsim_ellipse_forces": 60, "fastrip_forces": 60, "dlm_forces": 60,
-                 "asm_forces": 60}
+                 "asm_forces": 60, "polach_forces": 60}
 #: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
 #: fewer than twice this is solved on its grid alone
 EXACT_COARSEST = 8
 #: the methods of ``coefficients`` (default ``exact``: the coefficients are the exact
 #: theory's numbers) and of ``forces`` (default the node's ``method``)
 COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
-FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
+FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm",
+                 "polach")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -273,8 +274,14 @@ def build_parser() -> argparse.ArgumentParser:
     add_material(fo, _finite)
     fo.add_argument("--method", choices=FORCE_METHODS, default=node_default("method"),
                     help="mae_calibrated (the calibrated MAE), mae (the paper's MAE), "
-                    "fastsim_ellipse, exact, fastrip, dlm or asm; default %(default)s, the "
-                    "node's")
+                    "fastsim_ellipse, exact, fastrip, dlm, asm or polach (Polach's closed "
+                    "form on the equivalent ellipse); default %(default)s, the node's")
+    fo.add_argument("--polach-ka", type=_finite, metavar="KA",
+                    default=node_default("polach_ka"),
+                    help="Polach's kA in (0, 1] (method polach); default %(default)s")
+    fo.add_argument("--polach-ks", type=_finite, metavar="KS",
+                    default=node_default("polach_ks"),
+                    help="Polach's kS in (0, kA] (method polach); default %(default)s")
     fo.add_argument("--bound", choices=BOUNDS, default=node_default("traction_bound"),
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch); default %(default)s, the node's")
@@ -677,6 +684,18 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         result.update(Fx=fr.fx, Fy=fr.fy, Mz=fr.mz, slip_fraction=float(
             np.count_nonzero(fr.traction.slip)) / np.count_nonzero(patch.mask),
             ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
+    elif args.method == "polach":
+        from fastsim_ros.contact.compiled import EquivalentEllipseSolver
+        from fastsim_ros.contact.polach import PolachSolver
+        if law.reduces_slope:
+            raise UsageError("--method polach reduces its slope with --polach-ka and "
+                             "--polach-ks, not --slope-*")
+        pol = PolachSolver(args.nu, args.shear_modulus, k_a=args.polach_ka, k_s=args.polach_ks)
+        res = pol.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
+        e = EquivalentEllipseSolver(args.nu, args.shear_modulus).ellipse(patch)
+        result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
+                      polach_ka=args.polach_ka, polach_ks=args.polach_ks,
+                      ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
     else:
         from fastsim_ros.contact.compiled import EquivalentEllipseSolver
         eq = EquivalentEllipseSolver(args.nu, args.shear_modulus)

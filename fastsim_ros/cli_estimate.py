@@ -51,7 +51,7 @@ from fastsim_ros.contact.errors import InvalidInputError
 #: the most samples a measured file may hold
 MAX_SAMPLES = 100_000
 #: the solvers the fit may use (compiled batches: one call per model evaluation)
-METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse")
+METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse", "polach")
 #: the most samples ``--method exact`` takes (about 10 ms a solve at 20 x 20 cells, a few
 #: dozen evaluations of the curve)
 MAX_EXACT_SAMPLES = 200
@@ -83,7 +83,8 @@ def add_parser(sub: Any, finite: Any) -> None:
                    help="the measurement model: exact (default: Kalker's exact theory, the "
                    "reference, as for coefficients; seconds to a minute), mae_calibrated "
                    "(the node's method times the knee factor, the node's estimator's "
-                   "model; fast), mae or fastsim_ellipse (times the knee factor too)")
+                   "model; fast), mae or fastsim_ellipse (times the knee factor too), or "
+                   "polach (Polach's closed form, kA = kS = 1)")
     p.add_argument("--bound", choices=BOUNDS, default=cli.node_default("traction_bound"),
                    help="traction bound: mu p as given, or parabolic; default %(default)s, "
                    "the node's")

@@ -22,8 +22,9 @@ from fastsim_ros.contact.slope_reduction import SlopeReduction
 
 #: the methods of the library the node offers (INTERFACE.md: ``method``): the paper's
 #: MAE, the calibrated MAE (the default since docs/validation_wider.md shows it better
-#: than the paper's on every validation area) and FastSim on the equivalent ellipse
-METHODS = ("mae", "mae_calibrated", "fastsim_ellipse")
+#: than the paper's on every validation area), FastSim on the equivalent ellipse and
+#: Polach's closed form on it (what vehicle-dynamics codes run instead)
+METHODS = ("mae", "mae_calibrated", "fastsim_ellipse", "polach")
 #: friction laws (:mod:`fastsim_ros.contact.friction`): Coulomb, and the falling
 #: mu(v) = mu_s ((1 - A) exp(-B v) + A) of the local slip velocity v
 FRICTION_LAWS = ("constant", "exponential")
@@ -125,8 +126,10 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "tangential solver: mae (the paper's MAE + FastSim, Alonso & Gimenez 2007), "
                   "mae_calibrated (MAE with pair factors from the exact theory, flexibilities "
                   "calibrated on the patch's cells and slip along the rigid slip, "
-                  "docs/validation_wider.md) or fastsim_ellipse (FastSim on the equivalent "
-                  "ellipse)",
+                  "docs/validation_wider.md), fastsim_ellipse (FastSim on the equivalent "
+                  "ellipse) or polach (Polach's closed form on the equivalent ellipse, "
+                  "Polach 1999 and 2005, with polach_ka, polach_ks; forces only: no "
+                  "traction, steady rolling; docs/guide_real_rails.md)",
                   choices=METHODS, dynamic=True),
     ParameterSpec("traction_bound", "string", "given",
                   "traction bound: given (mu p) or parabolic (mu N p^2 / sum(p^2 dA))",
@@ -179,6 +182,13 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "beta of the creep-slope reduction: how fast k falls with Polach's eps "
                   "(the ratio of the slip to the adhesion area)",
                   low=0.0, high=1.0e6, dynamic=True),
+    ParameterSpec("polach_ka", "double", 1.0,
+                  "Polach's reduction factor kA of the adhesion area's stiffness (method "
+                  "polach; Polach 2005; 1: Kalker's slope; kS <= kA <= 1)",
+                  low=1.0e-3, high=1.0, dynamic=True),
+    ParameterSpec("polach_ks", "double", 1.0,
+                  "Polach's reduction factor kS of the slip area (method polach; kS <= kA)",
+                  low=1.0e-3, high=1.0, dynamic=True),
     # --- online friction estimation (issue 28; fastsim_ros/estimation/ekf.py)
     ParameterSpec("friction_estimation", "string", "off",
                   "estimate mu_s online from wheelset/measured_wrench (force.x, wheelset "
@@ -350,6 +360,20 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
                              "slope_reduction_alpha_inf < 1 with slope_reduction_beta > 0) "
                              "applies to steady rolling only: set rolling steady, or k0 1 "
                              "and alpha_inf 1")
+    if out["method"] == "polach":
+        if out["polach_ks"] > out["polach_ka"]:
+            raise ParameterError("parameters 'polach_ka', 'polach_ks': Polach's factors need "
+                                 f"kS <= kA, got kA {out['polach_ka']:g}, kS "
+                                 f"{out['polach_ks']:g}")
+        for name, bad, why in (("publish_traction", out["publish_traction"] is True,
+                                "its closed form has no traction field"),
+                               ("rolling", out["rolling"] == "transient",
+                                "its closed form is steady rolling"),
+                               ("slope_reduction_k0", reduces_slope(out),
+                                "its slope is reduced by polach_ka and polach_ks")):
+            if bad:
+                raise ParameterError(f"parameter {name!r}: method polach refuses "
+                                     f"{out[name]!r}: {why}")
     if out["patch_source"] == "profiles":
         if "contacts" in values and tuple(out["contacts"]) != PROFILE_CONTACTS:
             raise ParameterError("parameter 'contacts': in profiles mode the contacts are "

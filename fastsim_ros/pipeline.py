@@ -42,6 +42,7 @@ from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
+from fastsim_ros.contact.polach import PolachSolver
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
 from fastsim_ros.estimation.model import model_error
@@ -423,7 +424,7 @@ class Pipeline:
         self._override = solver
         nu, g = config["poisson_ratio"], config["shear_modulus"]
         # one solver per method of parameters.METHODS (CalibratedMaeSolver is a MaeSolver)
-        self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver] = {
+        self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver | PolachSolver] = {
             "mae": MaeSolver(nu, g), "mae_calibrated": CalibratedMaeSolver(nu, g),
             "fastsim_ellipse": EquivalentEllipseSolver(nu, g)}
         self._wheel: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
@@ -458,6 +459,10 @@ class Pipeline:
     def _apply(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
         """Take ``config``; ``changed``: the parameters set at run time (:meth:`update`)."""
         self.config = config
+        if config["method"] == "polach":  # kA, kS may change while running
+            nu, g = config["poisson_ratio"], config["shear_modulus"]
+            self._solvers["polach"] = PolachSolver(nu, g, k_a=float(config["polach_ka"]),
+                                                   k_s=float(config["polach_ks"]))
         self._solver = self._override or self._solvers[config["method"]]
         self._bound = config["traction_bound"]
         self._frame_id = config["wheelset_frame"]

@@ -65,12 +65,13 @@ from fastsim_ros.contact.compiled import _law as _kernel_law
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, friction_law
 from fastsim_ros.contact.knee import knee_factors
+from fastsim_ros.contact.polach import PolachSolver
 from fastsim_ros.contact.slope_reduction import SlopeReduction
 
 FloatArray = NDArray[np.float64]
-Solver = MaeSolver | EquivalentEllipseSolver
+Solver = MaeSolver | EquivalentEllipseSolver | PolachSolver
 #: the solvers the estimators may use as their measurement model
-METHODS = ("mae_calibrated", "mae", "fastsim_ellipse")
+METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "polach")
 #: the model error's standard deviation as a share of its bound mu_s (1 - k) N (the bound as
 #: two sigma; the module's docstring)
 MODEL_ERROR_SHARE = 0.5
@@ -102,6 +103,8 @@ def solver_for(method: str, nu: float, shear_modulus: float) -> Solver:
         return MaeSolver(nu, shear_modulus)
     if method == "fastsim_ellipse":
         return EquivalentEllipseSolver(nu, shear_modulus)
+    if method == "polach":
+        return PolachSolver(nu, shear_modulus)
     raise InvalidInputError(f"unknown method {method!r}: one of {', '.join(METHODS)}")
 
 
@@ -271,7 +274,7 @@ class CreepModel:
         """
         check_bound(self.bound)
         reduced = self.reduction is not None and not self.reduction.identity
-        if reduced:
+        if reduced or isinstance(self.solver, PolachSolver):  # Polach's: no FastSim knee
             object.__setattr__(self, "knee", False)
         object.__setattr__(self, "_kernel", None if reduced
                            else _mae_kernel(self.solver, self.bound))
