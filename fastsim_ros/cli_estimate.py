@@ -51,6 +51,11 @@ from fastsim_ros.contact.errors import InvalidInputError
 #: the most samples a measured file may hold
 MAX_SAMPLES = 100_000
 #: the solvers the fit may use (compiled batches: one call per model evaluation)
+#: the most model evaluations of a fit; of the exact model's exponential fit, that starts
+#: from the fast model's: least-squares steps (each takes 1 + 3 batches, the 3 its
+#: finite differences; a batch of 30 samples 1-3 s at 60 x 60 cells)
+MAX_EVALUATIONS = 200
+MAX_EXACT_EXPONENTIAL_EVALUATIONS = 3
 METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse", "polach")
 #: the most samples ``--method exact`` takes (about 10 ms a solve at 20 x 20 cells, a few
 #: dozen evaluations of the curve)
@@ -186,10 +191,24 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         correction, note = "none", (f"{args.method} under the slope reduction (the modified "
                                     "FastSim of Spiryagin et al.), uncorrected")
     # a fast method as the node's estimator takes it: times the knee factor
+    start = (args.mu, args.friction_limit_ratio, args.friction_decay)
+    evaluations = MAX_EVALUATIONS
+    if args.method == "exact" and exponential:
+        # the exact model costs seconds a batch: the fast model (the node's, the calibrated
+        # MAE times the knee factor) finds the law's valley, the exact one finishes from
+        # there in a few evaluations
+        seed = fit_friction(solver_for("mae_calibrated", args.nu, args.shear_modulus),
+                            patch, creepages, measured, law="exponential", speed=args.speed,
+                            bound=args.bound, mu0=args.mu,
+                            limit_ratio0=args.friction_limit_ratio,
+                            decay0=args.friction_decay, knee=True)
+        start = (seed.mu_s, min(seed.limit_ratio, 0.999), seed.decay)
+        evaluations = MAX_EXACT_EXPONENTIAL_EVALUATIONS
     fit = fit_friction(solver, patch, creepages, measured, law=args.friction_law,
-                       speed=args.speed, bound=args.bound, mu0=args.mu,
-                       limit_ratio0=args.friction_limit_ratio, decay0=args.friction_decay,
-                       knee=args.method != "exact", reduction=reduction)
+                       speed=args.speed, bound=args.bound, mu0=start[0],
+                       limit_ratio0=start[1], decay0=start[2],
+                       knee=args.method != "exact", reduction=reduction,
+                       max_evaluations=evaluations)
 
     def finite_or_none(v: float) -> float | None:
         return v if math.isfinite(v) else None

@@ -78,7 +78,8 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
                  *, law: str = "constant", speed: float | None = None, bound: str = "given",
                  mu0: float = 0.3, limit_ratio0: float = 0.5,
                  decay0: float = 1.0, knee: bool = False,
-                 reduction: SlopeReduction | None = None) -> FrictionFit:
+                 reduction: SlopeReduction | None = None,
+                 max_evaluations: int = 200) -> FrictionFit:
     """Fit ``law`` to ``measured`` (``(n,)`` Fx or ``(n, 2)`` Fx, Fy in N) at ``creepages``.
 
     ``creepages``: ``(n, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about the
@@ -89,6 +90,7 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
     the node's estimator's model; not with the exact solver or the
     parabolic bound).  ``reduction``: a known creep-slope reduction the law
     carries (the modified FastSim; fast solvers only; no knee factor then).
+    ``max_evaluations``: the most model evaluations (batches) of the search.
     """
     from scipy.optimize import least_squares
 
@@ -161,7 +163,7 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
         x0[2] = (1.0 - x0[1]) * x0[2]
     sol = least_squares(residuals, np.array(x0, dtype=np.float64), bounds=(lo, hi),
                         method="trf", x_scale="jac", diff_step=1e-3, xtol=1e-10, ftol=1e-12,
-                        gtol=1e-12, max_nfev=200)
+                        gtol=1e-12, max_nfev=max_evaluations)
     theta = np.array(sol.x, dtype=np.float64)
     predicted = forces(theta)
     dof = max(z.size - p, 1)
@@ -176,6 +178,12 @@ def fit_friction(solver: Solver | ExactSolver, area: GridArea, creepages: ArrayL
     # the residuals are forces over N: mu_s's column holds each sample's sensitivity r
     if float(np.max(np.abs(jac[:, 0]), initial=0.0)) < MIN_SENSITIVITY:
         seen = seen[seen != 0]
+    if seen.size and 0 in seen:
+        jtj = jac[:, seen].T @ jac[:, seen]
+        if np.linalg.cond(jtj) >= 1e14:
+            # A and B along a valley the samples do not close (constant friction fits as
+            # well as any falling law): they are undetermined, mu_s is as alone
+            seen = seen[seen == 0]
     if seen.size:
         jtj = jac[:, seen].T @ jac[:, seen]
         if np.linalg.cond(jtj) < 1e14:
