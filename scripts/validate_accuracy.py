@@ -43,7 +43,7 @@ from fastsim_ros import cli, cli_wheelset  # noqa: E402
 from fastsim_ros.contact import exact  # noqa: E402
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
-from fastsim_ros.contact.polach import PolachSolver
+from fastsim_ros.contact.polach import PolachSolver  # noqa: E402
 from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from fastsim_ros.machine import machine  # noqa: E402
 

@@ -57,7 +57,7 @@ from fastsim_ros.contact.asm import (asm_fastsim_coefficients, asm_flexibility, 
 from fastsim_ros.contact.dlm import dlm_coefficients, dlm_flexibility  # noqa: E402
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver,  # noqa: E402
                                           EquivalentEllipseSolver, MaeSolver, warm_up)
-from fastsim_ros.contact.polach import PolachSolver
+from fastsim_ros.contact.polach import PolachSolver  # noqa: E402
 from fastsim_ros.contact.equivalent import equivalent_coefficients  # noqa: E402
 from fastsim_ros.contact.errors import ContactError  # noqa: E402
 from fastsim_ros.contact.fastrip import fastrip, fastrip_coefficients  # noqa: E402

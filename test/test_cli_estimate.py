@@ -83,7 +83,7 @@ CONTACT = __import__("pathlib").Path(__file__).parent / "data" / "contact_tractc
 
 
 def contact_measured(tmp_path, series):
-    """CONTACT's printed Fx of one series of its tractcurv example, as ``--measured``."""
+    """Write the printed Fx of one series of CONTACT's tractcurv example as ``--measured``."""
     import csv
     lines = [line for line in CONTACT.read_text().splitlines() if not line.startswith("#")]
     rows = ["xi,eta,phi,Fx"] + [f"{r['cksi']},0,0,{r['fx']}" for r in csv.DictReader(lines)
@@ -112,7 +112,7 @@ def test_exact_falling_law_on_contacts_coulomb_curve_answers(capsys, tmp_path):
 
 
 def test_known_slope_reduction_recovers_the_modified_fastsim_law(capsys, tmp_path):
-    """CONTACT's modified-FastSim curve, its reduction given: mu_s 0.36 and A 0.38 within 5%."""
+    """With its reduction given, the modified-FastSim curve gives mu_s 0.36, A 0.38 (5%)."""
     path = contact_measured(tmp_path, "modified_fastsim")
     rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
                        "--friction-law", "exponential", "--method", "fastsim_ellipse",

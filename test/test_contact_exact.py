@@ -405,8 +405,11 @@ def test_a_warm_start_solves_the_same_problem_in_fewer_newton_steps(law):
 
 
 def test_a_steeply_falling_law_converges_by_continuation_in_the_speed():
-    """Friction halving within 0.7 mm/s of slip (B = 1000 s/m at 10 m/s), CONTACT's
-    Eurosprinter ellipse: continuation in |V| reaches a solution that obeys the law."""
+    """Continuation in |V| solves a steeply falling law, and the solution obeys it.
+
+    Friction halving within 0.7 mm/s of slip (B = 1000 s/m at 10 m/s) on
+    CONTACT's Eurosprinter ellipse.
+    """
     ar = areas.ellipse(6.304e-3, 12.61e-3, nx=60, ny=60, load=106700.0)
     law = ExponentialFriction(0.37, 0.9, 1000.0)
     g = 8.2e10

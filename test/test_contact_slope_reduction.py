@@ -49,7 +49,7 @@ def patch() -> GridArea:
 
 
 def skewed_patch() -> GridArea:
-    """A non-elliptical patch (a pear: wider at one side), Hertz-like pressure."""
+    """Make a non-elliptical patch (a pear: wider at one side), Hertz-like pressure."""
     n = 40
     x = (np.arange(n) + 0.5) / n * 2.0 - 1.0
     y = x.copy()
@@ -88,7 +88,7 @@ def test_plain_fastsim_gap_is_the_reduced_one(patch: GridArea) -> None:
                                        SlopeReduction(1.0, 0.3, 0.0)])
 @pytest.mark.parametrize("law", ["constant", "exponential"])
 def test_no_reduction_is_todays_numbers_to_the_bit(reduction: SlopeReduction, law: str) -> None:
-    """k = 1 at every creepage: every solver's forces bit for bit as without a reduction."""
+    """With k = 1 at every creepage every solver's forces are bit for bit those without."""
     area = skewed_patch()
     plain = friction_law(law, 0.3, limit_ratio=0.4, decay=0.6)
     reduced = friction_law(law, 0.3, limit_ratio=0.4, decay=0.6, reduction=reduction)
@@ -168,7 +168,7 @@ def test_initial_slope_is_k0_of_the_theorys(patch: GridArea) -> None:
 
 
 def test_factor_formula_and_constant_reduction() -> None:
-    """k = k0 [alpha + (1 - alpha)/(1 + beta eps)], eps = G pi a b k0 C11 w / (4 mu N)."""
+    """The factor is k0 [alpha + (1 - alpha)/(1 + beta eps)], eps = G pi a b k0 C11 w/(4 mu N)."""
     r = SlopeReduction(0.54, 0.02, 0.62)
     c11 = coefficient_table(NU).kalker(A / B)[0]
     w = 3e-3
