@@ -1032,6 +1032,8 @@ class Pipeline:
             return None
         memory = self._memories.get(contact)
         if memory is None:
+            # the parameters refuse transient rolling with Polach's closed form
+            assert not isinstance(self._solver, PolachSolver)
             memory = ContactMemory(TransientSolver(self._solver),
                                    max_gap=float(self.config["transient_max_gap"]))
             # the contact's counts, cumulative as every other count
