@@ -83,6 +83,10 @@ def add_parser(sub: Any, finite: Any) -> None:
                    help="rolling speed V (m/s; its magnitude is used), for the exponential law")
     p.add_argument("--load", type=finite, help="normal load N (N)")
     cli.add_slope_reduction(p, finite)
+    p.add_argument("--fit-slope-reduction", action="store_true",
+                   help="fit the slope reduction k0, alpha_inf, beta with the law (from "
+                   "--slope-*, or from 0.8, 0.5, 1 when those are no reduction; a fast "
+                   "method): a contaminated rail's reduced slope")
     cli.add_material(p, finite)
     p.add_argument("--method", choices=METHODS, default="exact",
                    help="the measurement model: exact (default: Kalker's exact theory, the "
@@ -164,7 +168,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
                                     f"{args.friction_decay:g}")
     reduction = cli.slope_reduction(args)
-    if reduction is not None and args.method == "exact":
+    if (reduction is not None or args.fit_slope_reduction) and args.method == "exact":
         raise cli.UsageError("--method exact is Kalker's exact theory, its slope in full: "
                              "the --slope-* reduction needs a fast method")
     creepages, measured = read_measured(args.measured,
@@ -187,7 +191,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     else:
         solver = solver_for(args.method, args.nu, args.shear_modulus)
     correction, note = model_correction(args.method, args.bound, solver)
-    if reduction is not None:
+    if reduction is not None or args.fit_slope_reduction:
         correction, note = "none", (f"{args.method} under the slope reduction (the modified "
                                     "FastSim of Spiryagin et al.), uncorrected")
     # a fast method as the node's estimator takes it: times the knee factor
@@ -208,7 +212,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
                        speed=args.speed, bound=args.bound, mu0=start[0],
                        limit_ratio0=start[1], decay0=start[2],
                        knee=args.method != "exact", reduction=reduction,
-                       max_evaluations=evaluations)
+                       max_evaluations=evaluations, fit_reduction=args.fit_slope_reduction)
 
     def finite_or_none(v: float) -> float | None:
         return v if math.isfinite(v) else None
@@ -238,7 +242,16 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "sigma_mu_static": finite_or_none(fit.sigmas["mu_s"]),
         "worst_error_percent_mu_N": fit.worst_error_percent,
         "rms_error_percent_mu_N": fit.rms_error_percent, "evaluations": fit.evaluations}
-    if reduction is not None:
+    if args.fit_slope_reduction and fit.reduction is not None:
+        r = fit.reduction
+        result.update(slope_reduction={
+            "k0": determined("slope_k0", r.k0),
+            "alpha_inf": determined("slope_alpha_inf", r.alpha_inf),
+            "beta": determined("slope_beta", r.beta),
+            "sigma_k0": finite_or_none(fit.sigmas["slope_k0"]),
+            "sigma_alpha_inf": finite_or_none(fit.sigmas["slope_alpha_inf"]),
+            "sigma_beta": finite_or_none(fit.sigmas["slope_beta"]), "fitted": True})
+    elif reduction is not None:
         result.update(slope_reduction={"k0": reduction.k0, "alpha_inf": reduction.alpha_inf,
                                        "beta": reduction.beta})
     if exponential:
@@ -290,5 +303,12 @@ def print_table(result: dict[str, Any]) -> None:
         print(f"  A = {pm(result['friction_limit_ratio'], result['sigma_friction_limit_ratio'])}")
         unit = " s/m" if result["friction_decay"] is not None else ""
         print(f"  B = {pm(result['friction_decay'], result['sigma_friction_decay'])}{unit}")
+    red = result.get("slope_reduction")
+    if red is not None and red.get("fitted"):
+        for key in ("k0", "alpha_inf", "beta"):
+            print(f"  slope reduction {key} = {pm(red[key], red['sigma_' + key])}")
+    elif red is not None:
+        print(f"  slope reduction (given): k0 {red['k0']:g}, alpha_inf {red['alpha_inf']:g}, "
+              f"beta {red['beta']:g}")
     print(f"  fitted curve: worst error {result['worst_error_percent_mu_N']:.3g}% of mu N, "
           f"rms {result['rms_error_percent_mu_N']:.3g}%")

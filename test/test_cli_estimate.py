@@ -128,3 +128,34 @@ def test_known_slope_reduction_recovers_the_modified_fastsim_law(capsys, tmp_pat
     rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
                        "--method", "exact", "--slope-k0", "0.5")
     assert rc == 2 and "fast method" in err
+
+
+def test_contacts_modified_fastsim_parameters_recovered(capsys, tmp_path):
+    """Fitted with the law: mu_s, A, B and k0, alpha_inf, beta of CONTACT's curve within 5%."""
+    path = contact_measured(tmp_path, "modified_fastsim")
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--friction-law", "exponential", "--method", "fastsim_ellipse",
+                       "--bound", "parabolic", "--fit-slope-reduction")
+    assert rc == 0, err
+    res = json.loads(out)
+    red = res["slope_reduction"]
+    for got, want in ((res["mu_static"], 0.36), (res["friction_limit_ratio"], 0.38),
+                      (res["friction_decay"], 0.7), (red["k0"], 0.54),
+                      (red["alpha_inf"], 0.02), (red["beta"], 0.62)):
+        assert got == pytest.approx(want, rel=0.05)
+    assert res["worst_error_percent_mu_N"] < 2.0
+
+
+def test_interface_layer_curve_says_what_it_cannot_determine(capsys, tmp_path):
+    """CONTACT's interface layer: mu_s within 3%, the reduction's shape left open."""
+    path = contact_measured(tmp_path, "exact_interface_layer")
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--friction-law", "exponential", "--method", "fastsim_ellipse",
+                       "--fit-slope-reduction")
+    assert rc == 0, err
+    res = json.loads(out)
+    assert res["mu_static"] == pytest.approx(0.33, rel=0.03)
+    assert res["worst_error_percent_mu_N"] < 2.0
+    red = res["slope_reduction"]
+    # k0, alpha_inf and beta trade off along the curve: not all three are pinned
+    assert red["beta"] is None or red["sigma_k0"] is None or red["sigma_k0"] > 0.1
