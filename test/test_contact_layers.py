@@ -27,7 +27,7 @@ ALLOWED = {
     "pairs": {"numpy", "errors", "rules"},
     "slope_reduction": {"errors"},
     "friction": {"numpy", "checks", "errors", "rules", "slope_reduction"},
-    "fastsim": {"numpy", "area", "checks", "friction", "rules", "traction"},
+    "fastsim": {"numpy", "area", "checks", "errors", "friction", "rules", "traction"},
     "mae": {"numpy", "area", "checks", "coefficients", "equivalent", "fastsim", "friction",
             "rules", "tables", "traction"},
     "equivalent": {"numpy", "area", "checks", "coefficients", "fastsim", "friction", "rules",

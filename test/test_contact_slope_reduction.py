@@ -215,3 +215,23 @@ def test_bad_reduction_refused(args: tuple[float, float, float]) -> None:
 def test_slip_dependent_reduced_law_needs_speed(patch: GridArea) -> None:
     with pytest.raises(InvalidInputError, match="speed"):
         EquivalentEllipseSolver(NU, G).solve(patch, 1e-3, 0.0, 0.0, friction=POLACH_LAW)
+
+
+def test_paths_that_cannot_apply_a_reduction_refuse_it(patch: GridArea) -> None:
+    """The exact theory, FastSim's bare sweep and the transient step never drop it silently."""
+    from fastsim_ros.contact import exact
+    from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
+    from fastsim_ros.contact.transient import TransientSolver
+    small = ellipse(A, B, nx=12, ny=12, load=LOAD)
+    with pytest.raises(InvalidInputError, match="full slope"):
+        exact.coulomb(small, 1e-3, 0.0, 0.0, nu=NU, shear_modulus=G, friction=POLACH_LAW,
+                      speed=SPEED)
+    ones = np.ones(small.ny)
+    with pytest.raises(InvalidInputError, match="slope reduction"):
+        fastsim(small, 1e-3, 0.0, 0.0, bound=traction_bound(small, 0.36),
+                flexibility=StripFlexibility(ones, ones, ones, ones), friction=POLACH_LAW,
+                speed=SPEED)
+    step = TransientSolver(CalibratedMaeSolver(NU, G))
+    with pytest.raises(InvalidInputError, match="slope reduction"):
+        step.step(None, small.pressure, small.x0, small.y0, small.dx, small.dy, 1e-3, 0.0,
+                  0.0, 1e-3, friction=POLACH_LAW, speed=SPEED)

@@ -160,6 +160,9 @@ def _law(mu: float | None, friction: FrictionLaw | None,
         # (0.65 us of a transient step's 7 us in Python)
         return k.LAW_CONSTANT, _NO_PARAMS, check_friction(float(mu)), 0.0
     law = resolve(mu, friction)
+    if law.reduces_slope:  # the solvers' own calls apply it (_Solver._reducing)
+        raise InvalidInputError("this call takes no slope reduction: the solvers' solve, "
+                                "solve_arrays and solve_batch apply it")
     if law.slip_dependent:
         return law.code, law.params, law.mu_s, check_speed(speed)
     return law.code, _NO_PARAMS, law.mu_s, 0.0

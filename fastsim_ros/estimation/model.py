@@ -281,7 +281,8 @@ class CreepModel:
         # the march's own slope (the MAE kernels); False: the EKF's forward difference
         object.__setattr__(self, "_marched_slope", self._kernel is not None)  # type: ignore
         # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
-        object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
+        object.__setattr__(self, "_law_template", self._kernel_law(friction_law(
+            self.law, 1.0, limit_ratio=self.limit_ratio, decay=self.decay)))
         object.__setattr__(self, "_knee", knee_factors(self.solver.nu)
                            if self.knee and not check_bound(self.bound) else None)
         object.__setattr__(self, "_ell", np.empty(kernels.ELL_SIZE))
