@@ -147,7 +147,7 @@ def test_contacts_modified_fastsim_parameters_recovered(capsys, tmp_path):
 
 
 def test_interface_layer_curve_says_what_it_cannot_determine(capsys, tmp_path):
-    """CONTACT's interface layer: mu_s within 3%, the reduction's shape left open."""
+    """On the interface-layer curve mu_s is within 3%, the reduction's shape left open."""
     path = contact_measured(tmp_path, "exact_interface_layer")
     rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
                        "--friction-law", "exponential", "--method", "fastsim_ellipse",
