@@ -26,7 +26,9 @@ each call, after a warm-up; the three compiled calls interleaved in blocks):
   a rig's noise on them (the far field's fixed point then follows a change
   of force every step), over the steady ``solve_arrays``,
 
-then the batched throughput (patch solves per second, one core) of
+the cost of the slope reduction of contaminated rails and of Polach's method
+(:func:`real_rails_table`; ``--real-rails-only`` runs it alone), then the
+batched throughput (patch solves per second, one core) of
 ``solve_batch`` on distinct patches and on one patch under many creepages.
 The machine (platform, CPU, cores, load average) is printed with the figures:
 quote it with them.
@@ -49,7 +51,9 @@ from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, EquivalentEllipseSolver,
                                           MaeSolver, warm_up)
 from fastsim_ros.contact.fastsim import traction_bound
+from fastsim_ros.contact.friction import ExponentialFriction, SlopeReduction
 from fastsim_ros.contact.mae import mae_fastsim
+from fastsim_ros.contact.polach import PolachSolver
 from fastsim_ros.contact.tables import coefficient_table
 from fastsim_ros.contact.transient import TransientSolver
 from machine import machine  # noqa: E402  (the one machine line of every benchmark)
@@ -206,6 +210,53 @@ def transient_table(calls: int, cells: int = 30) -> None:
           "(the target: 1.5).\n")
 
 
+def real_rails_table(calls: int, grids: list[int]) -> None:
+    """Print the cost of a solve with and without the slope reduction, and Polach's, one run.
+
+    ``solve_arrays`` of the calibrated MAE and of the equivalent ellipse at
+    Coulomb's ``mu`` (today's call), then under the falling law with the
+    Eurosprinter's slope reduction (k0 0.54, alpha_inf 0.02, beta 0.62; mu_s
+    0.36, A 0.38, B 0.7 s/m, 10 m/s: the modified FastSim, its extra cost the
+    equivalent ellipse and the factor ``k``), and ``PolachSolver.solve_arrays``
+    (Polach's closed form with kA 0.3, kS 0.1) on the same patch, interleaved.
+    """
+    law = ExponentialFriction(0.36, 0.38, 0.7, reduction=SlopeReduction(0.54, 0.02, 0.62))
+    falling = ExponentialFriction(0.36, 0.38, 0.7)
+    calibrated = CalibratedMaeSolver(NU, G)
+    baseline = EquivalentEllipseSolver(NU, G)
+    polach = PolachSolver(NU, G, k_a=0.3, k_s=0.1)
+    xi, eta, phi = CREEP
+    print("real rails: solve_arrays with Coulomb's mu, under the falling law alone, and under "
+          "the falling law with the slope reduction; Polach's closed form\n")
+    head = (f"{'patch':<14}{'grid':>6}  {'cal mu':>13}  {'cal law':>13}  {'cal reduced':>13}"
+            f"{'ratio':>7}  {'eq mu':>13}  {'eq reduced':>13}{'ratio':>7}  {'polach':>13}")
+    print(head)
+    print("-" * len(head))
+    for name, make in (("semi-ellipses", semi_ellipses), ("ellipse", ellipse)):
+        for n in grids:
+            ar = make(n)
+            p = np.array(ar.pressure)
+            grid = (ar.x0, ar.y0, ar.dx, ar.dy)
+            t = per_call({
+                "cal": lambda: calibrated.solve_arrays(p, *grid, xi, eta, phi, 0.36),
+                "cal_law": lambda: calibrated.solve_arrays(p, *grid, xi, eta, phi,
+                                                           friction=falling, speed=10.0),
+                "cal_red": lambda: calibrated.solve_arrays(p, *grid, xi, eta, phi,
+                                                           friction=law, speed=10.0),
+                "eq": lambda: baseline.solve_arrays(p, *grid, xi, eta, phi, 0.36),
+                "eq_red": lambda: baseline.solve_arrays(p, *grid, xi, eta, phi, friction=law,
+                                                        speed=10.0),
+                "polach": lambda: polach.solve_arrays(p, *grid, xi, eta, phi, friction=falling,
+                                                      speed=10.0)}, calls)
+
+            def cell(key: str) -> str:
+                return f"{t[key][0]:>6.1f} /{t[key][1]:>5.1f}"
+            print(f"{name:<14}{n:>6}  {cell('cal')}  {cell('cal_law')}  {cell('cal_red')}"
+                  f"{t['cal_red'][0] / t['cal'][0]:>7.2f}  {cell('eq')}  {cell('eq_red')}"
+                  f"{t['eq_red'][0] / t['eq'][0]:>7.2f}  {cell('polach')}")
+    print("\ntimes in us, median / p99; ratio: the reduced median over Coulomb's.\n")
+
+
 def main() -> None:
     """Run the benchmark and print its tables."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
@@ -214,7 +265,14 @@ def main() -> None:
                         help="timed calls of the numpy reference")
     parser.add_argument("--batch", type=int, default=2000, help="items per batch")
     parser.add_argument("--grids", type=int, nargs="+", default=list(GRIDS))
+    parser.add_argument("--real-rails-only", action="store_true",
+                        help="only the table of the slope reduction and Polach's method")
     args = parser.parse_args()
+    if args.real_rails_only:
+        print(f"machine: {machine()}")
+        print(f"warm-up (compile or load the cached kernels): {warm_up():.2f} s")
+        real_rails_table(args.calls, args.grids)
+        return
 
     print(f"machine: {machine()}")
     print(f"warm-up (compile or load the cached kernels): {warm_up():.2f} s")
@@ -308,6 +366,7 @@ def main() -> None:
           "far field (Kalker's local model); stepping: the far field\nwith a creepage step "
           "every call (its secant every time).\n")
     transient_table(args.calls)
+    real_rails_table(args.calls, args.grids)
     print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
     head = (f"{'patch':<14}{'grid':>6}  {'MAE distinct':>13}{'MAE 1 patch':>13}"
             f"{'eq distinct':>13}{'eq 1 patch':>13}{'cal distinct':>13}{'cal 1 patch':>13}")

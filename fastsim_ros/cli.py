@@ -57,6 +57,7 @@ from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
 from fastsim_ros.errors import UsageError
 from fastsim_ros.contact.friction import ConstantFriction, ExponentialFriction, FrictionLaw
+from fastsim_ros.contact.slope_reduction import SlopeReduction
 from fastsim_ros.params import SPECS
 
 
@@ -80,14 +81,15 @@ DEFAULT_CELLS = {"exact": 100, "mae": 100, "mae_calibrated": 100, "fastsim": 60,
                  "dlm": 100, "asm": 100,
                  "exact_forces": 60, "mae_forces": 60, "mae_calibrated_forces": 60,
                  "fastsim_ellipse_forces": 60, "fastrip_forces": 60, "dlm_forces": 60,
-                 "asm_forces": 60}
+                 "asm_forces": 60, "polach_forces": 60}
 #: the coarsest grid of an extrapolation of the exact forces (cells across): a shape on
 #: fewer than twice this is solved on its grid alone
 EXACT_COARSEST = 8
 #: the methods of ``coefficients`` (default ``exact``: the coefficients are the exact
 #: theory's numbers) and of ``forces`` (default the node's ``method``)
 COEFFICIENT_METHODS = ("exact", "mae", "mae_calibrated", "fastsim", "dlm", "asm")
-FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm")
+FORCE_METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact", "fastrip", "dlm", "asm",
+                 "polach")
 #: the most cells along each axis of a shape's grid (``--cells``)
 MAX_CELLS = 400
 #: the most cells the grid of a patch file may span (its cells' bounding box at
@@ -191,6 +193,35 @@ def add_poisson_ratio(p: Any, finite: Callable[[str], float]) -> None:
                    "published tables are at 0.25: ask for it)")
 
 
+def add_slope_reduction(p: Any, finite: Callable[[str], float]) -> None:
+    """Add ``--slope-k0``, ``--slope-alpha-inf``, ``--slope-beta`` (the node's defaults)."""
+    p.add_argument("--slope-k0", type=finite, metavar="K0",
+                   default=node_default("slope_reduction_k0"),
+                   help="creep-slope reduction of a contaminated rail (modified FastSim, "
+                   "Spiryagin et al.; docs/guide_real_rails.md): k0 in (0, 1], the slope's "
+                   "share at vanishing creepage; default %(default)s (with alpha_inf 1: the "
+                   "theory's full slope)")
+    p.add_argument("--slope-alpha-inf", type=finite, metavar="ALPHA",
+                   default=node_default("slope_reduction_alpha_inf"),
+                   help="alpha_inf in [0, 1]: k(inf)/k0 of the reduction; default %(default)s")
+    p.add_argument("--slope-beta", type=finite, metavar="BETA",
+                   default=node_default("slope_reduction_beta"),
+                   help="beta >= 0: how fast k falls with the slip area; default %(default)s")
+
+
+def slope_reduction(args: argparse.Namespace) -> SlopeReduction | None:
+    """Return the reduction of ``--slope-*`` (None: ``k = 1``), each flag checked."""
+    for flag, spec in (("--slope-k0", "slope_reduction_k0"),
+                       ("--slope-alpha-inf", "slope_reduction_alpha_inf"),
+                       ("--slope-beta", "slope_reduction_beta")):
+        value = getattr(args, flag[2:].replace("-", "_"))
+        lo, hi = SPECS[spec].low, SPECS[spec].high
+        if not lo <= value <= hi:  # type: ignore[operator]
+            raise InvalidInputError(f"{flag} must lie in [{lo:g}, {hi:g}], got {value:g}")
+    reduction = SlopeReduction(args.slope_k0, args.slope_alpha_inf, args.slope_beta)
+    return None if reduction.identity else reduction
+
+
 def add_allow_implausible(p: Any, quantities: Sequence[str] | None = None) -> None:
     """Add ``--allow-implausible``: accept values outside :data:`plausibility.PLAUSIBILITY`.
 
@@ -235,12 +266,19 @@ def build_parser() -> argparse.ArgumentParser:
                     help="B >= 0 (s/m) of the exponential law")
     fo.add_argument("--speed", type=_finite, metavar="V",
                     help="rolling speed V (m/s; its magnitude is used)")
+    add_slope_reduction(fo, _finite)
     fo.add_argument("--load", type=_finite, help="normal load N (N)")
     add_material(fo, _finite)
     fo.add_argument("--method", choices=FORCE_METHODS, default=node_default("method"),
                     help="mae_calibrated (the calibrated MAE), mae (the paper's MAE), "
-                    "fastsim_ellipse, exact, fastrip, dlm or asm; default %(default)s, the "
-                    "node's")
+                    "fastsim_ellipse, exact, fastrip, dlm, asm or polach (Polach's closed "
+                    "form on the equivalent ellipse); default %(default)s, the node's")
+    fo.add_argument("--polach-ka", type=_finite, metavar="KA",
+                    default=node_default("polach_ka"),
+                    help="Polach's kA in (0, 1] (method polach); default %(default)s")
+    fo.add_argument("--polach-ks", type=_finite, metavar="KS",
+                    default=node_default("polach_ks"),
+                    help="Polach's kS in (0, kA] (method polach); default %(default)s")
     fo.add_argument("--bound", choices=BOUNDS, default=node_default("traction_bound"),
                     help="traction bound: mu p as given, or parabolic, mu N p^2/sum(p^2 dA) "
                     "(Kalker's on a Hertzian patch); default %(default)s, the node's")
@@ -563,8 +601,12 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
         raise UsageError("--method fastrip takes the strips' Hertzian pressure of the given "
                          "load (--bound given)")
     law = _friction(args)
-    if args.method == "fastrip" and not isinstance(law, ConstantFriction):
-        raise UsageError("--method fastrip takes constant friction (--friction-law constant)")
+    if args.method == "exact" and law.reduces_slope:
+        raise UsageError("--method exact is Kalker's exact theory, its slope in full: the "
+                         "--slope-* reduction is an option of the fast methods")
+    if args.method == "fastrip" and law.slip_dependent and not law.reduces_slope:
+        raise UsageError("--method fastrip takes constant friction (--friction-law constant), "
+                         "or a law with a --slope-* reduction (taken at the rigid slip)")
     patch = _force_area(args)
     # before any solve: a unit mistake is refused, not answered with believable numbers
     check_plausible_area(args, patch)
@@ -576,6 +618,10 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     if isinstance(law, ExponentialFriction):
         result.update(friction_limit_ratio=law.limit_ratio, friction_decay=law.decay,
                       speed=args.speed)
+    if law.reduction is not None:
+        result.update(slope_reduction={"k0": law.reduction.k0,
+                                       "alpha_inf": law.reduction.alpha_inf,
+                                       "beta": law.reduction.beta})
     creepages = (args.xi, args.eta, args.phi)
     speed = None if args.speed is None else abs(args.speed)
     cells = [patch.nx, patch.ny]
@@ -623,12 +669,30 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     elif args.method == "fastrip":
         from fastsim_ros.contact.fastrip import fastrip
         from fastsim_ros.contact.tables import coefficient_table
-        fr = fastrip(patch, *creepages, mu=args.mu, table=coefficient_table(args.nu),
-                     shear_modulus=args.shear_modulus)
+        table = coefficient_table(args.nu)
+        fr_creep, fr_mu = creepages, args.mu
+        if law.reduces_slope:  # the modified FastSim's k and mu (equivalent.reduce_slope)
+            from fastsim_ros.contact.equivalent import reduce_slope
+            red = reduce_slope(patch, *creepages, law, speed, table=table,
+                               shear_modulus=args.shear_modulus)
+            fr_creep, fr_mu = (red.xi, red.eta, red.phi), red.friction.mu_s
+        fr = fastrip(patch, *fr_creep, mu=fr_mu, table=table, shear_modulus=args.shear_modulus)
         e = fr.ellipse
         result.update(Fx=fr.fx, Fy=fr.fy, Mz=fr.mz, slip_fraction=float(
             np.count_nonzero(fr.traction.slip)) / np.count_nonzero(patch.mask),
             ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
+    elif args.method == "polach":
+        from fastsim_ros.contact.compiled import EquivalentEllipseSolver
+        from fastsim_ros.contact.polach import PolachSolver
+        if law.reduces_slope:
+            raise UsageError("--method polach reduces its slope with --polach-ka and "
+                             "--polach-ks, not --slope-*")
+        pol = PolachSolver(args.nu, args.shear_modulus, k_a=args.polach_ka, k_s=args.polach_ks)
+        res = pol.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
+        e = EquivalentEllipseSolver(args.nu, args.shear_modulus).ellipse(patch)
+        result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
+                      polach_ka=args.polach_ka, polach_ks=args.polach_ks,
+                      ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
     else:
         from fastsim_ros.contact.compiled import EquivalentEllipseSolver
         eq = EquivalentEllipseSolver(args.nu, args.shear_modulus)
@@ -652,7 +716,7 @@ def _friction(args: argparse.Namespace) -> FrictionLaw:
             raise UsageError(f"{' and '.join(extra)} only apply to --friction-law exponential")
         if args.speed is not None:
             _speed(args.speed)
-        return ConstantFriction(args.mu)
+        return ConstantFriction(args.mu, reduction=slope_reduction(args))
     missing = [flag for flag, v in given.items() if v is None]
     if missing:
         raise UsageError(f"--friction-law exponential requires {', '.join(missing)}")
@@ -662,7 +726,7 @@ def _friction(args: argparse.Namespace) -> FrictionLaw:
     if not 0.0 <= b <= 1e4:
         raise InvalidInputError(f"--friction-decay must lie in [0, 1e4] s/m, got {b:g}")
     _speed(args.speed)
-    return ExponentialFriction(args.mu, a, b)
+    return ExponentialFriction(args.mu, a, b, reduction=slope_reduction(args))
 
 
 def _speed(v: float) -> None:

@@ -52,7 +52,12 @@ from fastsim_ros.errors import UsageError
 #: the most samples a measured file may hold
 MAX_SAMPLES = 100_000
 #: the solvers the fit may use (compiled batches: one call per model evaluation)
-METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse")
+#: the most model evaluations of a fit; of the exact model's exponential fit, that starts
+#: from the fast model's: least-squares steps (each takes 1 + 3 batches, the 3 its
+#: finite differences; a batch of 30 samples 1-3 s at 60 x 60 cells)
+MAX_EVALUATIONS = 200
+MAX_EXACT_EXPONENTIAL_EVALUATIONS = 3
+METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse", "polach")
 #: the most samples ``--method exact`` takes (about 10 ms a solve at 20 x 20 cells, a few
 #: dozen evaluations of the curve)
 MAX_EXACT_SAMPLES = 200
@@ -78,12 +83,18 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--speed", type=finite, metavar="V",
                    help="rolling speed V (m/s; its magnitude is used), for the exponential law")
     p.add_argument("--load", type=finite, help="normal load N (N)")
+    cli.add_slope_reduction(p, finite)
+    p.add_argument("--fit-slope-reduction", action="store_true",
+                   help="fit the slope reduction k0, alpha_inf, beta with the law (from "
+                   "--slope-*, or from 0.8, 0.5, 1 when those are no reduction; a fast "
+                   "method): a contaminated rail's reduced slope")
     cli.add_material(p, finite)
     p.add_argument("--method", choices=METHODS, default="exact",
                    help="the measurement model: exact (default: Kalker's exact theory, the "
                    "reference, as for coefficients; seconds to a minute), mae_calibrated "
                    "(the node's method times the knee factor, the node's estimator's "
-                   "model; fast), mae or fastsim_ellipse (times the knee factor too)")
+                   "model; fast), mae or fastsim_ellipse (times the knee factor too), or "
+                   "polach (Polach's closed form, kA = kS = 1)")
     p.add_argument("--bound", choices=BOUNDS, default=cli.node_default("traction_bound"),
                    help="traction bound: mu p as given, or parabolic; default %(default)s, "
                    "the node's")
@@ -157,6 +168,10 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         if not 0.0 <= args.friction_decay <= 1e4:
             raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
                                     f"{args.friction_decay:g}")
+    reduction = cli.slope_reduction(args)
+    if (reduction is not None or args.fit_slope_reduction) and args.method == "exact":
+        raise cli.UsageError("--method exact is Kalker's exact theory, its slope in full: "
+                             "the --slope-* reduction needs a fast method")
     creepages, measured = read_measured(args.measured,
                                         allow_implausible=args.allow_implausible)
     patch = cli._force_area(args)
@@ -177,11 +192,28 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     else:
         solver = solver_for(args.method, args.nu, args.shear_modulus)
     correction, note = model_correction(args.method, args.bound, solver)
+    if reduction is not None or args.fit_slope_reduction:
+        correction, note = "none", (f"{args.method} under the slope reduction (the modified "
+                                    "FastSim of Spiryagin et al.), uncorrected")
     # a fast method as the node's estimator takes it: times the knee factor
+    start = (args.mu, args.friction_limit_ratio, args.friction_decay)
+    evaluations = MAX_EVALUATIONS
+    if args.method == "exact" and exponential:
+        # the exact model costs seconds a batch: the fast model (the node's, the calibrated
+        # MAE times the knee factor) finds the law's valley, the exact one finishes from
+        # there in a few evaluations
+        seed = fit_friction(solver_for("mae_calibrated", args.nu, args.shear_modulus),
+                            patch, creepages, measured, law="exponential", speed=args.speed,
+                            bound=args.bound, mu0=args.mu,
+                            limit_ratio0=args.friction_limit_ratio,
+                            decay0=args.friction_decay, knee=True)
+        start = (seed.mu_s, min(seed.limit_ratio, 0.999), seed.decay)
+        evaluations = MAX_EXACT_EXPONENTIAL_EVALUATIONS
     fit = fit_friction(solver, patch, creepages, measured, law=args.friction_law,
-                       speed=args.speed, bound=args.bound, mu0=args.mu,
-                       limit_ratio0=args.friction_limit_ratio, decay0=args.friction_decay,
-                       knee=args.method != "exact")
+                       speed=args.speed, bound=args.bound, mu0=start[0],
+                       limit_ratio0=start[1], decay0=start[2],
+                       knee=args.method != "exact", reduction=reduction,
+                       max_evaluations=evaluations, fit_reduction=args.fit_slope_reduction)
 
     def finite_or_none(v: float) -> float | None:
         return v if math.isfinite(v) else None
@@ -211,6 +243,18 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
         "sigma_mu_static": finite_or_none(fit.sigmas["mu_s"]),
         "worst_error_percent_mu_N": fit.worst_error_percent,
         "rms_error_percent_mu_N": fit.rms_error_percent, "evaluations": fit.evaluations}
+    if args.fit_slope_reduction and fit.reduction is not None:
+        r = fit.reduction
+        result.update(slope_reduction={
+            "k0": determined("slope_k0", r.k0),
+            "alpha_inf": determined("slope_alpha_inf", r.alpha_inf),
+            "beta": determined("slope_beta", r.beta),
+            "sigma_k0": finite_or_none(fit.sigmas["slope_k0"]),
+            "sigma_alpha_inf": finite_or_none(fit.sigmas["slope_alpha_inf"]),
+            "sigma_beta": finite_or_none(fit.sigmas["slope_beta"]), "fitted": True})
+    elif reduction is not None:
+        result.update(slope_reduction={"k0": reduction.k0, "alpha_inf": reduction.alpha_inf,
+                                       "beta": reduction.beta})
     if exponential:
         result.update(friction_limit_ratio=determined("limit_ratio", fit.limit_ratio),
                       friction_decay=determined("decay", fit.decay),
@@ -260,5 +304,12 @@ def print_table(result: dict[str, Any]) -> None:
         print(f"  A = {pm(result['friction_limit_ratio'], result['sigma_friction_limit_ratio'])}")
         unit = " s/m" if result["friction_decay"] is not None else ""
         print(f"  B = {pm(result['friction_decay'], result['sigma_friction_decay'])}{unit}")
+    red = result.get("slope_reduction")
+    if red is not None and red.get("fitted"):
+        for key in ("k0", "alpha_inf", "beta"):
+            print(f"  slope reduction {key} = {pm(red[key], red['sigma_' + key])}")
+    elif red is not None:
+        print(f"  slope reduction (given): k0 {red['k0']:g}, alpha_inf {red['alpha_inf']:g}, "
+              f"beta {red['beta']:g}")
     print(f"  fitted curve: worst error {result['worst_error_percent_mu_N']:.3g}% of mu N, "
           f"rms {result['rms_error_percent_mu_N']:.3g}%")

@@ -46,7 +46,7 @@ from msg_adapters.cdr import StampedTwist
 from msg_adapters.profile_msgs import StampedPose, quaternion
 
 #: methods of ``wheelset``: the node's (compiled) and the exact theory
-METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "exact")
+METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "polach", "exact")
 #: the most cells a patch's grid may span on the command line (the exact solver's
 #: dense operator is the limit of ``--method exact``)
 MAX_PATCH_CELLS = 160_000

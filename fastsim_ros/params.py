@@ -18,12 +18,14 @@ from typing import Any
 
 import yaml
 
+from fastsim_ros.contact.slope_reduction import SlopeReduction
 from fastsim_ros.errors import ParameterError
 
 #: the methods of the library the node offers (docs/guide_node.md): the paper's
 #: MAE, the calibrated MAE (the default since docs/validation_wider.md shows it better
-#: than the paper's on every validation area) and FastSim on the equivalent ellipse
-METHODS = ("mae", "mae_calibrated", "fastsim_ellipse")
+#: than the paper's on every validation area), FastSim on the equivalent ellipse and
+#: Polach's closed form on it (what vehicle-dynamics codes run instead)
+METHODS = ("mae", "mae_calibrated", "fastsim_ellipse", "polach")
 #: friction laws (:mod:`fastsim_ros.contact.friction`): Coulomb, and the falling
 #: mu(v) = mu_s ((1 - A) exp(-B v) + A) of the local slip velocity v
 FRICTION_LAWS = ("constant", "exponential")
@@ -121,8 +123,10 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "tangential solver: mae (the paper's MAE + FastSim, Alonso & Gimenez 2007), "
                   "mae_calibrated (MAE with pair factors from the exact theory, flexibilities "
                   "calibrated on the patch's cells and slip along the rigid slip, "
-                  "docs/validation_wider.md) or fastsim_ellipse (FastSim on the equivalent "
-                  "ellipse)",
+                  "docs/validation_wider.md), fastsim_ellipse (FastSim on the equivalent "
+                  "ellipse) or polach (Polach's closed form on the equivalent ellipse, "
+                  "Polach 1999 and 2005, with polach_ka, polach_ks; forces only: no "
+                  "traction, steady rolling; docs/guide_real_rails.md)",
                   choices=METHODS, dynamic=True),
     ParameterSpec("traction_bound", "string", "given",
                   "traction bound: given (mu p) or parabolic (mu N p^2 / sum(p^2 dA))",
@@ -160,6 +164,28 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
     ParameterSpec("friction_decay", "double", 0.0,
                   "B (s/m) of mu(v) = mu_s ((1 - A) exp(-B v) + A), for a slip-dependent law",
                   low=0.0, high=1.0e4, dynamic=True),
+    ParameterSpec("slope_reduction_k0", "double", 1.0,
+                  "creep-slope reduction of a contaminated rail (modified FastSim, Spiryagin "
+                  "et al. 2013, as CONTACT): k = k0 [alpha_inf + (1 - alpha_inf)/(1 + beta "
+                  "eps)] divides the flexibilities; k0 is its value at vanishing creepage "
+                  "(1 with alpha_inf 1: the theory's full slope, today's numbers; any other: "
+                  "a slip-dependent law is taken at the rigid slip velocity; "
+                  "docs/guide_real_rails.md)",
+                  low=1.0e-3, high=1.0, dynamic=True),
+    ParameterSpec("slope_reduction_alpha_inf", "double", 1.0,
+                  "alpha_inf = k(inf)/k0 of the creep-slope reduction",
+                  low=0.0, high=1.0, dynamic=True),
+    ParameterSpec("slope_reduction_beta", "double", 0.0,
+                  "beta of the creep-slope reduction: how fast k falls with Polach's eps "
+                  "(the ratio of the slip to the adhesion area)",
+                  low=0.0, high=1.0e6, dynamic=True),
+    ParameterSpec("polach_ka", "double", 1.0,
+                  "Polach's reduction factor kA of the adhesion area's stiffness (method "
+                  "polach; Polach 2005; 1: Kalker's slope; kS <= kA <= 1)",
+                  low=1.0e-3, high=1.0, dynamic=True),
+    ParameterSpec("polach_ks", "double", 1.0,
+                  "Polach's reduction factor kS of the slip area (method polach; kS <= kA)",
+                  low=1.0e-3, high=1.0, dynamic=True),
     # --- online friction estimation (fastsim_ros/estimation/ekf.py)
     ParameterSpec("friction_estimation", "string", "off",
                   "estimate mu_s online from wheelset/measured_wrench (force.x, wheelset "
@@ -299,6 +325,25 @@ def defaults() -> dict[str, Any]:
     return {spec.name: spec.default for spec in PARAMETERS}
 
 
+def reduces_slope(values: Any) -> bool:
+    """Tell whether the parameters ask for a creep-slope reduction other than ``k = 1``."""
+    return not (values["slope_reduction_k0"] == 1.0
+                and (values["slope_reduction_alpha_inf"] == 1.0
+                     or values["slope_reduction_beta"] == 0.0))
+
+
+def slope_reduction_of(values: Any) -> SlopeReduction | None:
+    """Return the creep-slope reduction the parameters ask for (None: ``k = 1``).
+
+    ``values``: anything indexed by parameter name (a dict, the pipeline's config).
+    """
+    if not reduces_slope(values):
+        return None
+    return SlopeReduction(float(values["slope_reduction_k0"]),
+                          float(values["slope_reduction_alpha_inf"]),
+                          float(values["slope_reduction_beta"]))
+
+
 def checked(values: Mapping[str, Any]) -> dict[str, Any]:
     """Return the defaults updated with ``values``, each checked; raise ParameterError."""
     out = defaults()
@@ -307,6 +352,25 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
         if spec is None:
             raise ParameterError(f"unknown parameter {name!r}")
         out[name] = spec.check(value)
+    if out["rolling"] == "transient" and reduces_slope(out):
+        raise ParameterError("the creep-slope reduction (slope_reduction_k0 < 1, or "
+                             "slope_reduction_alpha_inf < 1 with slope_reduction_beta > 0) "
+                             "applies to steady rolling only: set rolling steady, or k0 1 "
+                             "and alpha_inf 1")
+    if out["method"] == "polach":
+        if out["polach_ks"] > out["polach_ka"]:
+            raise ParameterError("parameters 'polach_ka', 'polach_ks': Polach's factors need "
+                                 f"kS <= kA, got kA {out['polach_ka']:g}, kS "
+                                 f"{out['polach_ks']:g}")
+        for name, bad, why in (("publish_traction", out["publish_traction"] is True,
+                                "its closed form has no traction field"),
+                               ("rolling", out["rolling"] == "transient",
+                                "its closed form is steady rolling"),
+                               ("slope_reduction_k0", reduces_slope(out),
+                                "its slope is reduced by polach_ka and polach_ks")):
+            if bad:
+                raise ParameterError(f"parameter {name!r}: method polach refuses "
+                                     f"{out[name]!r}: {why}")
     if out["patch_source"] == "profiles":
         if "contacts" in values and tuple(out["contacts"]) != PROFILE_CONTACTS:
             raise ParameterError("parameter 'contacts': in profiles mode the contacts are "

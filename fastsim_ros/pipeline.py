@@ -34,6 +34,7 @@ import numpy as np
 
 from fastsim_ros import params as parameters
 from fastsim_ros import plausibility
+from fastsim_ros.params import slope_reduction_of
 from fastsim_ros import pipeline_kernels as fast
 from fastsim_ros.contact import compiled
 from fastsim_ros.contact.area import nearest_cells, regridded, turned_grid
@@ -41,6 +42,7 @@ from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
+from fastsim_ros.contact.polach import PolachSolver
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.errors import ParameterError
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
@@ -423,7 +425,7 @@ class Pipeline:
         self._override = solver
         nu, g = config["poisson_ratio"], config["shear_modulus"]
         # one solver per method of parameters.METHODS (CalibratedMaeSolver is a MaeSolver)
-        self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver] = {
+        self._solvers: dict[str, MaeSolver | EquivalentEllipseSolver | PolachSolver] = {
             "mae": MaeSolver(nu, g), "mae_calibrated": CalibratedMaeSolver(nu, g),
             "fastsim_ellipse": EquivalentEllipseSolver(nu, g)}
         self._wheel: deque[StampedTwist] = deque(maxlen=TWIST_HISTORY)
@@ -458,6 +460,10 @@ class Pipeline:
     def _apply(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
         """Take ``config``; ``changed``: the parameters set at run time (:meth:`update`)."""
         self.config = config
+        if config["method"] == "polach":  # kA, kS may change while running
+            nu, g = config["poisson_ratio"], config["shear_modulus"]
+            self._solvers["polach"] = PolachSolver(nu, g, k_a=float(config["polach_ka"]),
+                                                   k_s=float(config["polach_ks"]))
         self._solver = self._override or self._solvers[config["method"]]
         self._bound = config["traction_bound"]
         self._frame_id = config["wheelset_frame"]
@@ -476,7 +482,8 @@ class Pipeline:
         self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
                                        str(config["friction_law"]),
                                        float(config["friction_limit_ratio"]),
-                                       float(config["friction_decay"]), str(self._bound))
+                                       float(config["friction_decay"]), str(self._bound),
+                                       reduction=slope_reduction_of(config))
         mu = self._ekf.mu if self._ekf is not None else float(config["friction_coefficient"])
         self._use_mu(mu, config)
 
@@ -486,8 +493,10 @@ class Pipeline:
         # None: constant friction (Coulomb's law, speed unused); else the law, run at |V|
         law = friction_law(str(config["friction_law"]), self._mu,
                            limit_ratio=float(config["friction_limit_ratio"]),
-                           decay=float(config["friction_decay"]))
-        self._law: FrictionLaw | None = law if law.slip_dependent else None
+                           decay=float(config["friction_decay"]),
+                           reduction=slope_reduction_of(config))
+        self._law: FrictionLaw | None = (law if law.slip_dependent or law.reduces_slope
+                                         else None)
         # the compiled path (pipeline_kernels.solve_cloud): the MAE methods without
         # tractions; the solver's arguments as its solve_arrays passes them
         self._compiled: tuple[Any, ...] | None = None
@@ -501,7 +510,8 @@ class Pipeline:
             self._memory_key = key
         for memory in self._memories.values():
             memory.max_gap = float(config["transient_max_gap"])
-        if isinstance(solver, MaeSolver) and not self._tractions:
+        # the compiled path knows no slope reduction: the solver's solve_arrays applies it
+        if isinstance(solver, MaeSolver) and not self._tractions and not law.reduces_slope:
             code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
             self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
                               solver._knots, solver._polys, code, prm, mu_s,
@@ -750,7 +760,8 @@ class Pipeline:
             if self._law is not None:
                 self._law = friction_law(str(self.config["friction_law"]), self._mu,
                                          limit_ratio=float(self.config["friction_limit_ratio"]),
-                                         decay=float(self.config["friction_decay"]))
+                                         decay=float(self.config["friction_decay"]),
+                                         reduction=slope_reduction_of(self.config))
             c = self._compiled
             if c is not None:  # only mu_s (slot 7) depends on mu
                 self._compiled = c[:7] + (self._mu,) + c[8:]
@@ -1023,6 +1034,8 @@ class Pipeline:
             return None
         memory = self._memories.get(contact)
         if memory is None:
+            # the parameters refuse transient rolling with Polach's closed form
+            assert not isinstance(self._solver, PolachSolver)
             memory = ContactMemory(TransientSolver(self._solver),
                                    max_gap=float(self.config["transient_max_gap"]))
             # the contact's counts, cumulative as every other count
@@ -1246,6 +1259,9 @@ class Pipeline:
             ("friction_coefficient", f"{self._mu:g}"),
             ("friction_limit_ratio", f"{self.config['friction_limit_ratio']:g}"),
             ("friction_decay", f"{self.config['friction_decay']:g}"),
+            ("slope_reduction", "k0 {:g}, alpha_inf {:g}, beta {:g}".format(
+                self.config["slope_reduction_k0"], self.config["slope_reduction_alpha_inf"],
+                self.config["slope_reduction_beta"])),
             ("traction_bound", self._bound),
             ("solve_time_p50_us", f"{p50:.1f}"),
             ("solve_time_p99_us", f"{p99:.1f}"),

@@ -43,6 +43,7 @@ from fastsim_ros import cli, cli_wheelset  # noqa: E402
 from fastsim_ros.contact import exact  # noqa: E402
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
+from fastsim_ros.contact.polach import PolachSolver  # noqa: E402
 from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 
@@ -51,7 +52,8 @@ FIGURE = ROOT / "docs" / "figures" / "accuracy_sweeps.png"
 MU, NU, G = 0.3, 0.28, 8e10
 SPEED, RADIUS = 2.0, 0.46
 METHODS = {"calibrated MAE (default)": CalibratedMaeSolver(NU, G), "paper's MAE": MaeSolver(NU, G),
-           "equivalent ellipse": EquivalentEllipseSolver(NU, G)}
+           "equivalent ellipse": EquivalentEllipseSolver(NU, G),
+           "Polach": PolachSolver(NU, G)}
 #: the near-zero sweep's levels: name and the longitudinal creepage the axle spin sets
 LEVELS = (("linear range, xi 4e-4", None), ("knee, xi 1.5e-3", 1.5e-3),
           ("full slip, xi 1e-2", 1e-2))

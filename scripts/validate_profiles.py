@@ -67,10 +67,10 @@ DOCS = ROOT / "docs"
 DATA = DOCS / "data" / "validation_profiles.json"
 FIG = DOCS / "figures"
 REPORT = DOCS / "validation_profiles.md"
-METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse")
+METHODS = ("exact", "mae_calibrated", "mae", "fastsim_ellipse", "polach")
 DEFAULT = "mae_calibrated"
 LABEL = {"exact": "exact", "mae_calibrated": "calibrated MAE", "mae": "paper's MAE",
-         "fastsim_ellipse": "equiv. ellipse", "kpec": "CONTACT KPEC+FASTSIM",
+         "fastsim_ellipse": "equiv. ellipse", "polach": "Polach", "kpec": "CONTACT KPEC+FASTSIM",
          "analyn": "CONTACT ANALYN+FASTSIM"}
 TARGET = {"position": 0.5e-3, "angle": 0.01, "n": 0.01, "creepage": 0.02, "creepage_abs": 1e-5,
           "exact": 5.0, "default": 10.0}
@@ -330,7 +330,8 @@ def figures(results: dict[str, Any]) -> None:
     FIG.mkdir(parents=True, exist_ok=True)
     sides = {s: benchmark.a22(s) for s in ("left", "right")}
     fig, axes = plt.subplots(2, 2, figsize=(12, 8), sharex=True)
-    styles = {"exact": "-o", "mae_calibrated": "-s", "mae": "--", "fastsim_ellipse": ":"}
+    styles = {"exact": "-o", "mae_calibrated": "-s", "mae": "--", "fastsim_ellipse": ":",
+              "polach": "-."}
     for col, side in enumerate(("left", "right")):
         cases = sides[side]
         shift = [-c.dy * 1e3 for c in cases]

@@ -57,6 +57,7 @@ from fastsim_ros.contact.asm import (asm_fastsim_coefficients, asm_flexibility, 
 from fastsim_ros.contact.dlm import dlm_coefficients, dlm_flexibility  # noqa: E402
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver,  # noqa: E402
                                           EquivalentEllipseSolver, MaeSolver, warm_up)
+from fastsim_ros.contact.polach import PolachSolver  # noqa: E402
 from fastsim_ros.contact.equivalent import equivalent_coefficients  # noqa: E402
 from fastsim_ros.contact.errors import ContactError  # noqa: E402
 from fastsim_ros.contact.fastrip import fastrip, fastrip_coefficients  # noqa: E402
@@ -89,11 +90,12 @@ ONLINE_CELLS = 60
 CURVES = {"xi": (1.0, 0.0, 0.0), "eta": (0.0, 1.0, 0.0), "phi": (0.0, 0.0, 1.0),
           "combined": (0.5, 0.5, 0.5)}
 LEVELS = (0.05, 0.15, 0.3, 0.5, 0.8, 1.2, 2.0, 3.5)
-METHODS = ("mae_calibrated", "mae", "fastrip", "ellipse", "dlm", "asm")
+METHODS = ("mae_calibrated", "mae", "fastrip", "ellipse", "polach", "dlm", "asm")
 LABELS = {"mae_calibrated": "calibrated MAE", "mae": "paper's MAE", "fastrip": "FaStrip",
-          "ellipse": "equivalent ellipse", "dlm": "DLM + FastSim", "asm": "ASM + FastSim"}
+          "ellipse": "equivalent ellipse", "polach": "Polach", "dlm": "DLM + FastSim",
+          "asm": "ASM + FastSim"}
 #: the methods users would pick without the calibrated MAE
-BASELINES = ("mae", "fastrip", "ellipse")
+BASELINES = ("mae", "fastrip", "ellipse", "polach")
 #: bar offsets of the methods in the figures
 BAR = 0.13
 NEW = ("long narrow", "crescent", "egg")
@@ -171,6 +173,7 @@ def curves_on(ar: areas.GridArea) -> dict[str, Any]:
     mae = MaeSolver(NU, G)
     calibrated = CalibratedMaeSolver(NU, G)
     ell = EquivalentEllipseSolver(NU, G)
+    pol = PolachSolver(NU, G)
     sat = _saturation(ar)
     op = exact.SteadyRollingOperator.of(ar, nu=NU, shear_modulus=G)
     entry: dict[str, Any] = {"N": ar.load, "sat": sat, "cells": [ar.nx, ar.ny],
@@ -197,6 +200,7 @@ def curves_on(ar: areas.GridArea) -> dict[str, Any]:
                 "mae": lambda cr=cr: mae.solve(ar, *cr, mu=MU),
                 "fastrip": lambda cr=cr: fastrip(ar, *cr, mu=MU, table=t, shear_modulus=G),
                 "ellipse": lambda cr=cr: ell.solve(ar, *cr, mu=MU),
+                "polach": lambda cr=cr: pol.solve(ar, *cr, mu=MU),
                 "dlm": lambda cr=cr: fastsim_with(ar, flex_dlm, *cr, bound=bound),
                 "asm": lambda cr=cr: fastsim_with(ar, flex_asm, *cr, bound=bound)}
             for m, solve in solvers.items():

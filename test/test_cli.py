@@ -347,3 +347,45 @@ def test_coefficients_take_kalkers_tables_poisson_ratio_when_asked(capsys):
     assert steel["nu"] == 0.28 and tables["nu"] == 0.25
     assert tables["C11"] == pytest.approx(4.12, rel=0.005)
     assert steel["C11"] > tables["C11"] * 1.01
+
+
+EUROSPRINTER_FORCES = ["forces", "--shape", "ellipse", "--a", "6.304e-3", "--b", "12.61e-3",
+                       "--load", "106700", "--nu", "0.28", "--shear-modulus", "8.2e10",
+                       "--speed", "10", "--eta", "0", "--phi", "0", "--json"]
+
+
+def test_forces_slope_reduction_flags_give_contacts_modified_fastsim(capsys):
+    """At xi 0.003 CONTACT's modified FastSim prints -21040 N: ours within 2% of mu N."""
+    rc, out, err = run(capsys, *EUROSPRINTER_FORCES, "--xi", "0.003", "--mu", "0.36",
+                       "--friction-law", "exponential", "--friction-limit-ratio", "0.38",
+                       "--friction-decay", "0.7", "--slope-k0", "0.54", "--slope-alpha-inf",
+                       "0.02", "--slope-beta", "0.62", "--bound", "parabolic",
+                       "--method", "fastsim_ellipse")
+    assert rc == 0, err
+    res = json.loads(out)
+    assert abs(res["Fx"] - (-21040.0)) < 0.02 * 0.36 * 106700
+    assert res["slope_reduction"] == {"k0": 0.54, "alpha_inf": 0.02, "beta": 0.62}
+    # no reduction: the flags at k0 1 give the plain numbers to the bit
+    base = ["--xi", "0.003", "--mu", "0.36", "--method", "mae_calibrated"]
+    rc, plain, _ = run(capsys, *EUROSPRINTER_FORCES, *base)
+    rc, same, _ = run(capsys, *EUROSPRINTER_FORCES, *base, "--slope-k0", "1",
+                      "--slope-alpha-inf", "0.3", "--slope-beta", "0")
+    assert json.loads(plain)["Fx"] == json.loads(same)["Fx"]
+    for bad in (["--slope-k0", "0"], ["--slope-alpha-inf", "2"], ["--slope-beta", "-1"]):
+        rc, _, err = run(capsys, *EUROSPRINTER_FORCES, *base, *bad)
+        assert rc == 2 and bad[0] in err
+
+
+def test_forces_method_polach(capsys):
+    """Polach's closed form: Kalker's linear force times (kA + kS)/2 at small creepage."""
+    rc, out, err = run(capsys, *EUROSPRINTER_FORCES, "--xi", "1e-7", "--mu", "0.36",
+                       "--method", "polach", "--polach-ka", "0.3", "--polach-ks", "0.1")
+    assert rc == 0, err
+    res = json.loads(out)
+    from fastsim_ros.contact.tables import coefficient_table
+    c11 = coefficient_table(0.28).kalker(0.5)[0]
+    assert res["Fx"] == pytest.approx(-0.2 * 8.2e10 * 6.304e-3 * 12.61e-3 * c11 * 1e-7,
+                                      rel=1e-3)
+    rc, _, err = run(capsys, *EUROSPRINTER_FORCES, "--xi", "1e-3", "--mu", "0.36",
+                     "--method", "polach", "--slope-k0", "0.5")
+    assert rc == 2 and "--polach-ka" in err

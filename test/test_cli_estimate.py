@@ -77,3 +77,85 @@ def test_the_defaults_are_the_nodes_and_shown_in_the_help(capsys):
     text = " ".join(out.split())
     for shown in ("default 0.3", "default 0.28", "default 8e+10", "exact (default"):
         assert shown in text, shown
+
+
+CONTACT = __import__("pathlib").Path(__file__).parent / "data" / "contact_tractcurv.csv"
+
+
+def contact_measured(tmp_path, series):
+    """Write the printed Fx of one series of CONTACT's tractcurv example as ``--measured``."""
+    import csv
+    lines = [line for line in CONTACT.read_text().splitlines() if not line.startswith("#")]
+    rows = ["xi,eta,phi,Fx"] + [f"{r['cksi']},0,0,{r['fx']}" for r in csv.DictReader(lines)
+                                if r["series"] == series]
+    path = tmp_path / f"{series}.csv"
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+EUROSPRINTER = ["--shape", "ellipse", "--a", "6.304e-3", "--b", "12.61e-3", "--load",
+                "106700", "--nu", "0.28", "--shear-modulus", "8.2e10", "--speed", "10",
+                "--allow-implausible", "--json"]
+
+
+def test_exact_falling_law_on_contacts_coulomb_curve_answers(capsys, tmp_path):
+    """The exact model under the falling law converges on every point and finds Coulomb's."""
+    path = contact_measured(tmp_path, "exact_coulomb")
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--friction-law", "exponential", "--method", "exact")
+    assert rc == 0, err
+    res = json.loads(out)
+    assert res["mu_static"] == pytest.approx(0.33, rel=0.01)
+    # constant friction: A at 1 within its sigma, the fit as good as Coulomb's
+    assert res["friction_limit_ratio"] > 0.99
+    assert res["worst_error_percent_mu_N"] < 0.5
+
+
+def test_known_slope_reduction_recovers_the_modified_fastsim_law(capsys, tmp_path):
+    """With its reduction given, the modified-FastSim curve gives mu_s 0.36, A 0.38 (5%)."""
+    path = contact_measured(tmp_path, "modified_fastsim")
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--friction-law", "exponential", "--method", "fastsim_ellipse",
+                       "--bound", "parabolic", "--slope-k0", "0.54", "--slope-alpha-inf",
+                       "0.02", "--slope-beta", "0.62")
+    assert rc == 0, err
+    res = json.loads(out)
+    assert res["mu_static"] == pytest.approx(0.36, rel=0.05)
+    assert res["friction_limit_ratio"] == pytest.approx(0.38, rel=0.05)
+    assert res["worst_error_percent_mu_N"] < 2.0
+    assert res["slope_reduction"] == {"k0": 0.54, "alpha_inf": 0.02, "beta": 0.62}
+    # the exact theory has its full slope: the reduction is refused with it
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--method", "exact", "--slope-k0", "0.5")
+    assert rc == 2 and "fast method" in err
+
+
+def test_contacts_modified_fastsim_parameters_recovered(capsys, tmp_path):
+    """Fitted with the law: mu_s, A, B and k0, alpha_inf, beta of CONTACT's curve within 5%."""
+    path = contact_measured(tmp_path, "modified_fastsim")
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--friction-law", "exponential", "--method", "fastsim_ellipse",
+                       "--bound", "parabolic", "--fit-slope-reduction")
+    assert rc == 0, err
+    res = json.loads(out)
+    red = res["slope_reduction"]
+    for got, want in ((res["mu_static"], 0.36), (res["friction_limit_ratio"], 0.38),
+                      (res["friction_decay"], 0.7), (red["k0"], 0.54),
+                      (red["alpha_inf"], 0.02), (red["beta"], 0.62)):
+        assert got == pytest.approx(want, rel=0.05)
+    assert res["worst_error_percent_mu_N"] < 2.0
+
+
+def test_interface_layer_curve_says_what_it_cannot_determine(capsys, tmp_path):
+    """On the interface-layer curve mu_s is within 3%, the reduction's shape left open."""
+    path = contact_measured(tmp_path, "exact_interface_layer")
+    rc, out, err = run(capsys, "estimate", "--measured", path, *EUROSPRINTER,
+                       "--friction-law", "exponential", "--method", "fastsim_ellipse",
+                       "--fit-slope-reduction")
+    assert rc == 0, err
+    res = json.loads(out)
+    assert res["mu_static"] == pytest.approx(0.33, rel=0.03)
+    assert res["worst_error_percent_mu_N"] < 2.0
+    red = res["slope_reduction"]
+    # k0, alpha_inf and beta trade off along the curve: not all three are pinned
+    assert red["beta"] is None or red["sigma_k0"] is None or red["sigma_k0"] > 0.1

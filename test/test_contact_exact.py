@@ -402,3 +402,27 @@ def test_a_warm_start_solves_the_same_problem_in_fewer_newton_steps(law):
     assert warm.iterations < cold.iterations
     with pytest.raises(InvalidInputError, match="start tractions"):
         exact.coulomb(ar, 3e-3, 0.0, 0.5, start=start[1:], **kw)
+
+
+def test_a_steeply_falling_law_converges_by_continuation_in_the_speed():
+    """Continuation in |V| solves a steeply falling law, and the solution obeys it.
+
+    Friction halving within 0.7 mm/s of slip (B = 1000 s/m at 10 m/s) on
+    CONTACT's Eurosprinter ellipse.
+    """
+    ar = areas.ellipse(6.304e-3, 12.61e-3, nx=60, ny=60, load=106700.0)
+    law = ExponentialFriction(0.37, 0.9, 1000.0)
+    g = 8.2e10
+    # Newton from the coarse grid's tractions alone runs out of its 200 iterations here
+    sol = exact.coulomb(ar, 4e-4, 0.0, 0.0, nu=0.28, shear_modulus=g, friction=law,
+                        speed=10.0)
+    op = exact.SteadyRollingOperator.of(ar, nu=0.28, shear_modulus=g)
+    gx, gy = op.fft_product()(sol.tau_x, sol.tau_y)
+    wx, wy = rigid_slip(ar, 4e-4, 0.0, 0.0)
+    speed_slip = 10.0 * np.hypot(wx - gx, wy - gy)
+    bound = 0.37 * ar.pressure * law.ratio(speed_slip)
+    tau = np.hypot(sol.tau_x, sol.tau_y)
+    assert np.all(tau[ar.mask] <= bound[ar.mask] * (1 + 1e-3) + 1e-3 * 0.37 * ar.pressure.max())
+    assert 0 < np.count_nonzero(sol.slip) < np.count_nonzero(ar.mask)
+    assert np.allclose(tau[sol.slip], bound[sol.slip], rtol=1e-3,
+                       atol=1e-3 * 0.37 * ar.pressure.max())

@@ -18,6 +18,8 @@ from sensor_msgs.msg import PointCloud2
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import samples
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
+from fastsim_ros.contact.friction import ConstantFriction, SlopeReduction
+from fastsim_ros.contact.polach import PolachSolver
 from ros_harness import (DIAGNOSTICS_PERIOD, NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess,
                          stamp_ns)
 from ros_messages import WHEEL_RADIUS as R
@@ -40,7 +42,7 @@ def ellipse():
 
 #: the library's compiled solver of each method the node offers; the first is the default
 SOLVERS = {"mae_calibrated": CalibratedMaeSolver, "mae": MaeSolver,
-           "fastsim_ellipse": EquivalentEllipseSolver}
+           "fastsim_ellipse": EquivalentEllipseSolver, "polach": PolachSolver}
 DEFAULT_METHOD = "mae_calibrated"
 
 
@@ -315,6 +317,28 @@ def test_throttled_log_builds_no_message_while_suppressed():
     log.suppressed = 2
     log.warning("third")
     assert logger.lines[-1] == "third (and 2 more in the last 0 s)" and log.suppressed == 0
+
+
+def test_a_slope_reduction_set_while_running_gives_the_librarys_reduced_wrench(run_node):
+    """Set at run time, the reduction's parameters give the library's reduced solve."""
+    _, client = run_node(contacts=("left",))
+    xi = 1.5e-3
+    send_twist(client, rolling_twist(xi, stamp_ns=T0))
+    results = client.set_parameters(slope_reduction_k0=0.54, slope_reduction_alpha_inf=0.02,
+                                    slope_reduction_beta=0.62)
+    assert all(r.successful for r in results), [r.reason for r in results]
+    (w,) = exchange(client, "left", cloud_msg(egg(), origin=(0.0, 0.75, -R), stamp_ns=T0 + MS,
+                                              dtype="<f8"))
+    a = in_plane_area(egg())
+    law = ConstantFriction(0.3, reduction=SlopeReduction(0.54, 0.02, 0.62))
+    ref = CalibratedMaeSolver(0.28, 8e10).solve_arrays(a.pressure, a.x0, a.y0, a.dx, a.dy,
+                                                       xi, 0.0, 0.0, friction=law)
+    assert_library_equal(w, ref)
+    assert abs(ref.fx) < 0.8 * abs(library(DEFAULT_METHOD, egg(), xi, 0.0, 0.0).fx)
+    # Polach's method takes no slope reduction: refused, the node keeps its method
+    (result,) = client.set_parameters(method="polach")
+    assert not result.successful and "polach" in result.reason
+    assert client.get_parameter("method") == DEFAULT_METHOD
 
 
 def test_refused_parameter_keeps_the_node_and_its_value(run_node):

@@ -41,17 +41,17 @@ def test_roller_rig_yaml():
 
 
 def test_methods_and_the_default():
-    assert params.METHODS == ("mae", "mae_calibrated", "fastsim_ellipse")
+    assert params.METHODS == ("mae", "mae_calibrated", "fastsim_ellipse", "polach")
     spec = params.SPECS["method"]
     assert spec.default == "mae_calibrated" and spec.dynamic
     for method in params.METHODS:
         assert spec.check(method) == method
         assert method in spec.description  # the descriptor names every method
     assert "docs/validation_wider.md" in spec.description
-    assert spec.allowed() == "one of mae, mae_calibrated, fastsim_ellipse"
+    assert spec.allowed() == "one of mae, mae_calibrated, fastsim_ellipse, polach"
     # the config lists them with the default
     text = (CONFIG / "fastsim.yaml").read_text()
-    assert "one of mae, mae_calibrated, fastsim_ellipse" in text
+    assert "one of mae, mae_calibrated, fastsim_ellipse, polach" in text
     assert '    method: "mae_calibrated"' in text
 
 
@@ -263,3 +263,33 @@ def test_the_replay_refuses_what_the_node_warns_of_in_one_line_exit_2(tmp_path, 
     err = capsys.readouterr().err
     assert err == f"fastsim_replay: {path}: {line}\n"
     assert not (tmp_path / "out").exists()
+
+
+def test_slope_reduction_parameters():
+    """No reduction by default; k0 < 1 is one; transient rolling refuses it."""
+    assert params.slope_reduction_of(params.defaults()) is None
+    values = params.checked({"slope_reduction_k0": 0.54, "slope_reduction_alpha_inf": 0.02,
+                             "slope_reduction_beta": 0.62})
+    r = params.slope_reduction_of(values)
+    assert (r.k0, r.alpha_inf, r.beta) == (0.54, 0.02, 0.62)
+    # alpha_inf < 1 without beta is no reduction (k = k0 = 1 throughout)
+    assert params.slope_reduction_of(params.checked({"slope_reduction_alpha_inf": 0.3})) is None
+    for name, bad in (("slope_reduction_k0", 0.0), ("slope_reduction_k0", 1.2),
+                      ("slope_reduction_alpha_inf", -0.1), ("slope_reduction_beta", -1.0)):
+        with pytest.raises(ParameterError, match=name):
+            params.checked({name: bad})
+    with pytest.raises(ParameterError, match="steady rolling only"):
+        params.checked({"slope_reduction_k0": 0.5, "rolling": "transient"})
+    for name in ("slope_reduction_k0", "slope_reduction_alpha_inf", "slope_reduction_beta"):
+        assert SPECS[name].dynamic
+
+
+def test_polach_parameters():
+    """Polach's kS <= kA; the method refuses tractions, transient rolling, a slope reduction."""
+    assert params.checked({"method": "polach", "polach_ka": 0.3, "polach_ks": 0.1})
+    with pytest.raises(ParameterError, match="kS <= kA"):
+        params.checked({"method": "polach", "polach_ka": 0.1, "polach_ks": 0.3})
+    for extra in ({"publish_traction": True}, {"rolling": "transient"},
+                  {"slope_reduction_k0": 0.5}):
+        with pytest.raises(ParameterError, match="method polach refuses"):
+            params.checked({"method": "polach", **extra})

@@ -221,6 +221,11 @@ VARIANTS = {
                               "max_kinematics_age": 0.02, "publish_markers": False},
     "small_grids_only": {"max_patch_cells": 620, "friction_coefficient": 0.15},
     "traction_clouds": {"publish_traction": True},
+    "calibrated_falling_slope_reduced": {
+        "friction_law": "exponential", "friction_limit_ratio": 0.4, "friction_decay": 0.6,
+        "slope_reduction_k0": 0.5, "slope_reduction_alpha_inf": 0.1,
+        "slope_reduction_beta": 0.8},
+    "polach": {"method": "polach", "polach_ka": 0.5, "polach_ks": 0.2},
 }
 
 

@@ -28,6 +28,8 @@ _HOME = {
     # the fast path the node runs
     "MaeSolver": "compiled", "EquivalentEllipseSolver": "compiled",
     "ContactForces": "compiled", "warm_up": "compiled",
+    # contaminated rails: the modified FastSim's slope reduction, Polach's closed form
+    "SlopeReduction": "slope_reduction", "PolachSolver": "polach",
     # the numpy reference
     "traction_bound": "fastsim",  # (fastsim() itself: the submodule takes the name)
     "mae_geometry": "mae", "mae_coefficients": "mae", "mae_fastsim": "mae",

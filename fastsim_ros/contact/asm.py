@@ -62,11 +62,13 @@ from fastsim_ros.contact.checks import check_material
 from fastsim_ros.contact.coefficients import (UNIT_CREEPAGES, CreepCoefficients,
                                               coefficients_from_unit_solutions,
                                               coefficients_of_solver)
+from fastsim_ros.contact.equivalent import reduce_slope
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, sweep_integrals,
                                          traction_bound)
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.influence import line_influence
+from fastsim_ros.contact.tables import coefficient_table
 from fastsim_ros.contact.traction import Tractions
 
 FloatArray = NDArray[np.float64]
@@ -332,8 +334,16 @@ class FlexibilityMethod:
         """Solve FastSim (forces in N, ``Mz`` about ``reference``); ``phi`` in 1/m.
 
         ``flexibility``: ``flexibility_of``'s result for this area and
-        material, to reuse over many creepages.
+        material, to reuse over many creepages.  A law's slope reduction is
+        applied as :func:`~fastsim_ros.contact.equivalent.reduce_slope` says.
         """
+        if friction is not None and friction.reduces_slope:
+            # the modified FastSim (equivalent.reduce_slope): creepages times k, constant
+            # friction at the rigid slip velocity
+            red = reduce_slope(area, xi, eta, phi, friction, speed,
+                               table=coefficient_table(nu), shear_modulus=shear_modulus)
+            xi, eta, phi, friction, speed = red.xi, red.eta, red.phi, red.friction, None
+            mu = friction.mu_s
         flex = flexibility or self.flexibility_of(area, nu=nu, shear_modulus=shear_modulus)
         return fastsim_with(area, flex, xi, eta, phi,
                             bound=traction_bound(area, mu, bound=bound), reference=reference,

@@ -17,7 +17,11 @@ a tiny patch).  Results equal the numpy reference
 
 Friction: ``mu`` (Coulomb, as always), or ``friction=`` a law of
 :mod:`~fastsim_ros.contact.friction` with ``speed=`` the rolling speed
-``|V|`` (m/s) that a slip-dependent law needs.
+``|V|`` (m/s) that a slip-dependent law needs.  A law's slope reduction
+(:mod:`~fastsim_ros.contact.slope_reduction`) runs the solve at creepages
+times ``k`` with the law's coefficient at the rigid slip velocity, ``k`` on
+the patch's equivalent ellipse (as
+:func:`~fastsim_ros.contact.equivalent.reduce_slope`).
 
 Units: SI throughout (m, Pa, N, N m; ``phi`` in 1/m; ``speed`` in m/s).  Bad input raises the
 errors of :mod:`fastsim_ros.contact.errors` (validation runs in the kernels:
@@ -157,6 +161,9 @@ def _law(mu: float | None, friction: FrictionLaw | None,
         # (0.65 us of a transient step's 7 us in Python)
         return k.LAW_CONSTANT, _NO_PARAMS, check_friction(float(mu)), 0.0
     law = resolve(mu, friction)
+    if law.reduces_slope:  # the solvers' own calls apply it (_Solver._reducing)
+        raise InvalidInputError("this call takes no slope reduction: the solvers' solve, "
+                                "solve_arrays and solve_batch apply it")
     if law.slip_dependent:
         return law.code, law.params, law.mu_s, check_speed(speed)
     return law.code, _NO_PARAMS, law.mu_s, 0.0
@@ -238,8 +245,8 @@ class _Solver:
         ``mu_s`` times ``mu(v)/mu_s``); ``speed``: the rolling speed ``|V|``
         (m/s), required by a slip-dependent law.
         """
-        return self._solve(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta, phi,
-                           _law(mu, friction, speed), reference, bound, tractions)
+        return self._reducing(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta,
+                              phi, mu, friction, speed, reference, bound, tractions)
 
     def solve_arrays(self, pressure: ArrayLike, x0: float, y0: float, dx: float, dy: float,
                      xi: float, eta: float, phi: float, mu: float | None = None, *,
@@ -251,8 +258,65 @@ class _Solver:
         The grid as in :class:`~fastsim_ros.contact.area.GridArea` (``(x0,
         y0)`` the centre of cell ``[0, 0]``); the rest as :meth:`solve`.
         """
-        return self._solve(_pressure(pressure, 2), x0, y0, dx, dy, xi, eta, phi,
-                           _law(mu, friction, speed), reference, bound, tractions)
+        return self._reducing(_pressure(pressure, 2), x0, y0, dx, dy, xi, eta, phi, mu,
+                              friction, speed, reference, bound, tractions)
+
+    def _reducing(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+                  eta: float, phi: float, mu: float | None, friction: FrictionLaw | None,
+                  speed: float | None, reference: tuple[float, float], bound: str,
+                  tractions: bool) -> ContactForces:
+        """Solve, the law's slope reduction (if any) applied: creepages times ``k``."""
+        if friction is None or not friction.reduces_slope:
+            return self._solve(p, x0, y0, dx, dy, xi, eta, phi, _law(mu, friction, speed),
+                               reference, bound, tractions)
+        law = resolve(mu, friction)
+        k_factor, mu_eff = self._reduction(p, x0, y0, dx, dy, xi, eta, phi, law, speed)
+        return self._solve(p, x0, y0, dx, dy, k_factor * xi, k_factor * eta, k_factor * phi,
+                           (k.LAW_CONSTANT, _NO_PARAMS, mu_eff, 0.0), reference, bound,
+                           tractions)
+
+    def _reduction(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float,
+                   xi: float, eta: float, phi: float, law: FrictionLaw,
+                   speed: float | None) -> tuple[float, float]:
+        """Return ``(k, mu)`` of the modified FastSim on the patch's equivalent ellipse.
+
+        The kernels' ellipse (:func:`~fastsim_ros.contact.kernels.equivalent_prepare`)
+        and Kalker's ``C11 = 8 a / (3 L1 G)`` from its ``L1``: what
+        :func:`~fastsim_ros.contact.equivalent.reduce_slope` computes in numpy.
+        """
+        ell = np.empty(k.ELL_SIZE)
+        status, info = k.equivalent_prepare(p, float(x0), float(y0), float(dx), float(dy),
+                                            self.shear_modulus, self._knots, self._polys, ell)
+        if status:
+            _raise(status, info, self._knots, "slope reduction: ")
+        a = float(ell[k.ELL_A])
+        c11 = 8.0 * a / (3.0 * float(ell[k.ELL_L1]) * self.shear_modulus)
+        return law.reduced(float(xi), float(eta), float(phi), speed, a=a,
+                           b=float(ell[k.ELL_B]), c11=c11, shear_modulus=self.shear_modulus,
+                           load=float(ell[k.ELL_LOAD]))
+
+    def _reduce_batch(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
+                      mu: ArrayLike | None, friction: FrictionLaw | None,
+                      speed: ArrayLike | None) -> tuple[FloatArray, FloatArray] | None:
+        """Return a batch's ``(creepages, mu)`` under the law's slope reduction, or None."""
+        if friction is None or not friction.reduces_slope:
+            return None
+        law = resolve(None, friction)
+        size = cr.shape[0]
+        if mu is not None and not np.array_equal(_per_item(mu, size, "mu"),
+                                                 np.full(size, law.mu_s)):
+            raise InvalidInputError(f"mu differs from the friction law's mu_s = {law.mu_s}")
+        speeds = (None if speed is None or not law.slip_dependent
+                  else _per_item(speed, size, "speed"))
+        scaled = np.empty_like(cr)
+        mus = np.empty(size)
+        for b in range(size):
+            p = ps[0] if ps.shape[0] == 1 else ps[b]
+            v = None if speeds is None else float(speeds[b])
+            k_factor, mus[b] = self._reduction(p, grid[0][b], grid[1][b], grid[2][b],
+                                               grid[3][b], cr[b, 0], cr[b, 1], cr[b, 2], law, v)
+            scaled[b] = k_factor * cr[b]
+        return scaled, mus
 
     def _solve(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
                eta: float, phi: float, law: tuple[int, FloatArray, float, float],
@@ -324,7 +388,12 @@ class MaeSolver(_Solver):
         or ``(B,)``.  Item ``b`` equals ``solve_arrays`` on it.
         """
         ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
-        code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
+        reduced = self._reduce_batch(ps, grid, cr, mu, friction, speed)
+        if reduced is None:
+            code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
+        else:
+            cr, mus = reduced
+            code, prm, speeds = k.LAW_CONSTANT, _NO_PARAMS, np.zeros(cr.shape[0])
         out = np.empty((cr.shape[0], 3))
         status, index, info = k.mae_batch(ps, grid[0], grid[1], grid[2], grid[3], cr, mus,
                                           float(reference[0]), float(reference[1]),
@@ -443,7 +512,12 @@ class EquivalentEllipseSolver(_Solver):
                     speed: ArrayLike | None = None) -> FloatArray:
         """Solve a batch in one compiled loop: as :meth:`MaeSolver.solve_batch`."""
         ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
-        code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
+        reduced = self._reduce_batch(ps, grid, cr, mu, friction, speed)
+        if reduced is None:
+            code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
+        else:
+            cr, mus = reduced
+            code, prm, speeds = k.LAW_CONSTANT, _NO_PARAMS, np.zeros(cr.shape[0])
         out = np.empty((cr.shape[0], 3))
         status, index, info = k.equivalent_batch(
             ps, grid[0], grid[1], grid[2], grid[3], cr, mus, float(reference[0]),

@@ -21,7 +21,7 @@ from fastsim_ros.contact.area import GridArea, ellipse
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
 from fastsim_ros.contact.fastsim import (StripFlexibility, fastsim, kalker_flexibility,
                                          traction_bound)
-from fastsim_ros.contact.friction import FrictionLaw, resolve
+from fastsim_ros.contact.friction import ConstantFriction, FrictionLaw, resolve
 from fastsim_ros.contact.rules import ellipse_cells
 from fastsim_ros.contact.traction import Tractions
 from fastsim_ros.contact.tables import CoefficientTable
@@ -52,6 +52,41 @@ def equivalent_ellipse(area: GridArea) -> EquivalentEllipse:
     return EquivalentEllipse(x_c, y_c, a, a / g)
 
 
+@dataclass(frozen=True)
+class ReducedProblem:
+    """A solve with a slope reduction, as the solver runs it.
+
+    ``xi, eta`` (1), ``phi`` (1/m): the creepages times ``k``; ``friction``:
+    constant friction at the law's coefficient at the rigid slip velocity;
+    ``mu_ratio``: that coefficient over the law's ``mu_s`` (what scales a
+    traction bound computed with ``mu_s``); ``k``: the factor (1).
+    """
+
+    xi: float
+    eta: float
+    phi: float
+    friction: FrictionLaw
+    mu_ratio: float
+    k: float
+
+
+def reduce_slope(area: GridArea, xi: float, eta: float, phi: float, law: FrictionLaw,
+                 speed: float | None, *, table: CoefficientTable,
+                 shear_modulus: float) -> ReducedProblem:
+    """Return the problem a solve runs under ``law``'s slope reduction on ``area``.
+
+    The modified FastSim of Spiryagin et al.
+    (:mod:`~fastsim_ros.contact.slope_reduction`): ``k`` on the area's
+    equivalent ellipse with Kalker's ``C11`` at its ``a/b`` (``table``), the
+    area's load, ``shear_modulus`` (Pa); ``speed``: ``|V|`` (m/s).
+    """
+    e = equivalent_ellipse(area)
+    c11 = table.kalker(e.a / e.b)[0]
+    k, mu = law.reduced(xi, eta, phi, speed, a=e.a, b=e.b, c11=c11,
+                        shear_modulus=shear_modulus, load=area.load)
+    return ReducedProblem(k * xi, k * eta, k * phi, ConstantFriction(mu), mu / law.mu_s, k)
+
+
 @dataclass(frozen=True, eq=False)
 class EquivalentResult:
     """Forces (N), ``Mz`` (N m) about the reference point, the ellipse and its solve."""
@@ -74,9 +109,14 @@ def equivalent_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
     The ellipse is discretised on ``cells`` x ``cells`` cells over its bounding
     box (default: as many cells in contact as the area has, :func:`ellipse_cells`).
     ``friction``: the law (default ``ConstantFriction(mu)``; ``mu``, if also
-    given, must be its ``mu_s``); ``speed``: ``|V|`` (m/s) for a slip-dependent law.
+    given, must be its ``mu_s``; its slope reduction, if any, applied by
+    :func:`reduce_slope`); ``speed``: ``|V|`` (m/s) for a slip-dependent law.
     """
     law = resolve(mu, friction)
+    if law.reduces_slope:
+        red = reduce_slope(area, xi, eta, phi, law, speed, table=table,
+                           shear_modulus=shear_modulus)
+        xi, eta, phi, law, speed = red.xi, red.eta, red.phi, red.friction, None
     e = equivalent_ellipse(area)
     n = cells or ellipse_cells(int(np.count_nonzero(area.mask)))
     grid = ellipse(e.a, e.b, nx=n, ny=n, load=area.load).shifted(e.x_c, e.y_c)

@@ -321,6 +321,9 @@ def coulomb(area: GridArea, xi: float, eta: float, phi: float, *, mu: float | No
     as does :func:`full_adhesion`.
     """
     law = resolve(mu, friction)
+    if law.reduces_slope:
+        raise InvalidInputError("the exact theory has its full slope: a slope reduction is "
+                                "an option of the fast methods")
     mu = check_friction(law.mu_s)
     slip_law = law if law.slip_dependent else None
     v_roll = check_speed(speed) if slip_law is not None else 0.0

@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import check_bound, check_creepages, check_friction
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw, check_speed
 from fastsim_ros.contact.rules import rigid_slip_return
 from fastsim_ros.contact.traction import Tractions, resultants
@@ -309,9 +310,13 @@ def fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: FloatAr
     moved to it by the rigid-slip identity.  ``Mz`` is about ``reference``.
     ``bound`` is the static bound ``g_s`` (Pa) of a slip-dependent
     ``friction`` law (whose ``mu_s`` made it); ``speed``: ``|V|`` (m/s);
-    ``slip_rule``: :func:`sweep`'s.
+    ``slip_rule``: :func:`sweep`'s.  A law's slope reduction is the
+    methods' to apply (their creepages times ``k``): it is refused here.
     """
     check_creepages(xi, eta, phi)
+    if friction is not None and friction.reduces_slope:
+        raise InvalidInputError("FastSim's sweep takes the flexibilities as given: a slope "
+                                "reduction is applied by the methods (equivalent.reduce_slope)")
     xc, ys = sweep_point
     xp, yp = reference
     xi_s = xi + phi * (yp - ys)

@@ -24,11 +24,19 @@ solvers do not change.  FastSim evaluates ``ratio`` once per slipping cell
 (:func:`fastsim_ros.contact.fastsim.slip_ratio`: no equation to solve, any
 law will do); the exact solver's Newton also takes ``ratio_slope``.
 
+A law may carry a creep-slope reduction (``reduction``,
+:class:`~fastsim_ros.contact.slope_reduction.SlopeReduction`: the modified
+FastSim of Spiryagin et al.): :meth:`FrictionLaw.reduced` gives the factor
+``k`` on the creepages and the one friction coefficient, at the rigid slip
+velocity, that a solve then runs with.  Without one, or with ``k = 1``
+throughout, the solvers run as without it, bit for bit.
+
 With ``A = 1`` or ``B = 0`` the exponential law *is* the constant one:
 :class:`ExponentialFriction` then reports :data:`LAW_CONSTANT`, so every
 solver runs the constant-friction path and gives its numbers bit for bit.
 
-Imports numpy, :mod:`~fastsim_ros.contact.checks`, ``errors`` and ``rules`` (no SciPy).
+Imports numpy, :mod:`~fastsim_ros.contact.checks`, ``errors``, ``rules`` and
+``slope_reduction`` (no SciPy).
 """
 
 from __future__ import annotations
@@ -42,12 +50,14 @@ from numpy.typing import ArrayLike, NDArray
 from fastsim_ros.contact.checks import check_friction
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.rules import LAW_CONSTANT, LAW_EXPONENTIAL
+from fastsim_ros.contact.slope_reduction import (SlopeReduction, rigid_slip_velocity,
+                                                 total_creepage)
 
 FloatArray = NDArray[np.float64]
 
 __all__ = ["LAW_CONSTANT", "LAW_EXPONENTIAL", "LAW_NAMES", "FrictionLaw", "ConstantFriction",
            "ExponentialFriction", "friction_law", "resolve", "check_exponential",
-           "check_speed"]
+           "check_speed", "SlopeReduction"]
 #: the names the node, the replay and the command line use
 LAW_NAMES = ("constant", "exponential")
 
@@ -74,9 +84,14 @@ def check_speed(speed: float | None) -> float:
 
 @dataclass(frozen=True)
 class FrictionLaw:
-    """Base of the laws: ``mu(v) = mu_s ratio(v)``, ``v`` the local slip velocity (m/s)."""
+    """Base of the laws: ``mu(v) = mu_s ratio(v)``, ``v`` the local slip velocity (m/s).
+
+    ``reduction``: the creep-slope reduction of a contaminated rail (None:
+    the theory's full slope).
+    """
 
     mu_s: float
+    reduction: SlopeReduction | None = field(default=None, kw_only=True)
 
     #: the law's name (``friction_law`` of the node, the CSV and the command line)
     name = "constant"
@@ -107,6 +122,31 @@ class FrictionLaw:
     def mu(self, v: ArrayLike) -> FloatArray:
         """Return the friction coefficient at slip velocities ``v`` (m/s)."""
         return self.mu_s * self.ratio(v)
+
+    @property
+    def reduces_slope(self) -> bool:
+        """Tell whether the law carries a slope reduction other than ``k = 1`` throughout."""
+        return self.reduction is not None and not self.reduction.identity
+
+    def reduced(self, xi: float, eta: float, phi: float, speed: float | None, *, a: float,
+                b: float, c11: float, shear_modulus: float,
+                load: float) -> tuple[float, float]:
+        """Return ``(k, mu)``: the factor on the creepages and the solve's friction coefficient.
+
+        ``mu`` is the law's at the rigid slip velocity ``|V| sqrt(xi^2 +
+        eta^2)`` (``speed = |V|`` in m/s, needed by a slip-dependent law),
+        ``k`` the reduction's factor there
+        (:meth:`~fastsim_ros.contact.slope_reduction.SlopeReduction.factor`)
+        on the equivalent ellipse ``a, b`` (m) with Kalker's ``c11``, the
+        combined ``shear_modulus`` (Pa) and the patch's ``load`` (N).
+        """
+        reduction = self.reduction if self.reduction is not None else SlopeReduction()
+        mu = self.mu_s
+        if self.slip_dependent:
+            mu = float(self.mu(rigid_slip_velocity(xi, eta, check_speed(speed))))
+        k = reduction.factor(total_creepage(xi, eta, phi, a), a=a, b=b, c11=c11,
+                             shear_modulus=shear_modulus, load=load, mu=mu)
+        return k, mu
 
 
 @dataclass(frozen=True)
@@ -165,12 +205,15 @@ class ExponentialFriction(FrictionLaw):
 
 
 def friction_law(name: str, mu_s: float, *, limit_ratio: float = 1.0,
-                 decay: float = 0.0) -> FrictionLaw:
-    """Return the law called ``name`` (:data:`LAW_NAMES`) with its parameters checked."""
+                 decay: float = 0.0, reduction: SlopeReduction | None = None) -> FrictionLaw:
+    """Return the law called ``name`` (:data:`LAW_NAMES`) with its parameters checked.
+
+    ``reduction``: the creep-slope reduction it carries (None: none).
+    """
     if name == "constant":
-        return ConstantFriction(mu_s)
+        return ConstantFriction(mu_s, reduction=reduction)
     if name == "exponential":
-        return ExponentialFriction(mu_s, limit_ratio, decay)
+        return ExponentialFriction(mu_s, limit_ratio, decay, reduction=reduction)
     raise InvalidInputError(f"unknown friction law {name!r}: constant or exponential")
 
 

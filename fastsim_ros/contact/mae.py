@@ -26,6 +26,7 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import SplitRule, check_split_rule
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
+from fastsim_ros.contact.equivalent import reduce_slope
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.rules import face_blend, widest_position
@@ -382,7 +383,16 @@ def mae_fastsim(area: GridArea, xi: float, eta: float, phi: float, *, bound: Flo
     slip-dependent ``friction`` law the static one, of its ``mu_s``);
     ``speed``: rolling speed ``|V|`` (m/s) for such a law; ``shear_modulus``:
     combined ``G`` (Pa); ``table``: coefficients at the material's ``nu``.
+    A law's slope reduction is applied as
+    :func:`~fastsim_ros.contact.equivalent.reduce_slope` says.
     """
+    if friction is not None and friction.reduces_slope:
+        # the modified FastSim (equivalent.reduce_slope): creepages times k, friction at the
+        # rigid slip velocity, the bound of mu_s scaled to it
+        red = reduce_slope(area, xi, eta, phi, friction, speed, table=table,
+                           shear_modulus=shear_modulus)
+        xi, eta, phi, friction, speed = red.xi, red.eta, red.phi, red.friction, None
+        bound = bound * red.mu_ratio
     geometries = split_geometries(area, rule)
     pairs = [zone_flexibilities(g, table, shear_modulus) for g, _ in geometries]
     res = fastsim(area, xi, eta, phi, bound=bound,

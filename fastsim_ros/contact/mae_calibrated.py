@@ -63,7 +63,7 @@ from numpy.typing import NDArray
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import SplitRule
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
-from fastsim_ros.contact.equivalent import equivalent_ellipse
+from fastsim_ros.contact.equivalent import equivalent_ellipse, reduce_slope
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.knee import KneeFactors, interpolate
@@ -269,6 +269,12 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
     ``"rigid_slip"``: FastSim's radial return); ``knee``: FastSim's knee
     corrected strip by strip with these factors (:func:`strip_knee`).
     """
+    if friction is not None and friction.reduces_slope:
+        # the modified FastSim (equivalent.reduce_slope), as in mae.mae_fastsim
+        red = reduce_slope(area, xi, eta, phi, friction, speed, table=table,
+                           shear_modulus=shear_modulus)
+        xi, eta, phi, friction, speed = red.xi, red.eta, red.phi, red.friction, None
+        bound = bound * red.mu_ratio
     geometries = split_geometries(area, rule)
     zone_pairs = [calibrated_flexibilities(area, g, table, pairs, shear_modulus, share=share,
                                            without=without) for g, _ in geometries]

@@ -38,6 +38,10 @@ on the unknowns; on a slipping cell the Jacobian then gains ``- (z/|z|) g_s
 ratio'(V |s|) V (s/|s|)^T ds/dtau`` with ``ds/dtau = -B``, carried in the
 products and in the strip blocks alike.
 
+Where Newton alone does not converge under a steeply falling law,
+:func:`solve_continued` reaches the solution by continuation in the rolling
+speed (the law's argument is ``|V| |s|``).
+
 Cost per Newton iteration: a few FFT products of the ``2ny x 2nx`` grid per
 GMRES iteration, and the strip blocks' inverses (``(2 m)^3`` per strip of
 ``m`` cells).  Memory: the grid's spectra, the Krylov basis and the blocks,
@@ -76,6 +80,13 @@ R = TypeVar("R")
 SEGMENT_CELLS = 160
 #: Newton iterations before :class:`ConvergenceError`
 MAX_NEWTON = 200
+#: Newton iterations of one solve under a slip-dependent law before continuation
+#: (:func:`solve_continued`) takes over; a converging solve takes under 30
+CONTINUATION_AFTER = 40
+#: continuation: the smallest share of the rolling speed it starts from, and the least
+#: growth factor of the share per step before it gives up
+CONTINUATION_START = 2.0 ** -12
+CONTINUATION_MIN_GROWTH = 1.05
 #: step halvings of the line search before the step is taken anyway
 MAX_HALVINGS = 5
 #: iterations whose largest residual a step must not exceed (non-monotone search)
@@ -303,7 +314,7 @@ def _gmres(matvec: Callable[[FloatArray], FloatArray],
 
 def solve(op: SteadyRollingOperator, w: FloatArray, bound: FloatArray, *, tol: float,
           scale: float, law: FrictionLaw | None = None, speed: float = 0.0,
-          start: FloatArray | None = None) -> PartialSlip:
+          start: FloatArray | None = None, max_newton: int = MAX_NEWTON) -> PartialSlip:
     """Solve the partial-slip problem on ``op``'s cells in contact.
 
     ``w`` (m, 2): the rigid slip at the cells; ``bound`` (m,): the static
@@ -311,7 +322,7 @@ def solve(op: SteadyRollingOperator, w: FloatArray, bound: FloatArray, *, tol: f
     constant friction), with ``speed`` = ``|V|`` (m/s).  Converged when the
     largest residual ``|tau - P(tau - c s)|`` (a traction) is at most ``tol
     scale`` (``scale`` in Pa, ``mu max p`` for the callers).  Raises
-    :class:`ConvergenceError` after :data:`MAX_NEWTON` iterations.
+    :class:`ConvergenceError` after ``max_newton`` iterations.
     """
     product = op.fft_product()
     d_x, d_y = op.diagonal
@@ -374,8 +385,8 @@ def solve(op: SteadyRollingOperator, w: FloatArray, bound: FloatArray, *, tol: f
     history = [merit]
     newton = 1
     while fmax > tol * scale:
-        if newton >= MAX_NEWTON:
-            raise ConvergenceError(f"the partial-slip Newton did not converge in {MAX_NEWTON} "
+        if newton >= max_newton:
+            raise ConvergenceError(f"the partial-slip Newton did not converge in {max_newton} "
                                    f"iterations (residual {fmax / scale:.2e} of mu p_max)")
         newton += 1
         pi = np.array(eye)
@@ -405,6 +416,50 @@ def solve(op: SteadyRollingOperator, w: FloatArray, bound: FloatArray, *, tol: f
         history.append(merit_t)
     # at the fixed point the traction is the projection: exactly on the bound where clipped
     return PartialSlip(tau - f, out, newton, counts["krylov"], counts["products"])
+
+
+def solve_continued(op: SteadyRollingOperator, w: FloatArray, bound: FloatArray, *,
+                    tol: float, scale: float, law: FrictionLaw | None = None,
+                    speed: float = 0.0, start: FloatArray | None = None) -> PartialSlip:
+    """:func:`solve`, by continuation in the rolling speed where Newton alone does not converge.
+
+    A steeply falling law (the exponential one with ``B |V|`` of thousands:
+    friction halving within a millimetre per second of slip) makes the
+    radius of a slipping cell's disc swing with its slip from one Newton
+    iterate to the next, and the full-step Newton cycles between slip
+    areas.  The law enters only through ``ratio(|V| |s|)``: solved at the
+    speed ``t |V|``, ``t`` rising geometrically from
+    :data:`CONTINUATION_START` (nearly constant friction) to 1, each solve
+    starts within its Newton's reach of the next one's solution.  A step
+    that fails is retried with the square root of its growth factor (down to
+    :data:`CONTINUATION_MIN_GROWTH`, then :class:`ConvergenceError`).
+    """
+    if law is None or speed == 0.0:
+        return solve(op, w, bound, tol=tol, scale=scale, start=start)
+    try:
+        return solve(op, w, bound, tol=tol, scale=scale, law=law, speed=speed, start=start,
+                     max_newton=CONTINUATION_AFTER)
+    except ConvergenceError:
+        pass
+    share = CONTINUATION_START
+    res = solve(op, w, bound, tol=tol, scale=scale, law=law, speed=share * speed, start=start)
+    growth = 2.0
+    while share < 1.0:
+        nxt = min(1.0, share * growth)
+        try:
+            res = solve(op, w, bound, tol=tol, scale=scale, law=law, speed=nxt * speed,
+                        start=res.tau, max_newton=CONTINUATION_AFTER)
+        except ConvergenceError:
+            growth = math.sqrt(growth)
+            if growth < CONTINUATION_MIN_GROWTH:
+                raise ConvergenceError(
+                    "the partial-slip Newton did not converge under the slip-dependent law, "
+                    f"even by continuation in the rolling speed (stalled at {share:.3g} of "
+                    "|V|)") from None
+            continue
+        share = nxt
+        growth = min(2.0 * growth, 2.0)
+    return res
 
 
 #: grid sequencing: a grid starts from the tractions of the grid of twice its cells'
@@ -458,5 +513,5 @@ def solve_area(op: SteadyRollingOperator, creepages: tuple[float, float, float],
     wx, wy = rigid_slip(area, *creepages, reference)
     w = np.stack([wx[mask], wy[mask]], axis=1)
     bound = mu_s * area.pressure[mask]
-    return solve(op, w, bound, tol=tol, scale=mu_s * float(area.pressure.max()), law=law,
-                 speed=speed, start=start)
+    return solve_continued(op, w, bound, tol=tol, scale=mu_s * float(area.pressure.max()),
+                           law=law, speed=speed, start=start)

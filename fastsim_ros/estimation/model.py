@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -65,11 +65,13 @@ from fastsim_ros.contact.compiled import _law as _kernel_law
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, friction_law
 from fastsim_ros.contact.knee import knee_factors
+from fastsim_ros.contact.polach import PolachSolver
+from fastsim_ros.contact.slope_reduction import SlopeReduction
 
 FloatArray = NDArray[np.float64]
-Solver = MaeSolver | EquivalentEllipseSolver
+Solver = MaeSolver | EquivalentEllipseSolver | PolachSolver
 #: the solvers the estimators may use as their measurement model
-METHODS = ("mae_calibrated", "mae", "fastsim_ellipse")
+METHODS = ("mae_calibrated", "mae", "fastsim_ellipse", "polach")
 #: the model error's standard deviation as a share of its bound mu_s (1 - k) N (the bound as
 #: two sigma; the module's docstring)
 MODEL_ERROR_SHARE = 0.5
@@ -101,6 +103,8 @@ def solver_for(method: str, nu: float, shear_modulus: float) -> Solver:
         return MaeSolver(nu, shear_modulus)
     if method == "fastsim_ellipse":
         return EquivalentEllipseSolver(nu, shear_modulus)
+    if method == "polach":
+        return PolachSolver(nu, shear_modulus)
     raise InvalidInputError(f"unknown method {method!r}: one of {', '.join(METHODS)}")
 
 
@@ -253,22 +257,34 @@ class CreepModel:
     decay: float = 0.0
     bound: str = "given"
     knee: bool = True
+    reduction: SlopeReduction | None = field(default=None, kw_only=True)
 
     def friction(self, mu_s: float, limit_ratio: float | None = None,
                  decay: float | None = None) -> FrictionLaw:
         """Return the law at static coefficient ``mu_s`` (``A``, ``B``: the shape's by default)."""
         return friction_law(self.law, float(mu_s),
                             limit_ratio=self.limit_ratio if limit_ratio is None else limit_ratio,
-                            decay=self.decay if decay is None else decay)
+                            decay=self.decay if decay is None else decay,
+                            reduction=self.reduction)
 
     def __post_init__(self) -> None:
-        """Check the bound; keep the compiled MAE kernel's call (None: the solver's own)."""
+        """Check the bound; keep the compiled MAE kernel's call (None: the solver's own).
+
+        Under a slope reduction the solver's own call applies it (the kernel
+        knows none) and the knee factor, a correction of the full-slope
+        method toward the exact theory, is off: the modified FastSim is the model.
+        """
         check_bound(self.bound)
-        object.__setattr__(self, "_kernel", _mae_kernel(self.solver, self.bound))
+        reduced = self.reduction is not None and not self.reduction.identity
+        if reduced or isinstance(self.solver, PolachSolver):  # Polach's: no FastSim knee
+            object.__setattr__(self, "knee", False)
+        object.__setattr__(self, "_kernel", None if reduced
+                           else _mae_kernel(self.solver, self.bound))
         # the march's own slope (the MAE kernels); False: the EKF's forward difference
         object.__setattr__(self, "_marched_slope", self._kernel is not None)  # type: ignore
         # the law's kernel arguments but mu_s (its code and A, B do not depend on mu_s)
-        object.__setattr__(self, "_law_template", self._kernel_law(self.friction(1.0)))
+        object.__setattr__(self, "_law_template", self._kernel_law(friction_law(
+            self.law, 1.0, limit_ratio=self.limit_ratio, decay=self.decay)))
         # the ellipse's factor on the whole force, unless the solver corrects its knee strip by
         # strip itself (one correction, the published forces')
         object.__setattr__(self, "_knee", knee_factors(self.solver.nu)

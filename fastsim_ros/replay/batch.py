@@ -53,6 +53,7 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseS
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import friction_law
 from fastsim_ros import plausibility
+from fastsim_ros.params import slope_reduction_of
 from fastsim_ros.pipeline import (FRAME_TOLERANCE, NO_CONTACT, SOLVE_TIME_WINDOW, SOLVED,
                                   TWIST_HISTORY, Pipeline, PipelineConfig, patch_extent)
 from fastsim_ros.replay import kernels
@@ -367,9 +368,11 @@ class Batch:
         self.mu = float(config["friction_coefficient"])
         law = friction_law(str(config["friction_law"]), self.mu,
                            limit_ratio=float(config["friction_limit_ratio"]),
-                           decay=float(config["friction_decay"]))
+                           decay=float(config["friction_decay"]),
+                           reduction=slope_reduction_of(config))
         # constant friction runs as the solvers' plain mu (the pipeline passes no law)
-        self.law = law if law.slip_dependent else None
+        self.law = law if law.slip_dependent or law.reduces_slope else None
+        self.reduces_slope = law.reduces_slope
         self.law_code = law.code if self.law is not None else contact_kernels.LAW_CONSTANT
         self.law_params = np.array(law.params if self.law is not None else np.zeros(2),
                                    dtype=np.float64)
@@ -387,6 +390,21 @@ class Batch:
         s = self.solver
         x0, y0, dx, dy = (np.ascontiguousarray(grid[:, k]) for k in range(4))
         creep = np.ascontiguousarray(creep)
+        if self.reduces_slope:
+            # the batch kernels know no slope reduction: the solver's solve_arrays, one
+            # by one (a failed item keeps status 1: _solve_error words its rejection;
+            # the slip count as the fraction of one cell in contact)
+            for b in range(n):
+                try:
+                    f = s.solve_arrays(ps[0] if ps.shape[0] == 1 else ps[b], x0[b], y0[b],
+                                       dx[b], dy[b], creep[b, 0], creep[b, 1], creep[b, 2],
+                                       bound=self.bound,  # type: ignore[arg-type]
+                                       friction=self.law, speed=float(speed[b]))
+                except ContactError:
+                    status[b] = 1
+                    continue
+                out[b] = (f.fx, f.fy, f.mz, f.n, f.slip_fraction, 1.0)
+            return status, out
         # the solver's own tables and options: what its solve_arrays hands its kernel
         if isinstance(s, MaeSolver):
             kernels.solve_mae(ps, x0, y0, dx, dy, creep, self.mu_solve, speed, s._rule,
