@@ -345,7 +345,8 @@ def test_messages_of_a_solve():
             pose.pose.position.z) == pytest.approx(out.frame.origin)
     cloud = deserialize_message(msgs["contact/left/traction"], PointCloud2)
     tau = np.frombuffer(bytes(cloud.data), dtype=np.dtype(
-        {"names": ["tau_x"], "formats": ["<f4"], "offsets": [12], "itemsize": 24}))
+        {"names": ["tau_x"], "formats": ["<f4"], "offsets": [12],
+         "itemsize": cloud.point_step}))
     # the traction integrates to the force
     assert float(tau["tau_x"].astype(float).sum()) * out.patch.dx * out.patch.dy == \
         pytest.approx(out.forces.fx, rel=1e-5)

@@ -21,8 +21,8 @@ oppose the creepages and ``Fx xi + Fy eta + Mz phi <= 0``).
   ``s = 0``), which the elastic field carries out of the patch at its
   trailing edge instead of dissipating by slip; the share is ~0 in
   near-full adhesion and tends to 1 at full slip.  From the exact solver:
-  :func:`exact_dissipation` (``s = w - du/dx``, the solver's own discrete
-  operator); from FastSim's march:
+  :func:`fastsim_ros.contact.exact.slip_dissipation` (``s = w - du/dx``,
+  the solver's own discrete operator); from FastSim's march:
   :mod:`~fastsim_ros.contact.slip_power`.
 - **Wear rate**: a piecewise-linear function of ``T_gamma / A``
   (:class:`PiecewiseLinear`); default :data:`SHEFFIELD_WEAR`, the University
@@ -63,15 +63,7 @@ from bisect import bisect_right
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-import numpy as np
-from numpy.typing import NDArray
-
-from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.errors import InvalidInputError
-from fastsim_ros.contact.rolling import SteadyRollingOperator
-from fastsim_ros.contact.traction import Tractions, rigid_slip
-
-FloatArray = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -184,26 +176,3 @@ def indicators(fx: float, fy: float, mz: float, xi: float, eta: float, phi: floa
     power = dissipation * v
     share = dissipation / tg if tg > 0.0 else math.nan
     return WearIndicators(tg, per_area, wear(per_area), rcf(tg), power, share)
-
-
-def exact_dissipation(area: GridArea, solution: Tractions, xi: float, eta: float, phi: float,
-                      *, nu: float, shear_modulus: float,
-                      reference: tuple[float, float] = (0.0, 0.0),
-                      operator: SteadyRollingOperator | None = None
-                      ) -> tuple[float, FloatArray]:
-    """Return the exact solve's slip dissipation per metre rolled (N) and its density (N/m^2).
-
-    ``s = w - du/dx`` with ``du/dx`` the solver's own discrete operator
-    (:class:`~fastsim_ros.contact.rolling.SteadyRollingOperator`, upstream
-    difference) applied to the solution's tractions, ``w`` the rigid slip
-    about ``reference``; ``-tau . s`` on the slip cells (zero where they
-    stick, as CONTACT sets it), summed times the cell area.  Times ``|V|``:
-    the frictional power (W) and its density (W/m^2).
-    """
-    op = operator if operator is not None else SteadyRollingOperator.of(
-        area, nu=nu, shear_modulus=shear_modulus)
-    dux, duy = op.fft_product()(solution.tau_x, solution.tau_y)
-    wx, wy = rigid_slip(area, xi, eta, phi, reference)
-    density = np.where(solution.slip, -(solution.tau_x * (wx - dux)
-                                        + solution.tau_y * (wy - duy)), 0.0)
-    return float(density.sum() * area.cell_area), density
