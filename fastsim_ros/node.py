@@ -335,8 +335,12 @@ class _FrontEnd:
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
         outputs[MARKERS_TOPIC] = MarkerArray
-        if FRICTION_ESTIMATE_TOPIC in self.pipeline.outputs():  # friction_estimation on
+        declared = self.pipeline.outputs()
+        if FRICTION_ESTIMATE_TOPIC in declared:  # friction_estimation on
             outputs[FRICTION_ESTIMATE_TOPIC] = Vector3Stamped
+        for topic, name in declared.items():  # the wear topics (wear_outputs on)
+            if topic not in outputs and name == "geometry_msgs/msg/Vector3Stamped":
+                outputs[topic] = Vector3Stamped
         if isinstance(self.pipeline, ProfilePipeline):
             # profiles mode computes the patches and publishes them, so that a recording
             # replays in either mode (INTERFACE.md)
