@@ -151,7 +151,8 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "a patch is solved with kinematics at most this old by stamp (s)",
                   low=0.0, high=10.0, dynamic=True),
     ParameterSpec("publish_traction", "bool", False,
-                  "publish contact/<name>/traction (PointCloud2 of tau_x, tau_y, slip)",
+                  "publish contact/<name>/traction (PointCloud2 of tau_x, tau_y, slip and the "
+                  "frictional power density friction_power)",
                   dynamic=True),
     # --- wear and fatigue outputs (docs/guide_wear.md; fastsim_ros/contact/wear.py)
     ParameterSpec("wear_outputs", "bool", False,

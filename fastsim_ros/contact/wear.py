@@ -123,14 +123,12 @@ class PiecewiseLinear:
 
 #: 1 ug/(m mm^2) in kg/(m m^2) and 1 N/mm^2 in Pa: the published wear tables' units in SI
 UG_PER_M_MM2, N_PER_MM2 = 1e-3, 1e6
-_CATASTROPHIC_ZERO = 4778.7 / 61.9  # N/mm^2: where the catastrophic line is zero
-_CATASTROPHIC_END = 1000.0  # N/mm^2: the table's last breakpoint (held beyond)
-#: the USFD wear function (R8T/R260): T_gamma/A (Pa) -> wear rate (kg per metre rolled per m^2)
+#: the USFD wear function (R8T/R260): T_gamma/A (Pa) -> wear rate (kg per metre rolled per
+#: m^2), in SI: 5.3 and 55.0 ug/(m mm^2), the catastrophic line 61.9 T_gamma/A - 4778.7 from
+#: its zero (4778.7/61.9 N/mm^2) to 1000 N/mm^2 (57121.3 ug/(m mm^2)), held beyond
 SHEFFIELD_WEAR = PiecewiseLinear.of(
-    tuple(v * N_PER_MM2 for v in (0.0, 10.4, 10.4, 77.2, _CATASTROPHIC_ZERO,
-                                  _CATASTROPHIC_END)),
-    tuple(v * UG_PER_M_MM2 for v in (5.3, 5.3, 55.0, 55.0, 0.0,
-                                     61.9 * _CATASTROPHIC_END - 4778.7)))
+    (0.0, 10.4e6, 10.4e6, 77.2e6, 4778.7e6 / 61.9, 1000e6),
+    (5.3e-3, 5.3e-3, 55.0e-3, 55.0e-3, 0.0, 57.1213))
 #: Burstow's whole-life rail model: T_gamma (N) -> RCF damage per wheel passage
 BURSTOW_RCF = PiecewiseLinear.of((0.0, 15.0, 65.0, 175.0), (0.0, 0.0, 50e-6, 0.0))
 
