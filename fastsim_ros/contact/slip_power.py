@@ -2,28 +2,42 @@
 
 FastSim's elastic model (Kalker's simplified theory, METHOD.md 2): the
 surface displacement is ``u = L tau`` per strip.  A cell's step from its
-upstream neighbour (``h = dx``, or ``dx/2`` from a segment's front face)
-forms the trial traction ``t* = tau_up - (w_L / L) h`` (the march's rates,
-:func:`fastsim_ros.contact.kernels.strip_rates`, ``phi x`` at the step's
-middle); where the cell slips, the traction it could not hold, ``t* - tau``,
-is displacement released by slipping: the slip per unit rolling distance is
-``s = L (tau - t*) / h`` (``L`` the strip's ``L1``, ``L2``), zero where it
-sticks.  The dissipation per unit rolling distance and area is then
-``-tau . s`` (N/m per m^2, J/m^2 per metre rolled; times ``|V|``: the
-frictional power density, W/m^2), as CONTACT's ``FRIC.POWER`` sums it over
-the slip area (Vollebregt, CONTACT user guide, "total forces ... frictional
-power": ``V int tau_t . s_t dA`` over the slip area, reported with the
-traction on the upper body, hence negative there).
+upstream neighbour's traction ``tau_up`` (``h = dx``, or ``dx/2`` from a
+segment's front face, zero traction there) forms the trial traction ``t* =
+tau_up - (w_L / L) h`` (the march's rates,
+:func:`fastsim_ros.contact.kernels.strip_rates`: the spin term with the
+spin flexibility, ``phi x`` at the step's middle).  Where the cell slips,
+its slip per unit rolling distance is the one its method's projection
+uses, the slip a slip-dependent friction law of the march reads:
+
+- the radial return (the paper's MAE, the equivalent ellipse): ``s = L (tau
+  - t*) / h``, the traction the cell could not hold, released as
+  displacement (``L`` the strip's ``L1``, ``L2``);
+- the rigid-slip return (the calibrated MAE): ``s = (w h + L (tau -
+  tau_up)) / h``, ``w = (xi - phi (y - y_s), eta + phi (x - x_c))`` the
+  rigid slip at the cell.
+
+Zero where the cell sticks.  The dissipation per unit rolling distance and
+area is ``-tau . s`` (J/m^2 per metre rolled; times ``|V|``: the frictional
+power density, W/m^2), summed over the slip area as CONTACT's
+``FRIC.POWER`` (Vollebregt, CONTACT user guide, "frictional power": ``V
+int tau . s dA`` over the slip area, printed with the traction on the upper
+body, hence negative there).
+
+Without spin both slips are the same and the sum stays below T-gamma (the
+rest is the elastic energy the march carries out of the patch).  Under
+spin the march's spin term uses the spin flexibility (``L3``, MAE's
+``L4``), not ``L1``, ``L2``: its displacement is not one elastic field, so
+the radial return's dissipation may exceed T-gamma (the paper's MAE on
+semi-ellipses under pure spin: up to 1.2 T-gamma) and the rigid-slip
+return's falls short of the exact theory's (docs/guide_wear.md).
 
 The trial is re-formed from the stored tractions with the march's own
-operations (steady rolling: every cell's material entered under the
-present creepages), so the slip is that of the radial return and of the
-calibrated method's rigid-slip return alike (both end on the bound; the
-slip is what the projection removed).  Compiled (numba); read by
-:meth:`fastsim_ros.contact.compiled.MaeSolver.solve_arrays` and the
-equivalent ellipse's when tractions are asked for: one pass over the cells
-after the solve (plus the MAE set-up again, which the solve does not
-return).
+operations (steady rolling: every cell's material entered under the present
+creepages).  Compiled (numba); called by
+:class:`fastsim_ros.contact.compiled.MaeSolver` and the equivalent
+ellipse's solver when tractions are asked for: one pass over the cells
+after the solve, plus the MAE set-up again (the solve does not return it).
 """
 
 from __future__ import annotations
@@ -36,15 +50,17 @@ from fastsim_ros.contact import kernels as k
 
 @njit(cache=True, error_model="numpy")
 def march_dissipation(inside, tau_x, tau_y, slip, x0, y0, dx, dy, xi_s, eta_s, phi, flex,
-                      x_c, y_s, density):
+                      x_c, y_s, rigid, density):
     """Fill ``density`` (N/m^2 per metre rolled) with each cell's ``-tau . s``; return the sum (N).
 
     ``inside`` (bool, ``(ny, nx)``): the cells the march visited (bound
     positive); ``tau_x``, ``tau_y`` (Pa) and ``slip``: the march's results on
     the grid ``x0, y0, dx, dy`` (m); ``xi_s``, ``eta_s`` (1), ``phi`` (1/m):
     the creepages at the sweep point ``(x_c, y_s)`` (m); ``flex`` (m/Pa,
-    ``(4, ny)``): the strips' ``L1, L2, L3`` and spin flexibility.  The sum
-    is ``sum -tau . s dA``: the dissipation per metre rolled (N = J/m).
+    ``(4, ny)``): the strips' ``L1, L2, L3`` and spin flexibility;
+    ``rigid``: the rigid-slip return's slip, else the radial return's (the
+    module's).  The sum is ``sum -tau . s dA``: the dissipation per metre
+    rolled (N = J/m).
     """
     ny, nx = inside.shape
     half = 0.5 * dx
@@ -72,11 +88,18 @@ def march_dissipation(inside, tau_x, tau_y, slip, x0, y0, dx, dy, xi_s, eta_s, p
             upstream = True
             d = 0.0
             if slip[j, i]:
-                x_mid = (x0 + dx * i - x_c) + 0.5 * h
-                t_x = p_x - rate_x * h
-                t_y = p_y - (rate_y0 + rate_yx * x_mid) * h
-                s_x = flex[0, j] * (tau_x[j, i] - t_x) / h
-                s_y = flex[1, j] * (tau_y[j, i] - t_y) / h
+                x_rel = x0 + dx * i - x_c
+                if rigid:
+                    # the rigid-slip return's slip: (w h + L (tau - tau_up)) / h
+                    s_x = ((xi_s - phi * (y - y_s)) * h
+                           + flex[0, j] * (tau_x[j, i] - p_x)) / h
+                    s_y = ((eta_s + phi * x_rel) * h + flex[1, j] * (tau_y[j, i] - p_y)) / h
+                else:
+                    x_mid = x_rel + 0.5 * h
+                    t_x = p_x - rate_x * h
+                    t_y = p_y - (rate_y0 + rate_yx * x_mid) * h
+                    s_x = flex[0, j] * (tau_x[j, i] - t_x) / h
+                    s_y = flex[1, j] * (tau_y[j, i] - t_y) / h
                 d = -(tau_x[j, i] * s_x + tau_y[j, i] * s_y)
             density[j, i] = d
             total += d
@@ -99,7 +122,7 @@ def mae_dissipation(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic
         return status, 0.0
     xi_s, eta_s = k.creepages_at_s(geo, xi, eta, phi, xp, yp)
     return k.OK, march_dissipation(p > 0.0, tau_x, tau_y, slip, x0, y0, dx, dy, xi_s, eta_s,
-                                   phi, flex, geo[k.G_XC], geo[k.G_YS], density)
+                                   phi, flex, geo[k.G_XC], geo[k.G_YS], calibrated, density)
 
 
 @njit(cache=True, error_model="numpy")
@@ -131,4 +154,4 @@ def equivalent_dissipation(p, x0, y0, dx, dy, xi, eta, phi, xp, yp, parabolic, n
     xi_s = xi + phi * (yp - y_c)
     eta_s = eta - phi * (xp - x_c)
     return k.OK, march_dissipation(shape > 0.0, tau_x, tau_y, slip, gx0, gy0, gdx, gdy, xi_s,
-                                   eta_s, phi, flex, x_c, y_c, density)
+                                   eta_s, phi, flex, x_c, y_c, False, density)
