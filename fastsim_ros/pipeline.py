@@ -1202,14 +1202,14 @@ class Pipeline:
                 msgs.append((topic, out.traction_cloud_cdr(
                     stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid, power)))
             if self._wear:
-                w = self.wear(outcome)
-                if w is not None:
+                ind = self.wear(outcome)
+                if ind is not None:
                     if topics.energy in wanted:
                         msgs.append((topics.energy, topics.vector_cdr(
-                            stamp, w.t_gamma, w.t_gamma_per_area, w.frictional_power)))
+                            stamp, ind.t_gamma, ind.t_gamma_per_area, ind.frictional_power)))
                     if topics.damage in wanted:
                         msgs.append((topics.damage, topics.vector_cdr(
-                            stamp, w.wear_rate, w.rcf_damage, w.slip_share)))
+                            stamp, ind.wear_rate, ind.rcf_damage, ind.slip_share)))
         if outcome.markers and MARKERS_TOPIC in wanted:
             index = self.config.contacts.index(c)
             fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)

@@ -24,8 +24,8 @@ def forces(capsys, *argv):
 @pytest.mark.parametrize("method, bound, within", [
     ("exact", "given", 0.004), ("mae_calibrated", "parabolic", 0.06),
     ("mae", "parabolic", 0.06), ("fastsim_ellipse", "parabolic", 0.06)])
-def test_forces_json_carries_t_gamma_wear_rcf_and_the_frictional_power(capsys, method, bound,
-                                                                        within):
+def test_forces_json_carries_t_gamma_wear_rcf_and_the_frictional_power(
+        capsys, method, bound, within):
     """Every key from the result's own forces; the power against CONTACT's FRIC.POWER.
 
     Measured at xi = 1.6e-3 (the knee): the exact solver (44 x 44 cells)

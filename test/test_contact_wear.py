@@ -116,7 +116,7 @@ def test_a_bad_table_is_refused_with_its_reason(x, y, words):
 
 
 def test_indicators_follow_the_tables():
-    """T-gamma/A picks the wear regime, T-gamma the RCF damage; the power is the dissipation x V."""
+    """T-gamma/A picks the wear regime, T-gamma the RCF damage; the power is dissipation x V."""
     w = indicators(-20000.0, 0.0, 0.0, 2e-3, 0.0, 0.0, area=2e-6, speed=-12.0, dissipation=30.0)
     assert w.t_gamma == pytest.approx(40.0)
     assert w.t_gamma_per_area == pytest.approx(20e6)  # 20 N/mm^2: severe
@@ -197,7 +197,7 @@ def test_exact_frictional_power_is_below_t_gamma_v(exact_powers):
 
 @pytest.mark.parametrize("solver", [MaeSolver, CalibratedMaeSolver, EquivalentEllipseSolver])
 def test_fastsim_frictional_power_against_contact(solver):
-    """FastSim's march (parabolic bound, Kalker's; 60 x 60 cells) against CONTACT's FRIC.POWER.
+    """The march's power (parabolic bound, Kalker's; 60 x 60 cells) against CONTACT's FRIC.POWER.
 
     Measured low by 3.3% in the linear range (xi = 4e-4: 28.7 W against
     29.7 W), by at most 5.7% at the knee (xi = 2e-3) and 1.2% at

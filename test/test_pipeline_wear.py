@@ -1,4 +1,4 @@
-"""The pipeline's wear outputs: contact/<name>/energy and damage, the traction cloud's power field."""
+"""The pipeline's wear outputs: contact/<name>/energy and damage, the traction cloud's power."""
 
 import math
 
@@ -60,7 +60,7 @@ def test_energy_and_damage_of_a_solve(method, power):
 
 
 def test_the_power_reaches_the_forces_of_the_library_solve():
-    """With frictional_power the solve is the library's with tractions: same forces, its dissipation."""
+    """With frictional_power the solve is the library's with tractions: forces, dissipation."""
     xi = 2e-3
     pipe = make(frictional_power=True, wear_outputs=True)
     pipe.on_wheel_twist(cdr(rolling_twist(xi, stamp_ns=T0)))

@@ -1,4 +1,4 @@
-"""``fastsim_replay`` with ``wear_outputs``: the CSV's wear columns, the bag's wear topics, the summary.
+"""``fastsim_replay`` with ``wear_outputs``: the CSV's wear columns, the bag's topics, the summary.
 
 The bundled bags' own parameters plus ``wear_outputs`` and
 ``frictional_power``: the existing columns stay the golden ones (the wear

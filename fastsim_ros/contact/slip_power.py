@@ -128,7 +128,7 @@ def mae_dissipation(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic
 @njit(cache=True, error_model="numpy")
 def equivalent_dissipation(p, x0, y0, dx, dy, xi, eta, phi, xp, yp, parabolic, n,
                            shear_modulus, knots, polys, tau_x, tau_y, slip, density):
-    """:func:`march_dissipation` of a solve of :func:`fastsim_ros.contact.kernels.equivalent_solve`.
+    """:func:`march_dissipation` of an equivalent-ellipse solve (``kernels.equivalent_solve``).
 
     On the equivalent ellipse's ``n`` x ``n`` grid (the solve's tractions);
     returns ``(status, dissipation per metre rolled (N))``.

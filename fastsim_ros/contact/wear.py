@@ -1,4 +1,4 @@
-"""Wear and rolling-contact-fatigue indicators of a solved contact: T-gamma, its share that slips, wear, RCF.
+"""Wear and fatigue indicators of a solve: T-gamma, frictional power, wear rate, RCF damage.
 
 Pure physics (no ROS).  SI units: N, m, Pa, W; creepages ``xi``, ``eta``
 (1) and spin ``phi`` (1/m) about the point ``Mz`` is taken about (METHOD.md
