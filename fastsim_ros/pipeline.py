@@ -1108,6 +1108,10 @@ class Pipeline:
                 grid = (-(gx0 + (n_x - 1) * gdx), -(gy0 + (n_y - 1) * gdy), gdx, gdy)
             f = ContactForces(-f.fx, -f.fy, f.mz, f.n, f.slip_fraction, tau_x, tau_y, slip,
                               grid, f.dissipation, density)
+        if not self._publish_tractions and f.tau_x is not None:
+            # kept for the frictional power alone: its sum is taken, the fields go
+            f = ContactForces(f.fx, f.fy, f.mz, f.n, f.slip_fraction,
+                              dissipation=f.dissipation)
         if f.grid is not None and isinstance(self._solver, EquivalentEllipseSolver):
             f = _on_patch_cells(f, patch)
         isfinite = math.isfinite
