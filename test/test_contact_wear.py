@@ -177,9 +177,9 @@ def test_exact_frictional_power_is_below_t_gamma_v(exact_powers):
     """Slip dissipates less than T-gamma V: the stick zone's elastic creep is not slip.
 
     The gap is the work carried out of the patch by the elastic field at
-    the trailing edge: most of T-gamma V in the linear range (CONTACT: 29.7
-    of 36.4 W at xi = 4e-4), a few tens of watts that no longer grow once
-    the whole patch slips, so the share tends to 1.
+    the trailing edge: 18% of T-gamma V at xi = 4e-4 (CONTACT: 29.7 of 36.3
+    W slip), a few tens of watts that no longer grow once the whole patch
+    slips, so the share tends to 1.
     """
     rows = contact_power()
     shares = []

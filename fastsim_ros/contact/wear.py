@@ -16,14 +16,15 @@ oppose the creepages and ``Fx xi + Fy eta + Mz phi <= 0``).
   frictional power, W): ``sum -tau . s dA`` over the slip area, ``s`` the
   slip per unit rolling distance, as CONTACT's ``FRIC.POWER`` (Vollebregt &
   Kalker, CONTACT user guide; CONTACT prints it with the traction on the
-  upper body, so negative).  It is less than ``T_gamma``: ``T_gamma V`` also
-  holds the work of the stick zone's elastic creep (``-tau . w`` where
-  ``s = 0``), which the elastic field carries out of the patch at its
-  trailing edge instead of dissipating by slip; the share is ~0 in
-  near-full adhesion and tends to 1 at full slip.  From the exact solver:
+  upper body, so negative).  In the exact theory it is less than
+  ``T_gamma``: ``T_gamma V`` also holds the work of the stick zone's
+  elastic creep (``-tau . w`` where ``s = 0``), which the elastic field
+  carries out of the patch at its trailing edge instead of dissipating by
+  slip; the share is ~0 in near-full adhesion and tends to 1 at full slip.  From the exact solver:
   :func:`fastsim_ros.contact.exact.slip_dissipation` (``s = w - du/dx``,
   the solver's own discrete operator); from FastSim's march:
-  :mod:`~fastsim_ros.contact.slip_power`.
+  :mod:`~fastsim_ros.contact.slip_power` (whose spin flexibility can put it
+  above ``T_gamma`` under spin).
 - **Wear rate**: a piecewise-linear function of ``T_gamma / A``
   (:class:`PiecewiseLinear`); default :data:`SHEFFIELD_WEAR`, the University
   of Sheffield (USFD) wear function for R8T wheel / R260 rail steel from
