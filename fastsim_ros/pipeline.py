@@ -1166,8 +1166,9 @@ class Pipeline:
 
         Each as CDR bytes (INTERFACE.md "Outputs"): the contact's wrench and
         creepage, its frame when it moved, its traction cloud when asked
-        for, its marker when due, and the wheelset wrench when the rig cycle
-        is complete.  ``wanted``: if given, only these topics are encoded
+        for, its energy and damage (``wear_outputs``, :meth:`wear`), its
+        marker when due, and the wheelset wrench when the rig cycle is
+        complete.  ``wanted``: if given, only these topics are encoded
         (the node's topics that have subscribers).
         """
         if not outcome.has_wrench:
