@@ -42,6 +42,7 @@ def _numba_cache_dir() -> str:
 #: per-file time stamps are the only key, and a kernel changed in one file and
 #: compiled into another's can load stale (clear that directory after editing)
 _KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/knee.py",
+                   "contact/slip_power.py",
                    "contact/transient.py",
                    "pipeline_kernels.py", "replay/kernels.py",
                    "../msg_adapters/patch_kernels.py", "../msg_adapters/patch.py")

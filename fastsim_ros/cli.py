@@ -52,6 +52,7 @@ import numpy as np
 
 from fastsim_ros import plausibility
 from fastsim_ros.contact import area as areas
+from fastsim_ros.contact import wear
 from fastsim_ros.contact.checks import (BOUNDS, check_friction, check_material,
                                         check_poisson_ratio)
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
@@ -625,6 +626,8 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     creepages = (args.xi, args.eta, args.phi)
     speed = None if args.speed is None else abs(args.speed)
     cells = [patch.nx, patch.ny]
+    # the slip area's dissipation per metre rolled (N), where the method gives it
+    dissipation = math.nan
     if args.method == "exact":
         from fastsim_ros.contact import exact
         _check_exact_grid(patch, forces=True)
@@ -647,11 +650,16 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
             result.update(extrapolated=True)
         result.update(Fx=fx, Fy=fy, Mz=mz, slip_fraction=float(
             np.count_nonzero(sol.slip)) / np.count_nonzero(patch.mask))
+        # on the finest grid (the forces above may be extrapolated)
+        dissipation = exact.slip_dissipation(patch, sol, *creepages, nu=args.nu,
+                                             shear_modulus=args.shear_modulus)[0]
     elif args.method in ("mae", "mae_calibrated"):
         from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver
         solver = CalibratedMaeSolver if args.method == "mae_calibrated" else MaeSolver
         mae = solver(args.nu, args.shear_modulus)
-        res = mae.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
+        res = mae.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed,
+                        tractions=True)
+        dissipation = res.dissipation
         g = mae.geometry(patch)
         result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
                       split_y=g.y_s,
@@ -696,13 +704,38 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
     else:
         from fastsim_ros.contact.compiled import EquivalentEllipseSolver
         eq = EquivalentEllipseSolver(args.nu, args.shear_modulus)
-        res = eq.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed)
+        res = eq.solve(patch, *creepages, bound=args.bound, friction=law, speed=speed,
+                       tractions=True)
+        dissipation = res.dissipation
         e = eq.ellipse(patch)
         result.update(Fx=res.fx, Fy=res.fy, Mz=res.mz, slip_fraction=res.slip_fraction,
                       ellipse={"x_c": e.x_c, "y_c": e.y_c, "a": e.a, "b": e.b})
     _finite_result(result, FORCE_KEYS)
+    result.update(_wear(result, creepages, patch, dissipation, speed))
     result["cells"] = cells
     return result
+
+
+def _wear(result: dict[str, Any], creepages: tuple[float, float, float],
+          patch: areas.GridArea, dissipation: float, speed: float | None) -> dict[str, Any]:
+    """Return the wear and fatigue keys of a ``forces`` result (docs/guide_wear.md).
+
+    ``T_gamma`` (N), ``T_gamma_per_area`` (Pa), ``wear_rate`` (kg per metre
+    rolled per m^2, the USFD function), ``rcf_damage`` (per passage,
+    Burstow's), ``frictional_dissipation`` (N = J per metre rolled: the
+    slip area's; null where the method does not give it: dlm, asm,
+    fastrip), ``slip_share`` (that over ``T_gamma``) and
+    ``frictional_power`` (W, that times ``|V|``: null without ``--speed``).
+    """
+    area = float(np.count_nonzero(patch.mask)) * patch.cell_area
+    w = wear.indicators(result["Fx"], result["Fy"], result["Mz"], *creepages, area,
+                        1.0, dissipation)
+    return {"T_gamma": w.t_gamma, "T_gamma_per_area": w.t_gamma_per_area,
+            "wear_rate": w.wear_rate, "rcf_damage": w.rcf_damage,
+            "frictional_dissipation": _or_none(dissipation),
+            "slip_share": _or_none(w.slip_share),
+            "frictional_power": (_or_none(dissipation * speed) if speed is not None
+                                 else None)}
 
 
 def _friction(args: argparse.Namespace) -> FrictionLaw:
@@ -806,7 +839,9 @@ def _print_table(command: str, result: dict[str, Any]) -> None:
 #: units of the ``forces`` result's numbers in the readable table (the rest: none)
 FORCE_UNITS = {"N": "N", "Fx": "N", "Fy": "N", "Mz": "N m", "split_y": "m", "speed": "m/s",
                "friction_decay": "s/m", "area": "m^2", "a": "m", "b": "m", "x_c": "m",
-               "y_c": "m"}
+               "y_c": "m", "T_gamma": "N", "T_gamma_per_area": "Pa",
+               "wear_rate": "kg/(m m^2)", "frictional_dissipation": "J/m",
+               "frictional_power": "W"}
 
 
 def _text(key: str, value: Any) -> str:

@@ -70,7 +70,8 @@ _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
           "integer": ParameterType.PARAMETER_INTEGER,
           "bool": ParameterType.PARAMETER_BOOL,
           "string": ParameterType.PARAMETER_STRING,
-          "string_array": ParameterType.PARAMETER_STRING_ARRAY}
+          "string_array": ParameterType.PARAMETER_STRING_ARRAY,
+          "double_array": ParameterType.PARAMETER_DOUBLE_ARRAY}
 _MESSAGE_TYPES = {"wrench": WrenchStamped, "creepage": Vector3Stamped, "frame": PoseStamped,
                   "traction": PointCloud2}
 #: libyaml's loader where built (a params file in 0.5 ms, not 7: the check is on the start)
@@ -140,14 +141,19 @@ def _qos(reliability: str, depth: int) -> QoSProfile:
                                    else ReliabilityPolicy.RELIABLE))
 
 
-#: the parameters declared as doubles
+#: the parameters declared as doubles, and as lists of doubles
 _DOUBLES = frozenset(spec.name for spec in parameters.PARAMETERS if spec.kind == "double")
+_DOUBLE_ARRAYS = frozenset(spec.name for spec in parameters.PARAMETERS
+                           if spec.kind == "double_array")
 
 
 def _as_declared(given: Parameter) -> Parameter:
-    """Return ``given`` as a double if it is a whole number for a double parameter."""
+    """Return ``given`` as double(s) if whole numbers were given for a double (array) parameter."""
     if given.name in _DOUBLES and given.type_ == Parameter.Type.INTEGER:
         return Parameter(given.name, Parameter.Type.DOUBLE, float(given.value))
+    if given.name in _DOUBLE_ARRAYS and given.type_ == Parameter.Type.INTEGER_ARRAY:
+        return Parameter(given.name, Parameter.Type.DOUBLE_ARRAY,
+                         [float(v) for v in given.value])
     return given
 
 
@@ -236,7 +242,7 @@ class _FrontEnd:
                     # they are the default there and any other value is refused
                     default = list(parameters.PROFILE_CONTACTS if source == "profiles"
                                    else spec.default)
-                elif spec.kind == "string_array":
+                elif spec.kind in ("string_array", "double_array"):
                     default = list(spec.default)
                 node.declare_parameter(spec.name, default, descriptor(
                     spec, read_only=start_only_read_only and not spec.dynamic))
@@ -326,8 +332,12 @@ class _FrontEnd:
                    for kind, msgtype in _MESSAGE_TYPES.items()}
         outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
         outputs[MARKERS_TOPIC] = MarkerArray
-        if FRICTION_ESTIMATE_TOPIC in self.pipeline.outputs():  # friction_estimation on
+        declared = self.pipeline.outputs()
+        if FRICTION_ESTIMATE_TOPIC in declared:  # friction_estimation on
             outputs[FRICTION_ESTIMATE_TOPIC] = Vector3Stamped
+        for topic, name in declared.items():  # the wear topics (wear_outputs on)
+            if topic not in outputs and name == "geometry_msgs/msg/Vector3Stamped":
+                outputs[topic] = Vector3Stamped
         if isinstance(self.pipeline, ProfilePipeline):
             # profiles mode computes the patches and publishes them, so that a recording
             # replays in either mode

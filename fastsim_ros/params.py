@@ -18,7 +18,9 @@ from typing import Any
 
 import yaml
 
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.slope_reduction import SlopeReduction
+from fastsim_ros.contact.wear import BURSTOW_RCF, SHEFFIELD_WEAR, PiecewiseLinear
 from fastsim_ros.errors import ParameterError
 
 #: the methods of the library the node offers (docs/guide_node.md): the paper's
@@ -40,7 +42,9 @@ _NAME = re.compile(r"^[A-Za-z][A-Za-z0-9_]*$")
 
 @dataclass(frozen=True)
 class ParameterSpec:
-    """One parameter; ``kind``: ``double``, ``integer``, ``bool``, ``string``, ``string_array``.
+    """One parameter; ``kind``: ``double``, ``integer``, ``bool``, ``string`` or an ``_array``.
+
+    Arrays: ``string_array`` (names), ``double_array`` (a table's numbers).
 
     ``low``/``high``: inclusive numeric range; ``choices``: allowed strings;
     ``dynamic``: may change while the node runs (else start-up only).
@@ -67,6 +71,8 @@ class ParameterSpec:
             return f"in [{self.low:g}, {self.high:g}]"
         if self.kind == "string_array":
             return "a non-empty list of distinct names ([A-Za-z][A-Za-z0-9_]*)"
+        if self.kind == "double_array":
+            return "a list of at least 2 finite numbers"
         if self.kind == "string":
             return "a string" if self.empty_ok else "a non-empty name"
         return f"a {self.kind}"
@@ -98,6 +104,14 @@ class ParameterSpec:
                     or len(set(value)) != len(value)):
                 raise bad
             value = tuple(value)
+        elif self.kind == "double_array":
+            # a list, a tuple, or rclpy's array.array('d') of a DOUBLE_ARRAY
+            if (not isinstance(value, Sequence) or isinstance(value, (str, bytes))
+                    or len(value) < 2
+                    or not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                               and math.isfinite(v) for v in value)):
+                raise bad
+            value = tuple(float(v) for v in value)
         if self.low is not None and not (self.low <= value <= self.high):  # type: ignore
             raise bad
         if self.choices and value not in self.choices:
@@ -138,8 +152,33 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "a patch is solved with kinematics at most this old by stamp (s)",
                   low=0.0, high=10.0, dynamic=True),
     ParameterSpec("publish_traction", "bool", False,
-                  "publish contact/<name>/traction (PointCloud2 of tau_x, tau_y, slip)",
+                  "publish contact/<name>/traction (PointCloud2 of tau_x, tau_y, slip and the "
+                  "frictional power density friction_power)",
                   dynamic=True),
+    # --- wear and fatigue outputs (docs/guide_wear.md; fastsim_ros/contact/wear.py)
+    ParameterSpec("wear_outputs", "bool", False,
+                  "publish contact/<name>/energy (Vector3Stamped: x T-gamma N, y T-gamma/A Pa, "
+                  "z frictional power W) and contact/<name>/damage (x wear rate kg/(m m^2), "
+                  "y RCF damage per passage, z frictional power / (T-gamma |V|)) per solve, "
+                  "and add their columns to the replay's CSV"),
+    ParameterSpec("frictional_power", "bool", False,
+                  "compute the slip area's frictional power (sum -tau . s |V| dA): the solve "
+                  "keeps its tractions and sweeps them once more (steady rolling; NaN when "
+                  "off or transient); publish_traction computes it too", dynamic=True),
+    ParameterSpec("wear_function_x", "double_array", tuple(SHEFFIELD_WEAR.x),
+                  "wear function's breakpoints in T-gamma/A (Pa; non-decreasing, a value "
+                  "twice is a jump); default the University of Sheffield function for "
+                  "R8T/R260 steel (10.4 and 77.2 N/mm^2)", dynamic=True),
+    ParameterSpec("wear_function_y", "double_array", tuple(SHEFFIELD_WEAR.y),
+                  "wear rate at each breakpoint (kg per metre rolled per m^2 of contact; "
+                  "1 ug/(m mm^2) = 1e-3), linear between, held beyond the ends",
+                  dynamic=True),
+    ParameterSpec("rcf_function_x", "double_array", tuple(BURSTOW_RCF.x),
+                  "RCF damage function's breakpoints in T-gamma (N); default Burstow's "
+                  "whole-life rail model (15, 65, 175 N)", dynamic=True),
+    ParameterSpec("rcf_function_y", "double_array", tuple(BURSTOW_RCF.y),
+                  "RCF damage per wheel passage at each breakpoint (crack initiation at an "
+                  "accumulated 1), linear between, held beyond the ends", dynamic=True),
     ParameterSpec("allow_implausible", "bool", False,
                   "accept patches and loads that wheel-rail contact does not have in SI units "
                   "(fastsim_ros/plausibility.py: a patch over 0.1 m across, pressures under "
@@ -376,6 +415,11 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
             raise ParameterError("parameter 'contacts': in profiles mode the contacts are "
                                  "fixed: " + ", ".join(PROFILE_CONTACTS))
         out["contacts"] = PROFILE_CONTACTS
+    for table in ("wear_function", "rcf_function"):
+        try:
+            PiecewiseLinear.of(out[f"{table}_x"], out[f"{table}_y"])
+        except InvalidInputError as e:
+            raise ParameterError(f"parameters '{table}_x' and '{table}_y': {e}") from None
     return out
 
 

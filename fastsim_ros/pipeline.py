@@ -50,6 +50,7 @@ from fastsim_ros.estimation.model import model_error
 from fastsim_ros.contact import kernels as contact_kernels
 from fastsim_ros.contact.transient import (RESET_REASONS, ContactMemory, TransientSolver,
                                            mae_state)
+from fastsim_ros.contact.wear import PiecewiseLinear, WearIndicators, indicators
 from msg_adapters import outputs as out
 from msg_adapters import patch_kernels
 from msg_adapters.cdr import (Cloud, CloudReader, StampedTwist, read_twist, stamped_doubles,
@@ -88,15 +89,23 @@ CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "creepage": "geometry_msgs/msg/Vector3Stamped",
                    "frame": "geometry_msgs/msg/PoseStamped",
                    "traction": "sensor_msgs/msg/PointCloud2"}
+#: a contact's wear and fatigue topics (parameter wear_outputs; docs/guide_wear.md):
+#: energy = (T-gamma N, T-gamma/A Pa, frictional power W), damage = (wear rate kg/(m m^2),
+#: RCF damage per passage, frictional power / (T-gamma |V|))
+WEAR_OUTPUTS = {"energy": "geometry_msgs/msg/Vector3Stamped",
+                "damage": "geometry_msgs/msg/Vector3Stamped"}
 
 
-def output_topics(contacts: tuple[str, ...], *, patches: bool = False) -> dict[str, str]:
+def output_topics(contacts: tuple[str, ...], *, patches: bool = False,
+                  wear: bool = False) -> dict[str, str]:
     """Return every output topic (relative, but /diagnostics) with its message type.
 
-    ``patches``: the patches are outputs too (profiles mode computes them).
+    ``patches``: the patches are outputs too (profiles mode computes them);
+    ``wear``: the wear and fatigue topics too (:data:`WEAR_OUTPUTS`).
     """
+    kinds = {**CONTACT_OUTPUTS, **WEAR_OUTPUTS} if wear else CONTACT_OUTPUTS
     topics = {f"contact/{c}/{kind}": msgtype for c in contacts
-              for kind, msgtype in CONTACT_OUTPUTS.items()}
+              for kind, msgtype in kinds.items()}
     if patches:
         topics.update({patch_topic(c): "sensor_msgs/msg/PointCloud2" for c in contacts})
     topics[WHEELSET_WRENCH_TOPIC] = "geometry_msgs/msg/WrenchStamped"
@@ -127,10 +136,14 @@ def _on_patch_cells(f: ContactForces, patch: ContactPatch) -> ContactForces:
     grid = (patch.x0, patch.y0, patch.dx, patch.dy)
     shape = (patch.pressure.shape[0], patch.pressure.shape[1])
     inside = patch.pressure > 0.0
+    # the dissipation density moves as the tractions do (its sum stays the solve's)
+    density = (None if f.dissipation_density is None else
+               np.where(inside, regridded(f.dissipation_density, f.grid, grid, shape), 0.0))
     return ContactForces(f.fx, f.fy, f.mz, f.n, f.slip_fraction,
                          np.where(inside, regridded(f.tau_x, f.grid, grid, shape), 0.0),
                          np.where(inside, regridded(f.tau_y, f.grid, grid, shape), 0.0),
-                         nearest_cells(f.slip, f.grid, grid, shape) & inside, grid)
+                         nearest_cells(f.slip, f.grid, grid, shape) & inside, grid,
+                         f.dissipation, density)
 
 
 @dataclass(frozen=True)
@@ -340,14 +353,18 @@ class _ContactState:
 class _ContactTopics:
     """A contact's output topics (relative names), built once."""
 
-    __slots__ = ("wrench", "creepage", "frame", "traction", "wrench_cdr")
+    __slots__ = ("wrench", "creepage", "frame", "traction", "wrench_cdr", "energy", "damage",
+                 "vector_cdr")
 
     def __init__(self, contact: str) -> None:
         base = f"contact/{contact}/"
         self.wrench, self.creepage = base + "wrench", base + "creepage"
         self.frame, self.traction = base + "frame", base + "traction"
+        self.energy, self.damage = base + "energy", base + "damage"
         # the contact's WrenchStamped, (Fx, Fy, N) and (0, 0, Mz): only numbers change
         self.wrench_cdr = stamped_doubles_template(out.contact_frame_id(contact), 6).encode
+        # its Vector3Stamped (the wear topics)
+        self.vector_cdr = stamped_doubles_template(out.contact_frame_id(contact), 3).encode
 
 
 class _Every:
@@ -472,7 +489,14 @@ class Pipeline:
         self._min_speed = float(config["min_rolling_speed"])
         self._rail_required = bool(config["rail_twist_required"])
         self._allow_implausible = bool(config["allow_implausible"])
-        self._tractions = bool(config["publish_traction"])
+        # the tractions are kept for the cloud, or for the frictional power (a sweep more)
+        self._publish_tractions = bool(config["publish_traction"])
+        self._tractions = self._publish_tractions or bool(config["frictional_power"])
+        self._wear = bool(config["wear_outputs"])
+        self._wear_function = PiecewiseLinear.of(config["wear_function_x"],
+                                                 config["wear_function_y"])
+        self._rcf_function = PiecewiseLinear.of(config["rcf_function_x"],
+                                                config["rcf_function_y"])
         rate = float(config["marker_rate"])
         self._markers = bool(config["publish_markers"])
         self._marker_period_ns = 0 if rate == 0.0 else round(1e9 / rate)
@@ -559,7 +583,7 @@ class Pipeline:
 
     def outputs(self) -> dict[str, str]:
         """Return every topic the pipeline publishes (relative, but /diagnostics) with its type."""
-        topics = output_topics(self.config.contacts)
+        topics = output_topics(self.config.contacts, wear=self._wear)
         if self._ekf is not None:
             topics[FRICTION_ESTIMATE_TOPIC] = "geometry_msgs/msg/Vector3Stamped"
         return topics
@@ -1086,17 +1110,23 @@ class Pipeline:
                                 str(e)) from None
         stats.add_solve_time(time.perf_counter() - start)
         if reverse:
-            tau_x = tau_y = slip = None
+            tau_x = tau_y = slip = density = None
             if f.tau_x is not None and f.tau_y is not None and f.slip is not None:
                 tau_x, tau_y, slip = -f.tau_x[::-1, ::-1], -f.tau_y[::-1, ::-1], \
                     f.slip[::-1, ::-1]
+            if f.dissipation_density is not None:  # a scalar field: turned, not negated
+                density = f.dissipation_density[::-1, ::-1]
             grid = None
             if f.grid is not None:  # the turned grid's cell [0, 0] is the original's last
                 gx0, gy0, gdx, gdy = f.grid
                 n_y, n_x = (tau_x.shape if tau_x is not None else (1, 1))
                 grid = (-(gx0 + (n_x - 1) * gdx), -(gy0 + (n_y - 1) * gdy), gdx, gdy)
             f = ContactForces(-f.fx, -f.fy, f.mz, f.n, f.slip_fraction, tau_x, tau_y, slip,
-                              grid)
+                              grid, f.dissipation, density)
+        if not self._publish_tractions and f.tau_x is not None:
+            # kept for the frictional power alone: its sum is taken, the fields go
+            f = ContactForces(f.fx, f.fy, f.mz, f.n, f.slip_fraction,
+                              dissipation=f.dissipation)
         if f.grid is not None and isinstance(self._solver, EquivalentEllipseSolver):
             f = _on_patch_cells(f, patch)
         isfinite = math.isfinite
@@ -1151,8 +1181,9 @@ class Pipeline:
 
         Each as CDR bytes (docs/guide_node.md): the contact's wrench and
         creepage, its frame when it moved, its traction cloud when asked
-        for, its marker when due, and the wheelset wrench when the rig cycle
-        is complete.  ``wanted``: if given, only these topics are encoded
+        for, its energy and damage (``wear_outputs``, :meth:`wear`), its
+        marker when due, and the wheelset wrench when the rig cycle is
+        complete.  ``wanted``: if given, only these topics are encoded
         (the node's topics that have subscribers).
         """
         if not outcome.has_wrench:
@@ -1167,6 +1198,12 @@ class Pipeline:
         if f is None or outcome.frame is None or outcome.creepage is None:
             if topic in wanted:
                 msgs.append((topic, out.contact_wrench_cdr(stamp, c, 0.0, 0.0, 0.0, 0.0)))
+            if self._wear:  # no contact: no energy, no wear, no damage
+                if topics.energy in wanted:
+                    msgs.append((topics.energy, topics.vector_cdr(stamp, 0.0, 0.0, 0.0)))
+                if topics.damage in wanted:
+                    msgs.append((topics.damage, topics.vector_cdr(stamp, 0.0, 0.0,
+                                                                  math.nan)))
         else:
             if topic in wanted:  # (out.contact_wrench_cdr, from the contact's template)
                 msgs.append((topic, topics.wrench_cdr(stamp, f.fx, f.fy, f.n, 0.0, 0.0, f.mz)))
@@ -1177,10 +1214,22 @@ class Pipeline:
             if outcome.frame_changed and topic in wanted:
                 msgs.append((topic, out.pose_cdr(stamp, frame_id, outcome.frame)))
             topic = topics.traction
-            if (f.tau_x is not None and f.tau_y is not None and f.slip is not None
-                    and f.grid is not None and topic in wanted):
+            if (self._publish_tractions and f.tau_x is not None and f.tau_y is not None
+                    and f.slip is not None and f.grid is not None and topic in wanted):
+                v = abs(outcome.creepage.speed)
+                power = (None if f.dissipation_density is None
+                         else f.dissipation_density * v)
                 msgs.append((topic, out.traction_cloud_cdr(
-                    stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid)))
+                    stamp, frame_id, outcome.frame, f.tau_x, f.tau_y, f.slip, f.grid, power)))
+            if self._wear:
+                ind = self.wear(outcome)
+                if ind is not None:
+                    if topics.energy in wanted:
+                        msgs.append((topics.energy, topics.vector_cdr(
+                            stamp, ind.t_gamma, ind.t_gamma_per_area, ind.frictional_power)))
+                    if topics.damage in wanted:
+                        msgs.append((topics.damage, topics.vector_cdr(
+                            stamp, ind.wear_rate, ind.rcf_damage, ind.slip_share)))
         if outcome.markers and MARKERS_TOPIC in wanted:
             index = self.config.contacts.index(c)
             fx, fy = (f.fx, f.fy) if f is not None else (0.0, 0.0)
@@ -1196,6 +1245,21 @@ class Pipeline:
             msgs.append((FRICTION_ESTIMATE_TOPIC, stamped_doubles(
                 e.stamp_ns, frame_id, (e.mu, e.sigma, e.utilisation))))
         return msgs
+
+    def wear(self, outcome: Outcome) -> WearIndicators | None:
+        """Return a solved outcome's wear and fatigue indicators (None without a solve).
+
+        :func:`fastsim_ros.contact.wear.indicators` with the configured
+        tables; ``A`` the patch's cells in contact times the cell area; the
+        frictional power where the solve computed its dissipation (parameter
+        ``frictional_power`` or ``publish_traction``, steady rolling), else NaN.
+        """
+        f, cr, p = outcome.forces, outcome.creepage, outcome.patch
+        if f is None or cr is None or p is None:
+            return None
+        return indicators(f.fx, f.fy, f.mz, cr.xi, cr.eta, cr.phi, p.cells * p.dx * p.dy,
+                          cr.speed, f.dissipation, wear=self._wear_function,
+                          rcf=self._rcf_function)
 
     def diagnostics(self, stamp_ns: int,
                     extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> Any:

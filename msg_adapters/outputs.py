@@ -24,11 +24,13 @@ from msg_adapters.cdr import Template, Writer, stamped_doubles
 from msg_adapters.kinematics import Creepage
 from msg_adapters.patch import ContactFrame
 
-#: traction cloud layout: x y z tau_x tau_y as float32, slip as uint8, padded to 24 bytes
-TRACTION_DTYPE = np.dtype({"names": ["x", "y", "z", "tau_x", "tau_y", "slip"],
-                           "formats": ["<f4", "<f4", "<f4", "<f4", "<f4", "u1"],
-                           "offsets": [0, 4, 8, 12, 16, 20], "itemsize": 24})
-_TRACTION_OFFSETS = (("x", 0), ("y", 4), ("z", 8), ("tau_x", 12), ("tau_y", 16), ("slip", 20))
+#: traction cloud layout: x y z tau_x tau_y as float32, slip as uint8, the frictional power
+#: density friction_power as float32 after padding, 28 bytes a point
+TRACTION_DTYPE = np.dtype({"names": ["x", "y", "z", "tau_x", "tau_y", "slip", "friction_power"],
+                           "formats": ["<f4", "<f4", "<f4", "<f4", "<f4", "u1", "<f4"],
+                           "offsets": [0, 4, 8, 12, 16, 20, 24], "itemsize": 28})
+_TRACTION_OFFSETS = (("x", 0), ("y", 4), ("z", 8), ("tau_x", 12), ("tau_y", 16), ("slip", 20),
+                     ("friction_power", 24))
 _UINT8, _FLOAT32 = 2, 7
 
 
@@ -69,15 +71,19 @@ def pose_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame) -> bytes:
 
 def traction_cloud_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
                        tau_x: np.ndarray, tau_y: np.ndarray, slip: np.ndarray,
-                       grid: tuple[float, float, float, float]) -> bytes:
+                       grid: tuple[float, float, float, float],
+                       power: np.ndarray | None = None) -> bytes:
     """Return the solved traction as a serialized organised ``PointCloud2`` in the wheelset frame.
 
     One point per cell of ``grid = (x0, y0, dx, dy)`` in the contact plane
     (the patch's cells: the pipeline moves the equivalent ellipse's traction
     there from its own grid), placed at ``origin + x e_x + y e_y``; ``tau_x``,
     ``tau_y``: traction of the rail on the wheel along the contact frame's
-    axes (Pa); ``slip``: 1 where the cell is on the traction bound.
-    Fields ``x y z tau_x tau_y`` float32 and ``slip`` uint8 (TRACTION_DTYPE).
+    axes (Pa); ``slip``: 1 where the cell is on the traction bound;
+    ``power``: the frictional power density ``-tau . s |V|`` (W/m^2, zero
+    where the cell sticks; None: NaN, not computed).  Fields ``x y z tau_x
+    tau_y`` float32, ``slip`` uint8 and ``friction_power`` float32
+    (TRACTION_DTYPE).
     """
     ny, nx = tau_x.shape
     x0, y0, dx, dy = grid
@@ -88,6 +94,7 @@ def traction_cloud_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame,
     pts = np.zeros((ny, nx), dtype=TRACTION_DTYPE)
     pts["x"], pts["y"], pts["z"] = pos[..., 0], pos[..., 1], pos[..., 2]
     pts["tau_x"], pts["tau_y"], pts["slip"] = tau_x, tau_y, slip
+    pts["friction_power"] = np.nan if power is None else power
     w = Writer()
     w.header(wheelset_frame, stamp_ns)
     w.u32(ny)

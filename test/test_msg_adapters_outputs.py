@@ -95,7 +95,7 @@ def test_traction_cloud_decodes_to_the_cells():
     assert (cloud.height, cloud.width, cloud.header.frame_id) == (3, 4, "wheelset")
     assert [(f.name, f.offset, f.datatype, f.count) for f in cloud.fields] == [
         ("x", 0, 7, 1), ("y", 4, 7, 1), ("z", 8, 7, 1), ("tau_x", 12, 7, 1),
-        ("tau_y", 16, 7, 1), ("slip", 20, 2, 1)]
+        ("tau_y", 16, 7, 1), ("slip", 20, 2, 1), ("friction_power", 24, 7, 1)]
     pts = np.frombuffer(bytes(cloud.data), dtype=outputs.TRACTION_DTYPE).reshape(3, 4)
     assert np.array_equal(pts["tau_x"], tau_x.astype(np.float32))
     assert np.array_equal(pts["slip"], slip.astype(np.uint8))
@@ -104,4 +104,11 @@ def test_traction_cloud_decodes_to_the_cells():
     want = np.array(frame.origin) + (-1e-3 + 3e-3) * ex + (-2e-3 + 2 * 2e-3) * ey
     got = np.array([pts["x"][2, 3], pts["y"][2, 3], pts["z"][2, 3]], dtype=float)
     assert got == pytest.approx(want, abs=1e-7)
-    assert cloud.point_step == 24 and cloud.row_step == 96 and cloud.is_dense
+    assert cloud.point_step == 28 and cloud.row_step == 112 and cloud.is_dense
+    # no frictional power given: NaN (not computed), not a zero that reads as no slip
+    assert np.isnan(pts["friction_power"]).all()
+    power = rng.random((3, 4)) * 1e8
+    pts = np.frombuffer(bytes(deserialize_message(outputs.traction_cloud_cdr(
+        5, "wheelset", frame, tau_x, tau_y, slip, (-1e-3, -2e-3, 1e-3, 2e-3), power),
+        PointCloud2).data), dtype=outputs.TRACTION_DTYPE).reshape(3, 4)
+    assert np.array_equal(pts["friction_power"], power.astype(np.float32))

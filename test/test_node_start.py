@@ -53,7 +53,7 @@ def _cases() -> list[tuple[str, str, list[str]]]:
         if bad is not None:
             cases.append((f"{spec.name}-range", spec.name, ["-p", f"{spec.name}:={bad}"]))
     wrong_type = {"double": "'a word'", "integer": "2.5", "bool": "'maybe'",
-                  "string": "[1, 2]", "string_array": "3"}
+                  "string": "[1, 2]", "string_array": "3", "double_array": "'a word'"}
     for kind, bad in wrong_type.items():
         spec = next(s for s in PARAMETERS if s.kind == kind)
         cases.append((f"{spec.name}-type", spec.name, ["-p", f"{spec.name}:={bad}"]))
@@ -82,6 +82,10 @@ def _cases() -> list[tuple[str, str, list[str]]]:
         ("profiles-explicit-contacts", "contacts",
          PROFILES + ["-p", 'contacts:=["left", "right"]']),
         ("unknown-executor", "executor", ["-p", "executor:=threads"]),
+        # a wear table whose breakpoints and values differ in number, or go back
+        ("wear-table-lengths", "wear_function_x", ["-p", "wear_function_x:=[0.0, 1.0]"]),
+        ("rcf-table-decreasing", "rcf_function_x",
+         ["-p", "rcf_function_x:=[0.0, 65.0, 15.0, 175.0]"]),
     ]
     return cases
 

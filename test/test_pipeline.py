@@ -347,7 +347,8 @@ def test_messages_of_a_solve():
             pose.pose.position.z) == pytest.approx(out.frame.origin)
     cloud = deserialize_message(msgs["contact/left/traction"], PointCloud2)
     tau = np.frombuffer(bytes(cloud.data), dtype=np.dtype(
-        {"names": ["tau_x"], "formats": ["<f4"], "offsets": [12], "itemsize": 24}))
+        {"names": ["tau_x"], "formats": ["<f4"], "offsets": [12],
+         "itemsize": cloud.point_step}))
     # the traction integrates to the force
     assert float(tau["tau_x"].astype(float).sum()) * out.patch.dx * out.patch.dy == \
         pytest.approx(out.forces.fx, rel=1e-5)
@@ -560,7 +561,7 @@ def out_values(pipe):
 WARM_PATH_PROBE = """
 import numba
 from fastsim_ros import pipeline_kernels
-from fastsim_ros.contact import compiled, kernels, samples
+from fastsim_ros.contact import compiled, kernels, samples, slip_power
 from fastsim_ros.params import METHODS
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from msg_adapters import patch, patch_kernels
@@ -573,7 +574,7 @@ pipeline_kernels.warm_up()
 
 def signatures():
     return {(mod.__name__, name): len(f.signatures)
-            for mod in (kernels, patch_kernels, pipeline_kernels)
+            for mod in (kernels, patch_kernels, pipeline_kernels, slip_power)
             for name, f in vars(mod).items() if isinstance(f, numba.core.registry.CPUDispatcher)}
 
 
@@ -581,9 +582,11 @@ before = signatures()
 area = samples.semi_ellipses_patch(0.5, 2.0, cells=12, scale=8e-3, load=6e4)
 for method in METHODS:
     # Polach's closed form has no traction field (the parameters refuse it)
-    for traction in (False,) if method == "polach" else (False, True):
+    for traction, power in (((False, False),) if method == "polach"
+                            else ((False, False), (True, False), (False, True))):
         pipe = Pipeline(PipelineConfig.from_values({"contacts": ["left"], "method": method,
-                                                    "publish_traction": traction}))
+                                                    "publish_traction": traction,
+                                                    "frictional_power": power}))
         pipe.on_wheel_twist(cdr(rolling_twist(1e-3, stamp_ns=0)))
         for k, dtype in enumerate(("<f4", "<f8", ">f8")):
             out = pipe.on_patch("left", cdr(cloud_msg(area, stamp_ns=k + 1, dtype=dtype)))

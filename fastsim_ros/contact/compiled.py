@@ -33,12 +33,14 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from collections.abc import Callable
 from typing import Any, NoReturn
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fastsim_ros.contact import kernels as k
+from fastsim_ros.contact import slip_power
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import (Bound, SplitRule, check_bound, check_friction,
                                         check_shear_modulus, check_split_rule)
@@ -75,7 +77,12 @@ class ContactForces:
     (N); ``slip_fraction``: share of the cells in contact on the traction
     bound.  With ``tractions=True``: ``tau_x``, ``tau_y`` (Pa) and ``slip``
     on the grid ``grid = (x0, y0, dx, dy)`` (m) (the patch's for MAE, the
-    equivalent ellipse's for the baseline), else ``None``.
+    equivalent ellipse's for the baseline), else ``None``.  With them, the
+    frictional dissipation of the slip area (steady rolling,
+    :mod:`~fastsim_ros.contact.slip_power`): ``dissipation`` (N = J per
+    metre rolled, ``sum -tau . s dA``; times ``|V|``: the frictional power,
+    W) and per cell ``dissipation_density`` (N/m^2 per metre rolled, on
+    ``grid``); else NaN and ``None``.
     """
 
     fx: float
@@ -87,6 +94,8 @@ class ContactForces:
     tau_y: FloatArray | None = None
     slip: BoolArray | None = None
     grid: tuple[float, float, float, float] | None = None
+    dissipation: float = math.nan
+    dissipation_density: FloatArray | None = None
 
 
 def _table_range(knots: FloatArray) -> str:
@@ -324,13 +333,21 @@ class _Solver:
         raise NotImplementedError
 
     def _forces(self, result: tuple[Any, ...], grid: tuple[float, float, float, float],
-                out: tuple[FloatArray, FloatArray, BoolArray], tractions: bool) -> ContactForces:
+                out: tuple[FloatArray, FloatArray, BoolArray], tractions: bool,
+                dissipation: Callable[[FloatArray], float] | None = None) -> ContactForces:
+        """Return the solve's forces; with ``tractions`` its fields and ``dissipation``'s.
+
+        ``dissipation(density)``: fills the cells' dissipation density and
+        returns its sum (:mod:`~fastsim_ros.contact.slip_power`).
+        """
         status, info, fx, fy, mz, load, nslip, ncontact = result
         if status:
             _raise(status, info, self._knots)
         if tractions:
+            density = np.empty(out[0].shape)
+            total = dissipation(density) if dissipation is not None else math.nan
             return ContactForces(fx, fy, mz, load, nslip / ncontact, out[0], out[1], out[2],
-                                 grid)
+                                 grid, total, density if dissipation is not None else None)
         return ContactForces(fx, fy, mz, load, nslip / ncontact)
 
 
@@ -367,7 +384,15 @@ class MaeSolver(_Solver):
                              self._polys, code, prm, speed, out[0], out[1], out[2], tractions,
                              self._calibrated, self._pair_knots, self._pair_values,
                              self._knee_for(bound))
-        return self._forces(result, grid, out, tractions)
+
+        def dissipation(density: FloatArray) -> float:
+            status, total = slip_power.mae_dissipation(
+                p, grid[0], grid[1], grid[2], grid[3], float(xi), float(eta), float(phi),
+                float(mu), float(reference[0]), float(reference[1]), self._rule,
+                _bound(bound), self.shear_modulus, self._knots, self._polys, self._calibrated,
+                self._pair_knots, self._pair_values, out[0], out[1], out[2], density)
+            return float(total) if status == k.OK else math.nan
+        return self._forces(result, grid, out, tractions, dissipation)
 
     def _knee_for(self, bound: str) -> FloatArray:
         """Return the packed knee table the solve applies (none with the parabolic bound)."""
@@ -503,7 +528,15 @@ class EquivalentEllipseSolver(_Solver):
         if tractions and result[0] == k.OK:
             e = self._ellipse(p, x0, y0, dx, dy)
             grid = ellipse_grid(e.a, e.b, n, e.x_c, e.y_c)  # the kernel's grid, one formula
-        return self._forces(result, grid, out, tractions)  # type: ignore[arg-type]
+
+        def dissipation(density: FloatArray) -> float:
+            status, total = slip_power.equivalent_dissipation(
+                p, float(x0), float(y0), float(dx), float(dy), float(xi), float(eta),
+                float(phi), float(reference[0]), float(reference[1]), _bound(bound), n,
+                self.shear_modulus, self._knots, self._polys, out[0], out[1], out[2], density)
+            return float(total) if status == k.OK else math.nan
+        return self._forces(result, grid, out, tractions,  # type: ignore[arg-type]
+                            dissipation)
 
     def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
                     dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,

@@ -61,7 +61,7 @@ from fastsim_ros.contact.traction import Tractions, resultants, rigid_slip
 __all__ = ["SteadyRollingOperator", "StripBlock", "TractionSolution", "full_adhesion",
            "coulomb", "unit_solutions", "creep_coefficients", "extrapolation_grids",
            "extrapolated_coefficients", "EXTRAPOLATION_GRIDS", "MAX_COULOMB_CELLS",
-           "MAX_DENSE_COULOMB_CELLS"]
+           "MAX_DENSE_COULOMB_CELLS", "slip_dissipation"]
 
 FloatArray = NDArray[np.float64]
 SolverKind = Literal["fft", "dense"]
@@ -498,3 +498,27 @@ def _extrapolated(shape: str, ratios: tuple[float, ...], nu: float,
            for key in ("C11", "C12", "C13", "C21", "C22", "C23", "C31", "C32", "C33")}
     return CreepCoefficients(fit["C11"], fit["C12"], fit["C13"], fit["C21"], fit["C22"],
                              fit["C23"], fit["C31"], fit["C32"], fit["C33"], area=1.0)
+
+
+def slip_dissipation(area: GridArea, solution: Tractions, xi: float, eta: float, phi: float,
+                     *, nu: float, shear_modulus: float,
+                     reference: tuple[float, float] = (0.0, 0.0),
+                     operator: SteadyRollingOperator | None = None
+                     ) -> tuple[float, FloatArray]:
+    """Return the exact solve's slip dissipation per metre rolled (N) and its density (N/m^2).
+
+    ``s = w - du/dx`` with ``du/dx`` the solver's own discrete operator
+    (:class:`~fastsim_ros.contact.rolling.SteadyRollingOperator`, upstream
+    difference) applied to the solution's tractions, ``w`` the rigid slip
+    about ``reference``; ``-tau . s`` on the slip cells (zero where they
+    stick, as CONTACT sets it), summed times the cell area.  Times ``|V|``:
+    the frictional power (W) and its density (W/m^2).  ``operator``: the
+    area's own (:func:`coulomb`'s), else one is built.
+    """
+    op = operator if operator is not None else SteadyRollingOperator.of(
+        area, nu=nu, shear_modulus=shear_modulus)
+    dux, duy = op.fft_product()(solution.tau_x, solution.tau_y)
+    wx, wy = rigid_slip(area, xi, eta, phi, reference)
+    density = np.where(solution.slip, -(solution.tau_x * (wx - dux)
+                                        + solution.tau_y * (wy - duy)), 0.0)
+    return float(density.sum() * area.cell_area), density

@@ -32,6 +32,10 @@ directory's name, or the file's without ``.mcap``) gives:
   :data:`CSV_HEADER`; floats in Python's shortest round-trip form.  A
   ``no_contact`` row (an empty patch, zero wrench) has ``N, Fx, Fy, Mz`` =
   0 and ``xi, eta, phi, V, slip_fraction`` blank (undefined: no contact).
+  With ``wear_outputs: true`` the columns
+  :data:`~fastsim_ros.replay.records.WEAR_COLUMNS` follow (the
+  ``contact/<name>/energy`` and ``damage`` values, docs/guide_wear.md) and
+  the summary has a wear line per contact.
 - with ``--csv`` and ``friction_estimation: on``, ``OUT/NAME.friction.csv``:
   one row per ``friction/estimate`` message, header
   :data:`~fastsim_ros.replay.records.FRICTION_CSV_HEADER` (``stamp_ns, mu,

@@ -93,11 +93,13 @@ def supported(pipeline: Pipeline) -> bool:
     Inputs the batch knows (patches and twists: not the profiles mode's),
     no traction clouds (the batched solves keep no tractions), a method it
     knows, steady rolling (transient rolling carries each contact's state
-    from one patch to the next: the per-message path).
+    from one patch to the next: the per-message path), no wear outputs
+    (their messages and CSV columns are the per-message path's).
     """
     config = pipeline.config
     return (all(i.kind in KINDS for i in pipeline.inputs())
             and not bool(config["publish_traction"])
+            and not bool(config["wear_outputs"])
             and str(config["rolling"]) == "steady"
             and str(config["method"]) in ("mae", "mae_calibrated", "fastsim_ellipse"))
 

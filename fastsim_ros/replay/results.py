@@ -121,6 +121,8 @@ class Result:
     tabled: dict[str, str] = field(default_factory=dict)
     #: input topics the node could take but did not, as ``(topic, messages, what takes them)``
     unused: list[tuple[str, int, str]] = field(default_factory=list)
+    #: the contacts' wear summary lines (wear_outputs on; records.WearSummary)
+    wear: list[str] = field(default_factory=list)
 
     @property
     def speed(self) -> float:
@@ -167,6 +169,7 @@ class Result:
         if self.friction is not None:
             files = [p for t, p in self.tabled.items() if t.endswith("/friction/estimate")]
             lines += self.friction.summary(files[0] if files else "")
+        lines += self.wear
         lines += self._outputs()
         lines.append(f"  replay: {self.wall_s - self.plot_s:.2f} s, {self.speed:.1f}x real time"
                      + (f"; plot {self.plot_s:.2f} s" if self.plot_s else ""))

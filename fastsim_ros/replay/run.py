@@ -26,6 +26,7 @@ import sys
 import tempfile
 import time
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -35,15 +36,17 @@ from rclpy.serialization import serialize_message
 
 from fastsim_ros.contact.area import turned_grid
 from fastsim_ros.params import SPECS, ParameterError
+from fastsim_ros.contact.wear import WearIndicators
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC,
-                                  MEASURED_WRENCH_TOPIC, FrictionEstimate, Pipeline,
+                                  MEASURED_WRENCH_TOPIC, FrictionEstimate, Outcome, Pipeline,
                                   PipelineConfig)
 from fastsim_ros.profile_pipeline import LOAD_TOPIC, POSE_TOPIC, AnyPipeline, make_pipeline
 from fastsim_ros.replay import bagio, bulk, faults, heap, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot
 from fastsim_ros.replay.records import (CSV_HEADER, ESTIMATE_COLUMNS, FRICTION_CSV_HEADER,
-                                        Series, friction_row, record)
+                                        WEAR_COLUMNS, Series, WearSummary, friction_row,
+                                        record)
 from fastsim_ros.replay.results import FrictionPath, Profile, Result
 from fastsim_ros.replay.bagio import resolve
 
@@ -478,11 +481,13 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
         custom = {PARAMETERS_KEY: json.dumps(dict(config.values), sort_keys=True),
                   "fastsim.input": task.given or str(source), "fastsim.replay": PROG}
         estimating = FRICTION_ESTIMATE_TOPIC in pipeline.outputs()
+        inner = pipeline if isinstance(pipeline, Pipeline) else pipeline.pipeline
+        wearing = bool(config["wear_outputs"])
         rows = friction_rows = None
         if task.write_csv:
             csv_file = open(staging / f"{name}.csv", "w", newline="", encoding="utf-8")
             rows = csv.writer(csv_file, lineterminator="\n")
-            rows.writerow(CSV_HEADER)
+            rows.writerow(CSV_HEADER + (WEAR_COLUMNS if wearing else ()))
             if estimating:
                 friction_file = open(staging / friction_csv(name), "w", newline="",
                                      encoding="utf-8")
@@ -493,7 +498,8 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
         out = _Outputs(pipeline, rows, series, str(config["method"]),
                        str(config["friction_law"]), mu=mu, friction_rows=friction_rows,
                        estimates=Series(ESTIMATE_COLUMNS) if task.plot and estimating else None,
-                       path=FrictionPath(mu) if estimating else None)
+                       path=FrictionPath(mu) if estimating else None,
+                       wear=inner.wear if wearing else None)
         bar = _progress(name, reader.message_count, task.progress)
         indexed = bulk.open_indexed(source, reader) if task.path != "rosbags" else None
         if indexed is not None:
@@ -513,10 +519,12 @@ def _replay(task: Task, staging: Path, profile: bool, result: Result) -> None:
             result.solve_us[c] = pipeline.solve_time_percentiles(c)
         result.kinematics = dict(pipeline.kinematics_counts)
         result.friction = out.path
+        result.wear = [out.wear_summary[c].line(c) for c in contacts if c in out.wear_summary]
         result.unused = unused_topics(reader.connections, out.seen, pipeline, namespace)
         if task.write_csv:
             result.tabled = {resolve(f"contact/{c}/{kind}", namespace): f"{name}.csv"
-                             for c in contacts for kind in ("wrench", "creepage")}
+                             for c in contacts for kind in ("wrench", "creepage")
+                             + (("energy", "damage") if wearing else ())}
             if estimating:
                 result.tabled[resolve(FRICTION_ESTIMATE_TOPIC, namespace)] = friction_csv(name)
         for f in (csv_file, friction_file):
@@ -556,13 +564,16 @@ class _Outputs:
     estimates: Series | None = None
     path: FrictionPath | None = None
     seen: dict[str, int] = field(default_factory=dict)
+    #: the pipeline's wear indicators of an outcome (wear_outputs on), their summary
+    wear: Callable[[Outcome], WearIndicators | None] | None = None
+    wear_summary: dict[str, WearSummary] = field(default_factory=dict)
 
     def outcome(self, outcome: Any, log_ns: int) -> None:
         """Record one outcome's wrench and friction estimate (the per-message paths)."""
         if outcome.has_wrench:
             record(outcome, log_ns - self.first, self.rows,
                    None if self.series is None else self.series[outcome.contact],
-                   self.method, self.law, self.mu)
+                   self.method, self.law, self.mu, self.wear, self.wear_summary)
         if outcome.friction is not None:
             self.estimate(outcome.friction, log_ns)
 
