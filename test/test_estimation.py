@@ -427,7 +427,10 @@ def test_pipeline_estimates_mu_and_solves_with_it(hertz, method):
         kappa = pipe._creep_model.knee_factor(ContactSample(
             p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi, c.eta, c.phi, c.speed,
             ((ex[0], ey[0]),)), 0.35)[0]
-        assert 1.0 < kappa < 1.07  # at and beyond the knee: FastSim's force is low
+        if method == "mae_calibrated":  # its knee corrected strip by strip: no second factor
+            assert kappa == 1.0
+        else:
+            assert 1.0 < kappa < 1.07  # at and beyond the knee: FastSim's force is low
         noisy = (measured[0] + (kappa - 1.0) * (ex[0] * f.fx + ey[0] * f.fy)
                  + rng.normal(0.0, NOISE), measured[1], measured[2])
         assert pipe.on_wheel_twist(twist) == "ok"
@@ -750,8 +753,10 @@ def test_on_the_exact_theorys_forces_sigma_covers_the_model_error(solver, hertz,
     carried (without it the band is the noise's alone: 71-100% by seed).
     """
     rng = np.random.default_rng(6)
-    model = CreepModel(solver, knee=knee)
-    assert model.knee_corrected == knee
+    # the knee corrected: the default method's own strip factors (no factor on the model);
+    # FastSim's own knee: the method without them
+    model = CreepModel(CalibratedMaeSolver(NU, G, knee=knee), knee=knee)
+    assert not model.knee_corrected
     ekf = FrictionEkf(0.3, 0.1, process_noise=2e-5, measurement_noise=NOISE)
     xis, forces = exact_curve
     errors, covered = [], []
@@ -783,6 +788,7 @@ def test_models_kernel_call_is_the_solvers_bit_for_bit(solver, hertz, law, bound
 
     Without the knee factor; with it, the same times the factor (1 with the parabolic bound).
     """
+    solver = CalibratedMaeSolver(NU, G, knee=False)  # the model's own factor, on FastSim's knee
     model = CreepModel(solver, law, 0.4, 0.6, bound, knee=False)
     s = sample(hertz, 3e-3, 1e-3, 0.4, speed)
     fx, fy, k = model._solve(s, 0.3)
@@ -825,7 +831,7 @@ def test_on_contacts_published_curve_to_the_knee(share, corrected):
     cksi, fx, load = contact_curve()
     knee = cksi <= 6e-3
     area = ellipse(6.304e-3, 12.61e-3, nx=24, ny=24, load=load)
-    model = CreepModel(CalibratedMaeSolver(NU, 8.2e10), knee=corrected)
+    model = CreepModel(CalibratedMaeSolver(NU, 8.2e10, knee=corrected), knee=corrected)
     ekf = FrictionEkf(0.3, 0.1, process_noise=2e-5, measurement_noise=NOISE)
     for _ in range(3):
         for xi, z in zip(cksi[knee], fx[knee]):
@@ -940,17 +946,19 @@ def test_the_published_solve_carries_the_slope(speed, law):
     s = [ContactSample(p.pressure, p.x0, p.y0, p.dx, p.dy, creep.xi, creep.eta, creep.phi,
                        creep.speed, ((1.0, 0.0), (0.0, 1.0)))]
     h = 1e-6
-    plain = dataclasses.replace(model, knee=False)  # the march's own: FastSim's
+    plain = dataclasses.replace(model, knee=False)  # the march's own (its strips' knee)
     central = (plain.predict(s, 0.3 + h) - plain.predict(s, 0.3 - h)) / (2 * h)
     assert np.abs(np.array(state.slope) - central).max() < 1e-8 * s[0].load
     assert abs(state.slope[0]) > 0.1 * s[0].load  # beyond the linear range: observable
-    # the estimator's model value and slope from them: the knee-corrected model's
-    assert model.knee_corrected
+    # the estimator's model value and slope are the published force's and the march's: the
+    # default method corrects its knee strip by strip, the model adds no second factor
+    assert not model.knee_corrected
     ex, ey, _ = p.frame.axes
     x = [s[0]._replace(projection=((ex[0], ey[0]),))]
-    predicted, slope = pipe._knee_corrected(model, [(p, creep, on.forces)], [state.slope], 0.3)
-    assert predicted == pytest.approx(model.predict(x, 0.3)[0], rel=1e-12)
-    assert slope == pytest.approx(model.slope(x, 0.3)[0], rel=1e-12)
+    assert ex[0] * on.forces.fx + ey[0] * on.forces.fy == pytest.approx(
+        model.predict(x, 0.3)[0], rel=1e-12)
+    assert ex[0] * state.slope[0] + ey[0] * state.slope[1] == pytest.approx(
+        model.slope(x, 0.3)[0], rel=1e-9)
 
 
 def test_the_command_line_alone_recovers_mu_from_its_own_exact_curve(capsys, tmp_path):

@@ -1209,16 +1209,18 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
                 k, dk = knee_interpolate(knee_la, knee_s, knee_kappa, s_j, log_aspect,
                                          lx * lx / l2)
                 ds = -s_j * inv_mu
+                dk_dmu = dk * ds
                 capped = knee_capped(k, sx[j], sy[j], sgb[j])
                 if capped != k:
-                    # mu N_j and the strip's force in full slip both go as mu_s: k is fixed
+                    # k = mu N_j / |F_j|: mu N_j goes as mu_s, |F_j| as its march says
                     k = capped
-                    dk = 0.0
+                    f2 = sx[j] * sx[j] + sy[j] * sy[j]
+                    dk_dmu = k * (inv_mu - (sx[j] * dsx[j] + sy[j] * dsy[j]) / f2)
                 fx += k * sx[j]
                 fy += k * sy[j]
                 mz += k * sm[j]
-                dfx += k * dsx[j] + dk * ds * sx[j]
-                dfy += k * dsy[j] + dk * ds * sy[j]
+                dfx += k * dsx[j] + dk_dmu * sx[j]
+                dfy += k * dsy[j] + dk_dmu * sy[j]
                 continue
         fx += sx[j]
         fy += sy[j]
