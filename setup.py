@@ -9,7 +9,7 @@ package_name = 'fastsim_ros'
 
 setup(
     name=package_name,
-    version='0.1.0',
+    version='0.6.0',
     packages=[package_name, package_name + '.contact', package_name + '.geometry',
               package_name + '.replay', package_name + '.estimation', 'msg_adapters'],
     package_data={package_name: ['data/*.csv', 'data/profiles/*', 'data/mbench/*']},

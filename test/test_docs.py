@@ -47,8 +47,8 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def test_the_guide_builds_without_warnings(site: Path) -> None:
     """Every page of the toctree is built, the API pages from the docstrings included."""
     for page in ("index", "guide_node", "guide_profiles", "guide_estimation", "guide_transient",
-                 "guide_replay", "guide_cli", "guide_physics", "reports", "api", "changelog",
-                 "validation", "validation_wider"):
+                 "guide_replay", "guide_cli", "guide_real_rails", "guide_wear", "guide_physics",
+                 "reports", "api", "changelog", "validation", "validation_wider"):
         assert (site / f"{page}.html").is_file(), page
     api = (site / "api.html").read_text(encoding="utf-8")
     # autodoc read the physics core and a ROS front end (its ROS imports mocked)
