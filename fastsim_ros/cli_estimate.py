@@ -12,7 +12,7 @@ wheel in N, signs as in docs/guide_physics.md) on the area of ``forces``
 and ``--friction-decay`` give the starting point.  ``--json`` prints
 ``mu_s``, the law's parameters, their standard deviations (null where the
 data do not determine them) and the fitted curve's worst and rms errors in
-% of ``mu_s N``, and ``model_correction`` (``knee_factor`` or ``none``,
+% of ``mu_s N``, and ``model_correction`` (``knee_strips``, ``knee_factor`` or ``none``,
 with ``model_correction_note`` in words, also in the readable table): the
 correction the fit's model applies to the method's force.  Bad files and
 flags: one line on stderr, exit status 2 (the checks and messages of
@@ -269,13 +269,19 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
 def model_correction(method: str, bound: str, solver: Any) -> tuple[str, str]:
     """Return the correction the fit's model applies to the method's force, and why, in words.
 
-    ``("knee_factor", ...)`` for a fast method under the given bound (the
+    ``("knee_strips", ...)`` for the calibrated MAE under the given bound
+    (its own strip-by-strip knee factors: the published forces),
+    ``("knee_factor", ...)`` for another fast method under the given bound (the
     node's estimator's model, :class:`~fastsim_ros.estimation.model.CreepModel`),
     ``("none", ...)`` otherwise: a fitted ``mu_s`` differs from the one that
     made forces with the method alone by the knee factor's share.
     """
     if method == "exact":
         return "none", "the exact theory's forces, uncorrected"
+    if bound == "given" and getattr(solver, "knee", False):
+        return "knee_strips", (
+            f"{method}'s forces as the node publishes them: FastSim's knee corrected strip by "
+            "strip with the knee factors of fastsim_ros/contact/knee.py; no factor added")
     from fastsim_ros.estimation.model import CreepModel
     if not CreepModel(solver, bound=bound).knee_corrected:
         return "none", (f"{method}'s forces, uncorrected (the knee factor is tabulated for "

@@ -403,6 +403,9 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
                                  f"{out['polach_ks']:g}")
         for name, bad, why in (("publish_traction", out["publish_traction"] is True,
                                 "its closed form has no traction field"),
+                               ("frictional_power", out["frictional_power"] is True,
+                                "its closed form has no traction field to integrate the "
+                                "slip's power over (T-gamma and the wear outputs need none)"),
                                ("rolling", out["rolling"] == "transient",
                                 "its closed form is steady rolling"),
                                ("slope_reduction_k0", reduces_slope(out),

@@ -91,7 +91,7 @@ CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "traction": "sensor_msgs/msg/PointCloud2"}
 #: a contact's wear and fatigue topics (parameter wear_outputs; docs/guide_wear.md):
 #: energy = (T-gamma N, T-gamma/A Pa, frictional power W), damage = (wear rate kg/(m m^2),
-#: RCF damage per passage, frictional power / (T-gamma |V|))
+#: RCF damage per passage, frictional power / (T-gamma ``|V|``))
 WEAR_OUTPUTS = {"energy": "geometry_msgs/msg/Vector3Stamped",
                 "damage": "geometry_msgs/msg/Vector3Stamped"}
 
@@ -977,13 +977,15 @@ class Pipeline:
          calibrated, pair_knots, pair_values, knee) = self._compiled
         pressure = np.empty((ny, nx))
         frame_out, result = state.frame_out, state.result
+        prev_x, prev_y, out_x, out_y, out_slip, out_geo = state_arrays
         start = time.perf_counter()
         status = fast.solve_cloud(
             words, ny, nx, row, step, cols, pressure, frame_out,
             self._twist_array("wheel", wheel), self._twist_array("rail", rail),
             self._min_speed, rule, parabolic, shear_modulus, knots, polys, law, prm, mu,
             slip_dependent, calibrated, pair_knots, pair_values,
-            self._ekf is not None and memory is None, result, mem, *state_arrays, knee)
+            self._ekf is not None and memory is None, result, mem, prev_x, prev_y, out_x,
+            out_y, out_slip, out_geo, knee)
         elapsed = time.perf_counter() - start
         if status != fast.SOLVED:
             return None

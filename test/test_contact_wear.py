@@ -50,7 +50,7 @@ def test_t_gamma_is_the_creep_forces_work_per_metre(solver, creep):
 
     ``Mz`` about the reference point and the spin about the same point:
     ``int tau . w dA = Fx xi + Fy eta + Mz phi`` exactly for the rigid slip
-    ``w = (xi - phi (y - yp), eta + phi (x - xp))`` (METHOD.md 1), so the
+    ``w = (xi - phi (y - yp), eta + phi (x - xp))`` (docs/guide_physics.md, conventions), so the
     index from the forces is the work of the tractions, to rounding.
     """
     area = areas.semi_ellipses(0.6, 1.6, cells=30).scaled(6e-3).with_load(7e4)

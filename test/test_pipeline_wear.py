@@ -34,6 +34,10 @@ def test_the_wear_topics_are_outputs_only_when_asked_for():
 @pytest.mark.parametrize("power", [False, True])
 def test_energy_and_damage_of_a_solve(method, power):
     """x, y, z of both topics: T-gamma, T-gamma/A, P; wear rate, RCF damage, P / (T-gamma V)."""
+    if method == "polach" and power:  # no traction field: the power is refused, not NaN
+        with pytest.raises(ParameterError, match="'frictional_power': method polach refuses"):
+            make(method=method, wear_outputs=True, frictional_power=power)
+        return
     pipe = make(method=method, wear_outputs=True, frictional_power=power)
     pipe.on_wheel_twist(cdr(twist_msg((20.0, 0, 0), (0, 19.94 / R, 0), stamp_ns=T0)))
     out = solve(pipe, egg(), normal=contact_normal(0.2, "left"))
@@ -79,7 +83,8 @@ def test_the_power_reaches_the_forces_of_the_library_solve():
     assert (other.forces.fx, other.forces.fy) == pytest.approx((ref.fx, ref.fy), rel=1e-12)
 
 
-@pytest.mark.parametrize("method", METHODS)
+# Polach's closed form has no traction field (the parameters refuse the power with it)
+@pytest.mark.parametrize("method", [m for m in METHODS if m != "polach"])
 def test_reverse_running_dissipates_what_the_turned_patch_does(method):
     """Backing up: the power of the patch turned by 180 degrees, its density turned with it."""
     pipe = make(method=method, frictional_power=True, publish_traction=True)

@@ -1,6 +1,6 @@
 """The frictional dissipation of FastSim's steady march, from the tractions it produced.
 
-FastSim's elastic model (Kalker's simplified theory, METHOD.md 2): the
+FastSim's elastic model (Kalker's simplified theory, docs/guide_physics.md): the
 surface displacement is ``u = L tau`` per strip.  A cell's step from its
 upstream neighbour's traction ``tau_up`` (``h = dx``, or ``dx/2`` from a
 segment's front face, zero traction there) forms the trial traction ``t* =

@@ -1,8 +1,8 @@
 """Wear and fatigue indicators of a solve: T-gamma, frictional power, wear rate, RCF damage.
 
 Pure physics (no ROS).  SI units: N, m, Pa, W; creepages ``xi``, ``eta``
-(1) and spin ``phi`` (1/m) about the point ``Mz`` is taken about (METHOD.md
-section 1: ``Fx``, ``Fy``, ``Mz`` are the rail's on the wheel, so they
+(1) and spin ``phi`` (1/m) about the point ``Mz`` is taken about (docs/guide_physics.md,
+conventions: ``Fx``, ``Fy``, ``Mz`` are the rail's on the wheel, so they
 oppose the creepages and ``Fx xi + Fy eta + Mz phi <= 0``).
 
 - **T-gamma** (N = J per metre rolled): ``T_gamma = |Fx xi + Fy eta + Mz phi|``,
