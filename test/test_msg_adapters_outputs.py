@@ -105,3 +105,23 @@ def test_traction_cloud_decodes_to_the_cells():
     got = np.array([pts["x"][2, 3], pts["y"][2, 3], pts["z"][2, 3]], dtype=float)
     assert got == pytest.approx(want, abs=1e-7)
     assert cloud.point_step == 24 and cloud.row_step == 96 and cloud.is_dense
+
+
+#: statuses whose strings end at every byte offset modulo 4 (CDR aligns each length to 4)
+STATUSES = [("fastsim: left", 1, "2 of 5 patches rejected this period; last: r\u00e4d",
+             [("method", "mae_calibrated"), ("a", ""), ("bb", "1"), ("ccc", "22"),
+              ("dddd", "333")]),
+            ("", 2, "", []),
+            ("fastsim: right", 0, "ok", [(f"k{i}", "v" * i) for i in range(9)])]
+
+
+@pytest.mark.parametrize("stamp", STAMPS)
+@pytest.mark.parametrize("count", [0, 1, 3])
+def test_diagnostic_array_cdr_decodes_to_the_diagnostic_array(stamp, count):
+    from diagnostic_msgs.msg import DiagnosticArray
+    statuses = STATUSES[:count]
+    got = deserialize_message(outputs.diagnostic_array_cdr(stamp, statuses), DiagnosticArray)
+    want = outputs.diagnostic_array(stamp, statuses)
+    assert got == want
+    # the same bytes but for CDR's padding, which rclpy leaves as it was
+    assert len(outputs.diagnostic_array_cdr(stamp, statuses)) == len(serialize_message(want))

@@ -31,11 +31,14 @@ per-message rules (:meth:`fastsim_ros.pipeline.Pipeline.on_patch`,
 
 Every number goes through the floating-point operations of the pipeline, in
 its order, so the outputs are the per-message path's bit for bit (the tests
-compare both paths on every bundled bag).  The counts, rate windows and last
-rejection of each contact are written back to the pipeline (:meth:`Batch.store`)
-before each diagnostics array, which the pipeline builds itself.  In the
-diagnostics each solve's time is its batch's mean (the solves run in one
-compiled loop).
+compare both paths on every bundled bag).  A run may span several
+diagnostics: the verdicts of its twists and patches are kept by the
+message's place in the bag and counted up to each diagnostics' place
+(:meth:`Batch.store`, which writes the counts, rate windows, last rejection
+and solve times of each contact, and the twists' counts, back to the
+pipeline), so each diagnostics array, which the pipeline builds itself,
+counts what the per-message path had counted by then.  In the diagnostics
+each solve's time is its run's mean (the solves run in one compiled loop).
 """
 
 from __future__ import annotations
@@ -76,6 +79,10 @@ _MISSING, _WRONG_FRAME, _OLD = CODE["missing_field"], CODE["wrong_frame"], CODE[
 #: kinds of input the batch takes (anything else: the per-message path)
 KINDS = ("wheel_twist", "rail_twist", "patch")
 _FIRST = np.iinfo(np.int64).min
+#: the pipeline's twist counts (``kinematics_counts``), sorted; taken wheel and rail twists
+_TWIST_ORDER = np.array(sorted(("wheel", "rail", "nonfinite", "wrong_frame", "old_stamp",
+                                "malformed")))
+_TWIST_COUNTS = ("wheel", "rail")
 #: patch layouts kept per topic (a grid that keeps changing shape: the rest one by one)
 MAX_LAYOUTS = 64
 #: where the adapter loop leaves the contact frame (origin, e_x, e_y, e_z) and the grid fit
@@ -236,6 +243,8 @@ class Patches:
     published), ``marker``, ``cycle`` with the rig cycle's ``cycle_stamp``
     and ``cycle_wrench`` (force, torque in the wheelset frame).  ``parsed``:
     the message is a PointCloud2 (it has a stamp; it counts in the rate).
+    ``solve_time``: the run's mean solve time (s) where the solver ran, NaN
+    elsewhere; ``place``: the message's place in the bag (arrival order).
     """
 
     index: Ints
@@ -253,6 +262,8 @@ class Patches:
     cycle_stamp: Ints
     cycle_wrench: Floats
     parsed: Bools
+    solve_time: Floats = field(default_factory=lambda: np.zeros(0))
+    place: Ints = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
 
 @dataclass
@@ -354,6 +365,11 @@ class Batch:
         self.layouts: dict[int, list[Layout]] = {}
         self.state = _ContactState(len(self.contacts))
         self.timing = Timing(inputs=[] if keep_inputs else None)
+        # verdicts not yet counted: twists (place in the bag, index of _TWIST_COUNTS) and
+        # the runs' patches (with the first row not yet counted)
+        self._twist_place = np.zeros(0, dtype=np.int64)
+        self._twist_count = np.zeros(0, dtype=np.int64)
+        self._pending: list[tuple[Patches, int]] = []
         self._setup_solver()
 
     # ---------------------------------------------------------------- solver
@@ -433,6 +449,8 @@ class Batch:
         at = index[kind == 2]
         contact_of = self.of_contact[w.channel[at]]
         p, groups, singles = self._decode(w, at, contact_of)
+        p.place = base + at
+        p.solve_time = np.full(at.size, np.nan)
         t1 = time.perf_counter()
         todo = self._kinematics(p, base)
         t2 = time.perf_counter()
@@ -442,6 +460,7 @@ class Batch:
         self._old_stamps(p)
         t3 = time.perf_counter()
         self._advance(p)
+        self._pending.append((p, 0))
         t4 = time.perf_counter()
         self.timing.decode += t1 - t0
         self.timing.kinematics += t2 - t1
@@ -503,9 +522,13 @@ class Batch:
             hist.stamp = np.concatenate((hist.stamp, stamp[taken]))
             hist.value = np.concatenate((hist.value, value[taken]))
             hist.arrival = np.concatenate((hist.arrival, base + at[taken]))
-            self.pipeline.kinematics_counts["wheel" if which == 0 else "rail"] += int(taken.size)
-        for r in ("nonfinite", "wrong_frame", "old_stamp", "malformed"):
-            self.pipeline.kinematics_counts[r] += int(np.count_nonzero(reason == r))
+            reason[taken] = _TWIST_COUNTS[which]
+        counted = reason != ""
+        place = np.concatenate((self._twist_place, base + at[counted]))
+        count = np.concatenate((self._twist_count, np.searchsorted(
+            _TWIST_ORDER, reason[counted].astype(str)).astype(np.int64)))
+        order = np.argsort(place, kind="stable")   # the wheel's and the rail's, by place
+        self._twist_place, self._twist_count = place[order], count[order]
 
     # ---------------------------------------------------------------- patches
 
@@ -790,11 +813,7 @@ class Batch:
         done = np.concatenate(solved)
         self.timing.solves += done.size
         if done.size:
-            mean = elapsed / done.size
-            for c, k in zip(*np.unique(p.contact[done], return_counts=True)):
-                times = self.state.solve_times[int(c)]
-                times += [mean] * int(k)
-                del times[:-SOLVE_TIME_WINDOW]
+            p.solve_time[done] = elapsed / done.size
 
     def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats) -> None:
         """``implausible``: the pipeline's rule (:func:`fastsim_ros.pipeline.implausible`).
@@ -832,25 +851,63 @@ class Batch:
                         st.last_marker, st.has_marker, st.wrench_stamp, st.wrench,
                         st.has_wrench, st.last_sum, p.changed, p.marker, p.cycle, p.cycle_stamp,
                         p.cycle_wrench)
-        rejected = p.status >= len((SOLVED, NO_CONTACT))
+
+    def _count(self, upto: int | None) -> None:
+        """Count the verdicts of the messages before place ``upto`` in the bag (None: all)."""
+        st = self.state
+        twists = self._twist_place.size if upto is None else int(
+            np.searchsorted(self._twist_place, upto, "left"))
+        if twists:
+            counts = np.bincount(self._twist_count[:twists], minlength=len(_TWIST_ORDER))
+            for name, k in zip(_TWIST_ORDER, counts.tolist()):
+                if k:
+                    self.pipeline.kinematics_counts[name] += k
+            self._twist_place = self._twist_place[twists:]
+            self._twist_count = self._twist_count[twists:]
+        left: list[tuple[Patches, int]] = []
+        for p, r0 in self._pending:
+            r1 = p.place.size if upto is None else int(np.searchsorted(p.place, upto, "left"))
+            if r1 > r0:
+                self._count_rows(p, r0, r1)
+            if r1 < p.place.size:
+                left.append((p, r1))
+        self._pending = left
+
+    def _count_rows(self, p: Patches, r0: int, r1: int) -> None:
+        """Count patch rows ``r0:r1`` of a run: statuses, rate windows, rejections, solve times."""
+        st = self.state
+        status, contact = p.status[r0:r1], p.contact[r0:r1]
+        rejected = status >= len((SOLVED, NO_CONTACT))
+        parsed = p.parsed[r0:r1]
+        timed = np.isfinite(p.solve_time[r0:r1])
         for c in range(len(self.contacts)):
-            mine = p.contact == c
-            st.counts[c] += np.bincount(p.status[mine], minlength=len(STATUSES))
-            windowed = np.flatnonzero(mine & p.parsed)   # a PointCloud2: in the rate window
+            mine = contact == c
+            st.counts[c] += np.bincount(status[mine], minlength=len(STATUSES))
+            windowed = np.flatnonzero(mine & parsed)   # a PointCloud2: in the rate window
             if windowed.size:
                 st.window_inputs[c] += windowed.size
                 if st.window_first[c] is None:
-                    st.window_first[c] = int(p.stamp[windowed[0]])
-                st.window_last[c] = int(p.stamp[windowed[-1]])
+                    st.window_first[c] = int(p.stamp[r0 + windowed[0]])
+                st.window_last[c] = int(p.stamp[r0 + windowed[-1]])
                 st.window_rejected[c] += int(np.count_nonzero(rejected[windowed]))
             last = np.flatnonzero(mine & rejected)
             if last.size:
-                st.last_detail[c] = p.detail[int(last[-1])]
+                st.last_detail[c] = p.detail[r0 + int(last[-1])]
+            solved = np.flatnonzero(mine & timed)
+            if solved.size:
+                times = st.solve_times[c]
+                times += p.solve_time[r0 + solved].tolist()
+                del times[:-SOLVE_TIME_WINDOW]
 
     # ---------------------------------------------------------------- the pipeline
 
-    def store(self) -> None:
-        """Write the counters, rate windows, last rejections and solve times to the pipeline."""
+    def store(self, upto: int | None = None) -> None:
+        """Write the counters, rate windows, last rejections and solve times to the pipeline.
+
+        As they stand after the messages before place ``upto`` in the bag
+        (None: every message run so far).
+        """
+        self._count(upto)
         st = self.state
         contacts = self.pipeline._contacts
         for c, name in enumerate(self.contacts):
