@@ -248,7 +248,8 @@ def long_bag(out: Path, seconds: float, rate: float = 200.0, cells: int = 30) ->
     The wheelset twist and the patch at ``rate`` each, the patch half a
     period after the twist; a Hertzian tread patch (60 kN) at 20 m/s under
     a braking creepage of steady running, ``1e-3 (1 + 0.5 sin(2 pi t / 10
-    s))`` (partial slip throughout); the default method.  The messages are serialised once and their stamps patched in.
+    s))`` (partial slip throughout); the default method.  The messages are
+    serialised once and their stamps patched in.
     Returns the bag's directory (its params file beside it).
     """
     sys.path.insert(0, str(ROOT / "scripts"))

@@ -136,7 +136,7 @@ class Floor(Node):
 
 
 class _Cycle:
-    """The fair floor's rig cycle: each contact's newest stamp (ns), the last sum's, its message."""
+    """The fair floor's rig cycle: each contact's newest stamp (ns), the last sum's, the sum."""
 
     def __init__(self, n: int, total: bytearray, pub) -> None:
         self.newest = [_NONE] * n

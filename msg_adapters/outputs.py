@@ -182,7 +182,6 @@ def diagnostic_array(stamp_ns: int, statuses: Iterable[tuple[str, int, str,
     return msg
 
 
-
 _PAD = (b"", b"\x00\x00\x00", b"\x00\x00", b"\x00")   # by length % 4: to the next 4
 _U32 = struct.Struct("<I").pack
 

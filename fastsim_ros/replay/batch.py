@@ -79,9 +79,9 @@ _MISSING, _WRONG_FRAME, _OLD = CODE["missing_field"], CODE["wrong_frame"], CODE[
 #: kinds of input the batch takes (anything else: the per-message path)
 KINDS = ("wheel_twist", "rail_twist", "patch")
 _FIRST = np.iinfo(np.int64).min
-#: the pipeline's twist counts (``kinematics_counts``), sorted; taken wheel and rail twists
-_TWIST_ORDER = np.array(sorted(("wheel", "rail", "nonfinite", "wrong_frame", "old_stamp",
-                                "malformed")))
+#: the pipeline's twist counts (``kinematics_counts``) by code; taken wheel and rail twists
+_TWIST_ORDER = ("wheel", "rail", "nonfinite", "wrong_frame", "old_stamp", "malformed")
+_TWIST_CODE = {name: k for k, name in enumerate(_TWIST_ORDER)}
 _TWIST_COUNTS = ("wheel", "rail")
 #: patch layouts kept per topic (a grid that keeps changing shape: the rest one by one)
 MAX_LAYOUTS = 64
@@ -524,9 +524,9 @@ class Batch:
             hist.arrival = np.concatenate((hist.arrival, base + at[taken]))
             reason[taken] = _TWIST_COUNTS[which]
         counted = reason != ""
+        code = np.array([_TWIST_CODE[r] for r in reason[counted].tolist()], dtype=np.int64)
         place = np.concatenate((self._twist_place, base + at[counted]))
-        count = np.concatenate((self._twist_count, np.searchsorted(
-            _TWIST_ORDER, reason[counted].astype(str)).astype(np.int64)))
+        count = np.concatenate((self._twist_count, code))
         order = np.argsort(place, kind="stable")   # the wheel's and the rail's, by place
         self._twist_place, self._twist_count = place[order], count[order]
 
@@ -854,7 +854,6 @@ class Batch:
 
     def _count(self, upto: int | None) -> None:
         """Count the verdicts of the messages before place ``upto`` in the bag (None: all)."""
-        st = self.state
         twists = self._twist_place.size if upto is None else int(
             np.searchsorted(self._twist_place, upto, "left"))
         if twists:

@@ -175,7 +175,7 @@ class IndexedReplay:
         counts = np.bincount(channel, minlength=1)
         for c in np.flatnonzero(counts).tolist():
             self.seen[c] = self.seen.get(c, 0) + int(counts[c])
-        if not np.isin(channel, list(self.skip)).any():
+        if not self.skip or not np.isin(channel, list(self.skip)).any():
             self.writer.copy_chunk(chunk, raw, {c: int(counts[c]) for c in
                                                 np.flatnonzero(counts).tolist()})
             self.result.messages_out += int(channel.size)
