@@ -265,6 +265,16 @@ class Patches:
     solve_time: Floats = field(default_factory=lambda: np.zeros(0))
     place: Ints = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
+    def rows(self, r0: int, r1: int) -> Patches:
+        """Return rows ``r0:r1`` (views of the arrays; the details renumbered)."""
+        return Patches(
+            self.index[r0:r1], self.contact[r0:r1], self.stamp[r0:r1], self.status[r0:r1],
+            {i - r0: d for i, d in self.detail.items() if r0 <= i < r1},
+            self.frame[r0:r1], self.creep[r0:r1], self.force[r0:r1], self.slip[r0:r1],
+            self.changed[r0:r1], self.marker[r0:r1], self.cycle[r0:r1],
+            self.cycle_stamp[r0:r1], self.cycle_wrench[r0:r1], self.parsed[r0:r1],
+            self.solve_time[r0:r1], self.place[r0:r1])
+
 
 @dataclass
 class Timing:
@@ -370,6 +380,8 @@ class Batch:
         self._twist_place = np.zeros(0, dtype=np.int64)
         self._twist_count = np.zeros(0, dtype=np.int64)
         self._pending: list[tuple[Patches, int]] = []
+        # the window run last: (window, base, first message, its patches)
+        self._window: tuple[Window, int, int, Patches] | None = None
         self._setup_solver()
 
     # ---------------------------------------------------------------- solver
@@ -437,7 +449,22 @@ class Batch:
         """Apply the rules to messages ``lo:hi`` of a window; return their patches.
 
         ``base``: messages of the bag before the window (arrival order).
+        The runs of a window come in order (``lo`` where the last ended):
+        the first applies the rules to the rest of the window at once (one
+        run of numpy and compiled loops instead of one per diagnostics) and
+        the others return their rows of it.
         """
+        done = self._window
+        if done is None or done[0] is not w or done[1] != base or lo < done[2]:
+            done = self._window = (w, base, lo, self._run(w, lo, len(w), base))
+        p = done[3]
+        if hi >= len(w):   # the window's last run: its buffers go with it
+            self._window = None
+        r0, r1 = np.searchsorted(p.index, (lo, hi), "left").tolist()
+        return p if r0 == 0 and r1 == p.index.size else p.rows(r0, r1)
+
+    def _run(self, w: Window, lo: int, hi: int, base: int) -> Patches:
+        """Apply the rules to messages ``lo:hi`` of a window (see :meth:`run`)."""
         t0 = time.perf_counter()
         channel = w.channel[lo:hi]
         known = channel < self.kind.size

@@ -212,27 +212,16 @@ class IndexedReplay:
                 if first is None:
                     first = out.first = int(log[0])
                     next_diag = first + 1_000_000_000
-                # the diagnostics' places in the window: the first message at or after each
-                # whole second from the first message (the per-message path's timer)
-                cuts: list[int] = []
                 lo = 0
                 while lo < n:
                     j = lo + int(np.searchsorted(log[lo:], next_diag, "left"))
+                    if j > lo:
+                        self._messages(w, lo, j, base)
                     if j < n:
-                        cuts.append(j)
                         stamp = int(log[j])
+                        self._diagnostics(diagnostics, stamp, base + j)
                         next_diag += ((stamp - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
                     lo = j
-                if self.batch is not None:   # the window in one run, diagnostics between
-                    self._batch(w, 0, n, base, cuts, diagnostics)
-                else:
-                    lo = 0
-                    for j in cuts + [n]:
-                        if j > lo:
-                            self._messages(w, lo, j, base)
-                        if j < n:
-                            self._diagnostics(diagnostics, int(log[j]), base + j)
-                        lo = j
                 base += n
                 last = int(log[-1])
                 self.result.messages_in += n
@@ -288,6 +277,9 @@ class IndexedReplay:
         self.phases["diagnostics"] += time.perf_counter() - t0
 
     def _messages(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
+        if self.batch is not None:
+            self._batch(w, lo, hi, base)
+            return
         for i in range(lo, hi):  # the pipeline's own handlers, one message at a time
             handler = self.handlers.get(int(w.channel[i]))
             if handler is None:
@@ -304,14 +296,7 @@ class IndexedReplay:
             self.result.messages_out += 1
         self.out.outcome(outcome, log_ns)
 
-    def _batch(self, w: mcap.Window, lo: int, hi: int, base: int, cuts: list[int],
-               diagnostics: str) -> None:
-        """Run messages ``lo:hi`` as one batch; write their outputs, a diagnostics at each cut.
-
-        ``cuts``: places in the window (ascending) of the diagnostics arrays;
-        the outputs of the messages before a cut are written before it, as
-        the per-message path writes them.
-        """
+    def _batch(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
         assert self.batch is not None
         p = self.batch.run(w, lo, hi, base)
         t0 = time.perf_counter()
@@ -364,17 +349,9 @@ class IndexedReplay:
                           self.channel(resolve(WHEELSET_WRENCH_TOPIC, self.namespace))))
         t1 = time.perf_counter()
         self.phases["encode"] += t1 - t0
-        r0 = 0
-        for j in cuts + [hi]:
-            r1 = int(np.searchsorted(p.index, j, "left"))  # rows of the messages before j
-            if r1 > r0 and parts:
-                t1 = time.perf_counter()
-                self._write(parts if r0 == 0 and r1 == p.index.size else
-                            _rows_within(parts, r0, r1), log)
-                self.phases["write"] += time.perf_counter() - t1
-            if j < hi:
-                self._diagnostics(diagnostics, int(w.log_time[j]), base + j)
-            r0 = r1
+        if parts:
+            self._write(parts, log)
+        self.phases["write"] += time.perf_counter() - t1
         if self.out.rows is not None or self.out.series is not None:
             t2 = time.perf_counter()
             self._records(p, wrench, log)
@@ -437,12 +414,3 @@ class IndexedReplay:
             at += k
         self.writer.write_records(out.tobytes(), channels[order], times[order], offsets[order])
         self.result.messages_out += int(keys.size)
-
-
-def _rows_within(parts: list[Any], r0: int, r1: int) -> list[Any]:
-    """Return the outputs of patch rows ``r0:r1`` (each part's rows ascend)."""
-    out = []
-    for keys, rows, payloads, cid in parts:
-        a, b = np.searchsorted(rows, (r0, r1), "left")
-        out.append((keys[a:b], rows[a:b], payloads[a:b], cid))
-    return out
