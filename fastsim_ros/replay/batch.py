@@ -653,6 +653,8 @@ class Batch:
             i = good[j]  # rows or columns running backwards: the adapter's orientation
             pressure[i] = np.ascontiguousarray(pressure[i][::y_order[~bad][j],
                                                            ::x_order[~bad][j]])
+        if good.size == n:   # every patch to solve: the array as it is (no copy)
+            return _Group(r, pressure), rest
         keep = np.zeros(n, dtype=np.bool_)
         keep[good] = True
         return _Group(r, pressure[keep]), rest
@@ -835,25 +837,29 @@ class Batch:
                 p.status[rows[j]] = CODE["nonfinite"]
                 p.detail[rows[j]] = "nonfinite: the solve gave a non-finite force"
             if not self.allow_implausible:
-                self._implausible(p, rows[ok & finite], ps[ok & finite], grid[ok & finite])
+                self._implausible(p, rows, ps, grid, np.flatnonzero(ok & finite))
         elapsed = time.perf_counter() - t0
         done = np.concatenate(solved)
         self.timing.solves += done.size
         if done.size:
             p.solve_time[done] = elapsed / done.size
 
-    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats) -> None:
+    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats,
+                     solved: Ints) -> None:
         """``implausible``: the pipeline's rule (:func:`fastsim_ros.pipeline.implausible`).
 
-        Its bounds tested on every row at once (the grid's span, the largest
-        pressure, the creepages); the rows that fail one get the pipeline's
-        own words from :func:`~fastsim_ros.plausibility.stream_problem`.
+        On items ``solved`` of a solve (``rows``, ``ps``, ``grid``: its
+        patches' rows, pressures and grids).  Its bounds tested on every row
+        at once (the grid's span, the largest pressure, the creepages); the
+        rows that fail one get the pipeline's own words from
+        :func:`~fastsim_ros.plausibility.stream_problem`.
         """
-        if rows.size == 0:
+        if solved.size == 0:
             return
         table = plausibility.PLAUSIBLE
         ny, nx = ps.shape[1], ps.shape[2]
-        peak = ps.max(axis=(1, 2))
+        peak = ps.reshape(ps.shape[0], -1).max(axis=1)[solved]
+        rows, grid = rows[solved], grid[solved]
         creep = p.creep[rows]
         suspect = ((nx * grid[:, 2] > table["patch_extent"].high)
                    | (ny * grid[:, 3] > table["patch_extent"].high)
@@ -862,7 +868,7 @@ class Batch:
                    | ~(np.abs(creep[:, 1]) <= table["creepage"].high)
                    | ~(np.abs(creep[:, 2]) <= table["spin"].high))
         for j in np.flatnonzero(suspect).tolist():
-            ex, ey = patch_extent(ps[j], float(grid[j, 2]), float(grid[j, 3]))
+            ex, ey = patch_extent(ps[solved[j]], float(grid[j, 2]), float(grid[j, 3]))
             why = plausibility.stream_problem(ex, ey, float(peak[j]), float(creep[j, 0]),
                                               float(creep[j, 1]), float(creep[j, 2]))
             if why is not None:
