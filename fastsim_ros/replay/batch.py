@@ -694,7 +694,10 @@ class Batch:
         Run after the patches' own verdicts: the old ones among them (solved
         or rejected for a later check) become ``old_stamp``, as the pipeline's
         check before the others makes them; a rejected patch does not move
-        the last stamp (the pipeline's rule).
+        the last stamp (the pipeline's rule).  The last stamp before a patch
+        is the largest of the taken ones before it (and the contact's last
+        before the run): a taken patch that is old is older than that
+        largest, so counting it changes nothing.
         """
         st = self.state
         parsed = p.parsed & (p.status != _WRONG_FRAME)
@@ -702,16 +705,19 @@ class Batch:
             mine = np.flatnonzero((p.contact == c) & parsed)
             if mine.size == 0:
                 continue
-            last = int(st.last_stamp[c]) if st.has_stamp[c] else None
-            stamps = p.stamp[mine].tolist()
-            taken = np.isin(p.status[mine], (_SOLVED, _EMPTY)).tolist()
-            for i, s, ok in zip(mine.tolist(), stamps, taken):
-                if last is not None and s < last:
-                    p.status[i] = _OLD
-                    p.detail[i] = f"old_stamp: stamp {s} ns is older than the last, {last} ns"
-                elif ok:
-                    last = s
-            if last is not None:
+            first = int(st.last_stamp[c]) if st.has_stamp[c] else _FIRST
+            stamps = p.stamp[mine]
+            status = p.status[mine]
+            taken = (status == _SOLVED) | (status == _EMPTY)
+            newest = np.maximum.accumulate(np.where(taken, stamps, _FIRST))
+            before = np.maximum(np.concatenate(([first], newest[:-1])), first)
+            old = stamps < before
+            for i, s, last in zip(mine[old].tolist(), stamps[old].tolist(),
+                                  before[old].tolist()):
+                p.status[i] = _OLD
+                p.detail[i] = f"old_stamp: stamp {s} ns is older than the last, {last} ns"
+            last = max(first, int(newest[-1]))
+            if last != _FIRST:
                 st.last_stamp[c] = last
                 st.has_stamp[c] = True
 
