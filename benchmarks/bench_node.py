@@ -556,6 +556,13 @@ def attribute(trace: Any, answered: tuple[Any, ...], driver_gc: Gc, t_first: flo
     sel = inside & (kind == 3)
     print(f"    executor spin_once: {sel.sum() / span:.0f}/s; callbacks "
           f"{np.count_nonzero(inside & cb) / span:.0f}/s")
+    sel = inside & (kind == 4)
+    if sel.any():   # the pipeline's handler inside the patches' callbacks
+        d = (end[sel] - start[sel]) * 1e6
+        whole = (ce - cs) * 1e6
+        print(f"    Pipeline.on_patch: {np.median(d):.0f} us median, p99 "
+              f"{np.percentile(d, 99):.0f} us; the patch callbacks around it "
+              f"{np.median(whole):.0f} us median")
     share = counts / max(1, tail.sum())
     return {f"tail {name}": float(100 * share[j]) for j, name in enumerate(PARTS)}
 

@@ -14,7 +14,9 @@ up with them):
 - ``gc``: each collection of the cyclic garbage collector (``gc.callbacks``:
   start, stop, generation);
 - ``spin``: each ``executor.spin_once`` call of the node's loop (entry,
-  return): the executor's wake-ups.
+  return): the executor's wake-ups;
+- ``on_patch``: each ``Pipeline.on_patch`` inside a patch's callback (the
+  pipeline's handler, without the encoding and the publishes).
 
 The events go into preallocated ``array`` buffers (no object the collector
 tracks is made per event) and are written to ``OUT.npz`` when the node
@@ -30,7 +32,7 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-KINDS = ("callback", "diagnostics", "gc", "spin")
+KINDS = ("callback", "diagnostics", "gc", "spin", "on_patch")
 
 
 class Timeline:
@@ -116,6 +118,16 @@ def install(timeline: Timeline, node_module: Any) -> None:
             return getattr(self._executor, name)
 
     node_module.make_executor = lambda kind: Spinning(make_executor(kind))
+
+    from fastsim_ros.pipeline import Pipeline
+    on_patch = Pipeline.on_patch
+
+    def traced_on_patch(self: Any, contact: str, cloud: Any, **kwargs: Any) -> Any:
+        t0 = clock()
+        outcome = on_patch(self, contact, cloud, **kwargs)
+        add(4, t0, clock(), 0, 0)
+        return outcome
+    Pipeline.on_patch = traced_on_patch  # type: ignore[method-assign]
 
 
 def main() -> int:
