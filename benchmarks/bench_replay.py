@@ -6,6 +6,7 @@ Usage (from the package root)::
     .venv/bin/python benchmarks/bench_replay.py [--repeats R] [--copies K] [--bags NAME ...]
     .venv/bin/python benchmarks/bench_replay.py --scheduler [--small N]
     .venv/bin/python benchmarks/bench_replay.py --mcap-only [--rounds N] [--mcap-before REV]
+    .venv/bin/python benchmarks/bench_replay.py --long [--seconds S] [--rounds N]
 
 Prints, with the machine line:
 
@@ -36,6 +37,14 @@ Prints, with the machine line:
    alternating order, ``--rounds`` times each: median patches per second
    and the ratio (``--mcap-only``: this section alone).
 
+With ``--long``, instead: a recording made here (``--seconds`` of one
+contact at 200 Hz, 30 x 30-cell Hertzian patches in steady running's
+partial slip, the default method) replayed ``--rounds`` times in this process after one
+untimed replay (the kernels loaded: the wall beyond start-up), and the
+command line's start-up measured apart; patches per second, the multiple
+of real time, the batch solver's rate on the same patches in the same run
+and the share; each run printed, then the medians.
+
 With ``--scheduler``, instead: ``N`` small bags (generated: the first
 0.5 s of ``hertz_ramp``, 200 by default) replayed by two local worker
 processes of a Dask cluster started here (a scheduler and two workers, as
@@ -56,6 +65,7 @@ import importlib.util
 import io
 import math
 import os
+import struct
 import subprocess
 import sys
 import tempfile
@@ -232,6 +242,102 @@ def mcap_layers(names: list[str], rounds: int, out: Path, rev: str) -> None:
           f"{patches / min(walls[heads[1]]):.0f} patches/s)")
 
 
+def long_bag(out: Path, seconds: float, rate: float = 200.0, cells: int = 30) -> Path:
+    """Write a recording of one contact: ``seconds`` at ``rate`` Hz, ``cells`` x ``cells``.
+
+    The wheelset twist and the patch at ``rate`` each, the patch half a
+    period after the twist; a Hertzian tread patch (60 kN) at 20 m/s under
+    a braking creepage of steady running, ``1e-3 (1 + 0.5 sin(2 pi t / 10
+    s))`` (partial slip throughout); the default method.  The messages are
+    serialised once and their stamps patched in.
+    Returns the bag's directory (its params file beside it).
+    """
+    sys.path.insert(0, str(ROOT / "scripts"))
+    import make_bags as mb
+    from rosbags.rosbag2 import Writer
+    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode, StoragePlugin
+    name = f"long_{seconds:g}s"
+    path = out / name
+    area = mb.hertz_area(mb.R, 0.3, 6.0e4, cells)
+    cloud = bytearray(mb.TYPESTORE.serialize_cdr(
+        mb.cloud_msg(0, mb.cloud_points(area, (0.0, mb.Y_WHEEL, -mb.R), mb.left_normal(0.0))),
+        mb.CLOUD))
+    v0, dt = 20.0, 1.0 / rate
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)
+    with writer:
+        twist_conn = writer.add_connection("/wheelset/twist", mb.TWIST, typestore=mb.TYPESTORE,
+                                           offered_qos_profiles=mb.QOS)
+        patch_conn = writer.add_connection("/contact/left/patch", mb.CLOUD,
+                                           typestore=mb.TYPESTORE, offered_qos_profiles=mb.QOS)
+        for k in range(int(round(seconds * rate))):
+            t = k * dt
+            xi = 1.0e-3 * (1.0 + 0.5 * math.sin(2.0 * math.pi * t / 10.0))
+            ns = mb.stamp_ns(t)
+            writer.write(twist_conn, ns, mb.TYPESTORE.serialize_cdr(
+                mb.twist_msg(ns, (v0, 0, 0), (0, mb.omega_for(v0, xi, mb.R), 0)), mb.TWIST))
+            ns = mb.stamp_ns(t + dt / 2)
+            cloud[4:12] = struct.pack("<iI", *divmod(ns, 1_000_000_000))
+            writer.write(patch_conn, ns, bytes(cloud))
+    params = dict(mb.BASE_PARAMS, contacts=["left"], method="mae_calibrated")
+    (out / f"{name}.params.yaml").write_text(mb.params_text(name, params))
+    return path
+
+
+def long_main(seconds: float, rounds: int) -> int:
+    """Print the long recording's replay: rate, x real time, the batch solver's, the share."""
+    print(f"machine: {machine()}")
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp)
+        t0 = time.perf_counter()
+        bag = long_bag(out, seconds)
+        print(f"recording: {seconds:g} s, one contact, 200 Hz, 30 x 30 cells, written in "
+              f"{time.perf_counter() - t0:.1f} s")
+        params = out / f"{bag.name}.params.yaml"
+        # start-up: the command line from process start on a recording of one twist and patch
+        short = long_bag(out / "short", 1.0 / 200.0)
+        cmd = [sys.executable, "-m", "fastsim_ros.replay", str(short), "-o", str(out / "s"),
+               "--params", str(params), "--no-progress", "--overwrite"]
+        starts = []
+        for _ in range(3):
+            t0 = time.perf_counter()
+            subprocess.run(cmd, check=True, cwd=ROOT, capture_output=True)
+            starts.append(time.perf_counter() - t0)
+        print(f"start-up (the command line on a one-patch recording, 3 runs): median "
+              f"{np.median(starts):.2f} s ({', '.join(f'{s:.2f}' for s in starts)})")
+        warm = compiled.warm_up()
+        patch_adapter.warm_up()
+        batch.warm_up()
+        print(f"kernels ready in {warm:.2f} s")
+        values = load_params_file(params)
+        replay.replay_bag(bag, "warm", out, values, progress=False)
+        n_patch = int(round(seconds * 200))
+        rows = []
+        for k in range(rounds):
+            r = replay.replay_bag(bag, f"run{k}", out, values, progress=False, profile=True)
+            if not r.ok:
+                raise SystemExit(f"replay failed: {r.error}")
+            rate = batch_rate(r.profile.solves, values)
+            rows.append((n_patch / r.wall_s, r.duration_s / r.wall_s, rate))
+            phases = r.profile.phases
+            print(f"  run {k}: wall {r.wall_s:.3f} s, {n_patch / r.wall_s:8.0f} patches/s, "
+                  f"{r.duration_s / r.wall_s:6.1f}x real time; batch solver {rate:8.0f}/s; "
+                  f"share {100 * n_patch / r.wall_s / rate:5.1f}%; us/patch: " + ", ".join(
+                      f"{key} {phases.get(key, 0.0) / n_patch * 1e6:.1f}" for key in PHASES))
+            for f in out.glob(f"run{k}*"):
+                if f.is_dir():
+                    import shutil
+                    shutil.rmtree(f)
+        med = np.median(np.array(rows), axis=0)
+        share = 100 * np.median([a / c for a, _, c in rows])
+        print(f"median of {rounds}: {med[0]:.0f} patches/s, {med[1]:.1f}x real time beyond "
+              f"start-up, batch solver {med[2]:.0f}/s, share {share:.1f}% (range "
+              f"{100 * min(a / c for a, _, c in rows):.1f}-"
+              f"{100 * max(a / c for a, _, c in rows):.1f}%)")
+    print(f"machine: {machine()}")
+    return 0
+
+
 def _spin(n: int) -> int:
     total = 0
     for k in range(n):
@@ -278,7 +384,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="section 4 alone: the MCAP module of --mcap-before against today's")
     ap.add_argument("--mcap-before", default=MCAP_BEFORE,
                     help="git revision of the hand-written MCAP module (default %(default)s)")
+    ap.add_argument("--long", action="store_true",
+                    help="instead: a long one-contact recording (--seconds) made and replayed")
+    ap.add_argument("--seconds", type=float, default=60.0, help="the long recording's length")
     args = ap.parse_args(argv)
+    if args.long:
+        return long_main(args.seconds, args.rounds)
     if args.scheduler:
         return cluster_main(args.small, args.rounds)
     print(f"machine: {machine()}")

@@ -8,6 +8,14 @@ is copied into a pre-serialised ``WrenchStamped`` of that contact, which is
 published as bytes.  ``bench_node.py --floor`` drives it alternately with
 the node and prints node/floor ratios.
 
+``--fair``: the fair floor.  Each patch is answered with the messages the
+node publishes per patch when they have subscribers (docs/guide_node.md's
+outputs): the contact's ``WrenchStamped`` and its ``Vector3Stamped``
+creepage, and once per rig cycle (every contact answered a patch of a
+newer stamp than the last sum's, the node's rule) the ``wheelset/wrench``;
+each pre-serialised, stamp copied in, published as bytes.  The floor
+without the flag, the one-message floor, publishes the wrench alone.
+
 ``--solve``: the relay also runs the node's MAE solve (``MaeSolver.solve_arrays``)
 on one fixed, already converted 30 x 30-cell patch for every patch it
 answers: the least any node that solves each patch costs on this stack
@@ -19,6 +27,7 @@ answers: the least any node that solves each patch costs on this stack
 from __future__ import annotations
 
 import argparse
+import struct
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -32,19 +41,22 @@ from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import serialize_message
 
-from geometry_msgs.msg import TwistStamped, WrenchStamped
+from geometry_msgs.msg import TwistStamped, Vector3Stamped, WrenchStamped
 from sensor_msgs.msg import PointCloud2
 
 #: a header stamp (int32 sec, uint32 nanosec) sits at bytes 4..12 of a little-endian
 #: CDR message: right after the encapsulation header, first in std_msgs/Header
 STAMP = slice(4, 12)
+_STAMP = struct.Struct("<iI")
+#: before any stamp (ns): older than every stamp
+_NONE = -(1 << 62)
 
 
 class Floor(Node):
     """Answer ``contact/<name>/patch`` with a fixed ``contact/<name>/wrench``, stamp copied."""
 
     def __init__(self, contacts: Sequence[str], depth: int = 10,
-                 solve: Callable[[], object] | None = None) -> None:
+                 solve: Callable[[], object] | None = None, fair: bool = False) -> None:
         super().__init__("fastsim_floor")
         self._solve = solve
         qos_in = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
@@ -53,15 +65,32 @@ class Floor(Node):
                              reliability=ReliabilityPolicy.RELIABLE)
         self.create_subscription(TwistStamped, "wheelset/twist", self._on_twist, qos_in,
                                  raw=True)
-        for name in contacts:
+        cycle = None
+        if fair:
+            total = WrenchStamped()
+            total.header.frame_id = "wheelset"
+            total.wrench.force.x = -1000.0 * len(contacts)
+            total.wrench.force.z = 60000.0 * len(contacts)
+            # the rig cycle's state: per contact the newest stamp answered, the last sum's
+            cycle = _Cycle(len(contacts), bytearray(serialize_message(total)),
+                           self.create_publisher(WrenchStamped, "wheelset/wrench", qos_out))
+        for k, name in enumerate(contacts):
             wrench = WrenchStamped()
             wrench.header.frame_id = f"{name}_contact"
             wrench.wrench.force.x, wrench.wrench.force.z = -1000.0, 60000.0
             pub = self.create_publisher(WrenchStamped, f"contact/{name}/wrench", qos_out)
-            self.create_subscription(PointCloud2, f"contact/{name}/patch",
-                                     self._answer(pub, bytearray(serialize_message(wrench)),
-                                                  solve),
-                                     qos_in, raw=True)
+            if cycle is None:
+                answer = self._answer(pub, bytearray(serialize_message(wrench)), solve)
+            else:
+                creepage = Vector3Stamped()
+                creepage.header.frame_id = f"{name}_contact"
+                creepage.vector.x = 1e-3
+                answer = self._answer_fair(
+                    k, pub, bytearray(serialize_message(wrench)),
+                    self.create_publisher(Vector3Stamped, f"contact/{name}/creepage", qos_out),
+                    bytearray(serialize_message(creepage)), cycle, solve)
+            self.create_subscription(PointCloud2, f"contact/{name}/patch", answer, qos_in,
+                                     raw=True)
 
     def _on_twist(self, raw: bytes) -> None:
         pass
@@ -80,6 +109,40 @@ class Floor(Node):
             wrench[STAMP] = raw[STAMP]
             pub.publish(bytes(wrench))
         return solving
+
+    @staticmethod
+    def _answer_fair(k: int, pub, wrench: bytearray, creepage_pub, creepage: bytearray,
+                     cycle: "_Cycle",
+                     solve: Callable[[], object] | None) -> Callable[[bytes], None]:
+        newest, total = cycle.newest, cycle.total
+
+        def callback(raw: bytes) -> None:
+            if solve is not None:
+                solve()
+            stamp = raw[STAMP]
+            wrench[STAMP] = stamp
+            pub.publish(bytes(wrench))
+            creepage[STAMP] = stamp
+            creepage_pub.publish(bytes(creepage))
+            # the rig cycle (the pipeline's rule): every contact newer than the last sum
+            sec, nanosec = _STAMP.unpack(stamp)
+            newest[k] = sec * 1_000_000_000 + nanosec
+            last = cycle.last_sum
+            if min(newest) > last:
+                cycle.last_sum = max(newest)
+                total[STAMP] = _STAMP.pack(*divmod(cycle.last_sum, 1_000_000_000))
+                cycle.pub.publish(bytes(total))
+        return callback
+
+
+class _Cycle:
+    """The fair floor's rig cycle: each contact's newest stamp (ns), the last sum's, the sum."""
+
+    def __init__(self, n: int, total: bytearray, pub) -> None:
+        self.newest = [_NONE] * n
+        self.last_sum = _NONE
+        self.total = total
+        self.pub = pub
 
 
 def fixed_solve() -> Callable[[], object]:
@@ -103,13 +166,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0], allow_abbrev=False)
     parser.add_argument("--contacts", nargs="+", default=["left", "right"])
     parser.add_argument("--depth", type=int, default=10, help="QoS depth (the node's qos_depth)")
+    parser.add_argument("--fair", action="store_true",
+                        help="publish the node's messages: wrench and creepage per patch, the "
+                        "wheelset wrench per rig cycle (the fair floor)")
     parser.add_argument("--solve", action="store_true",
                         help="also run the node's solve on a fixed patch for every patch")
     args, ros_args = parser.parse_known_args(argv)
     rclpy.init(args=[sys.argv[0], *ros_args])  # its signal handlers end spin_once
     node = None
     try:
-        node = Floor(args.contacts, args.depth, fixed_solve() if args.solve else None)
+        node = Floor(args.contacts, args.depth, fixed_solve() if args.solve else None,
+                     fair=args.fair)
         executor = EventsExecutor()
         executor.add_node(node)
         while rclpy.ok():  # as the node: spin_once, which returns on SIGTERM

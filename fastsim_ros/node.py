@@ -543,7 +543,8 @@ class _FrontEnd:
         for c in self.pipeline.config.contacts:
             extra[c] = extra.get(c, []) + unheard
         try:
-            self._diagnostics.publish(self.pipeline.diagnostics(
+            # CDR written directly: the message's ~80 Python objects cost more than the rest
+            self._diagnostics.publish(self.pipeline.diagnostics_cdr(
                 node.get_clock().now().nanoseconds, extra))
         except _rclpy.RCLError:
             self._raise_unless_shut_down()

@@ -1271,6 +1271,11 @@ class Pipeline:
         wheel and the rail, dropped by reason), the kinematics being shared,
         then the key-values ``extra[contact]`` if given (the node's connections).
         """
+        return out.diagnostic_array(stamp_ns, self._statuses(stamp_ns, extra))
+
+    def _statuses(self, stamp_ns: int, extra: Mapping[str, Sequence[tuple[str, str]]] | None
+                  ) -> list[tuple[str, int, str, Sequence[tuple[str, str]]]]:
+        """Return the diagnostics' statuses (each contact's report starts a new rate window)."""
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
         if self._ekf is not None:  # the estimator's state, shared by the contacts
             twists += (("friction_estimation/mu", f"{self._ekf.mu:.6g}"),
@@ -1283,7 +1288,12 @@ class Pipeline:
             r = self.report(c)
             more = tuple(extra.get(c, ())) if extra is not None else ()
             statuses.append((r.name, r.level, r.message, r.values + twists + more))
-        return out.diagnostic_array(stamp_ns, statuses)
+        return statuses
+
+    def diagnostics_cdr(self, stamp_ns: int,
+                        extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> bytes:
+        """Return :meth:`diagnostics`' message as CDR bytes, written without its objects."""
+        return out.diagnostic_array_cdr(stamp_ns, self._statuses(stamp_ns, extra))
 
     # ---------------------------------------------------------------- diagnostics
 

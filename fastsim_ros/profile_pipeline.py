@@ -283,6 +283,13 @@ class ProfilePipeline:
         merged = {c: tuple((extra or {}).get(c, ())) + counts for c in self.config.contacts}
         return self.pipeline.diagnostics(stamp_ns, merged)
 
+    def diagnostics_cdr(self, stamp_ns: int,
+                        extra: Mapping[str, Sequence[tuple[str, str]]] | None = None) -> bytes:
+        """Return :meth:`diagnostics`' message as CDR bytes, written without its objects."""
+        counts = tuple((f"poses/{k}", str(v)) for k, v in self.pose_counts.items())
+        merged = {c: tuple((extra or {}).get(c, ())) + counts for c in self.config.contacts}
+        return self.pipeline.diagnostics_cdr(stamp_ns, merged)
+
     def outputs(self) -> dict[str, str]:
         """Return every topic profiles mode publishes: the pipeline's and the patches."""
         return {**self.pipeline.outputs(), **output_topics(self.config.contacts, patches=True)}

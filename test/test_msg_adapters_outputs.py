@@ -112,3 +112,23 @@ def test_traction_cloud_decodes_to_the_cells():
         5, "wheelset", frame, tau_x, tau_y, slip, (-1e-3, -2e-3, 1e-3, 2e-3), power),
         PointCloud2).data), dtype=outputs.TRACTION_DTYPE).reshape(3, 4)
     assert np.array_equal(pts["friction_power"], power.astype(np.float32))
+
+
+#: statuses whose strings end at every byte offset modulo 4 (CDR aligns each length to 4)
+STATUSES = [("fastsim: left", 1, "2 of 5 patches rejected this period; last: r\u00e4d",
+             [("method", "mae_calibrated"), ("a", ""), ("bb", "1"), ("ccc", "22"),
+              ("dddd", "333")]),
+            ("", 2, "", []),
+            ("fastsim: right", 0, "ok", [(f"k{i}", "v" * i) for i in range(9)])]
+
+
+@pytest.mark.parametrize("stamp", STAMPS)
+@pytest.mark.parametrize("count", [0, 1, 3])
+def test_diagnostic_array_cdr_decodes_to_the_diagnostic_array(stamp, count):
+    from diagnostic_msgs.msg import DiagnosticArray
+    statuses = STATUSES[:count]
+    got = deserialize_message(outputs.diagnostic_array_cdr(stamp, statuses), DiagnosticArray)
+    want = outputs.diagnostic_array(stamp, statuses)
+    assert got == want
+    # the same bytes but for CDR's padding, which rclpy leaves as it was
+    assert len(outputs.diagnostic_array_cdr(stamp, statuses)) == len(serialize_message(want))

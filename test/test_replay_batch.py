@@ -332,3 +332,20 @@ def test_markers_equal_the_node_markers():
     for k, row in enumerate(m.deletions(stamps)):
         assert row.tobytes() == outputs.force_marker_cdr(int(stamps[k]), "wheelset", 1, "right",
                                                          None, 0.0, 0.0, 1e-5)
+
+
+@pytest.mark.parametrize("window", [97, 1000])
+def test_windows_that_end_mid_second_count_the_diagnostics_as_the_per_message_path(
+        tmp_path, monkeypatch, varied, window):
+    # a window's first run takes the rules to its end at once and each diagnostics counts the
+    # verdicts before its place: with windows that end anywhere between two diagnostics (and
+    # runs that carry rows not yet counted into the next window) the diagnostics, outputs and
+    # counts are still the per-message path's
+    from fastsim_ros.replay import bulk
+    values = checked(dict(contacts=["left", "right"]))
+    reference = replayed(varied, tmp_path / "rosbags", values, "rosbags")
+    monkeypatch.setattr(bulk, "WINDOW", window)
+    batched = replayed(varied, tmp_path / "auto", values, "auto")
+    assert_same(batched, reference)
+    diagnostics = reference[1]["/diagnostics"][1]
+    assert len(diagnostics) >= 2       # one inside the recording, the last at its end

@@ -31,11 +31,14 @@ per-message rules (:meth:`fastsim_ros.pipeline.Pipeline.on_patch`,
 
 Every number goes through the floating-point operations of the pipeline, in
 its order, so the outputs are the per-message path's bit for bit (the tests
-compare both paths on every bundled bag).  The counts, rate windows and last
-rejection of each contact are written back to the pipeline (:meth:`Batch.store`)
-before each diagnostics array, which the pipeline builds itself.  In the
-diagnostics each solve's time is its batch's mean (the solves run in one
-compiled loop).
+compare both paths on every bundled bag).  A run may span several
+diagnostics: the verdicts of its twists and patches are kept by the
+message's place in the bag and counted up to each diagnostics' place
+(:meth:`Batch.store`, which writes the counts, rate windows, last rejection
+and solve times of each contact, and the twists' counts, back to the
+pipeline), so each diagnostics array, which the pipeline builds itself,
+counts what the per-message path had counted by then.  In the diagnostics
+each solve's time is its run's mean (the solves run in one compiled loop).
 """
 
 from __future__ import annotations
@@ -77,6 +80,10 @@ _MISSING, _WRONG_FRAME, _OLD = CODE["missing_field"], CODE["wrong_frame"], CODE[
 #: kinds of input the batch takes (anything else: the per-message path)
 KINDS = ("wheel_twist", "rail_twist", "patch")
 _FIRST = np.iinfo(np.int64).min
+#: the pipeline's twist counts (``kinematics_counts``) by code; taken wheel and rail twists
+_TWIST_ORDER = ("wheel", "rail", "nonfinite", "wrong_frame", "old_stamp", "malformed")
+_TWIST_CODE = {name: k for k, name in enumerate(_TWIST_ORDER)}
+_TWIST_COUNTS = ("wheel", "rail")
 #: patch layouts kept per topic (a grid that keeps changing shape: the rest one by one)
 MAX_LAYOUTS = 64
 #: where the adapter loop leaves the contact frame (origin, e_x, e_y, e_z) and the grid fit
@@ -239,6 +246,8 @@ class Patches:
     published), ``marker``, ``cycle`` with the rig cycle's ``cycle_stamp``
     and ``cycle_wrench`` (force, torque in the wheelset frame).  ``parsed``:
     the message is a PointCloud2 (it has a stamp; it counts in the rate).
+    ``solve_time``: the run's mean solve time (s) where the solver ran, NaN
+    elsewhere; ``place``: the message's place in the bag (arrival order).
     """
 
     index: Ints
@@ -256,6 +265,18 @@ class Patches:
     cycle_stamp: Ints
     cycle_wrench: Floats
     parsed: Bools
+    solve_time: Floats = field(default_factory=lambda: np.zeros(0))
+    place: Ints = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+
+    def rows(self, r0: int, r1: int) -> Patches:
+        """Return rows ``r0:r1`` (views of the arrays; the details renumbered)."""
+        return Patches(
+            self.index[r0:r1], self.contact[r0:r1], self.stamp[r0:r1], self.status[r0:r1],
+            {i - r0: d for i, d in self.detail.items() if r0 <= i < r1},
+            self.frame[r0:r1], self.creep[r0:r1], self.force[r0:r1], self.slip[r0:r1],
+            self.changed[r0:r1], self.marker[r0:r1], self.cycle[r0:r1],
+            self.cycle_stamp[r0:r1], self.cycle_wrench[r0:r1], self.parsed[r0:r1],
+            self.solve_time[r0:r1], self.place[r0:r1])
 
 
 @dataclass
@@ -357,6 +378,13 @@ class Batch:
         self.layouts: dict[int, list[Layout]] = {}
         self.state = _ContactState(len(self.contacts))
         self.timing = Timing(inputs=[] if keep_inputs else None)
+        # verdicts not yet counted: twists (place in the bag, index of _TWIST_COUNTS) and
+        # the runs' patches (with the first row not yet counted)
+        self._twist_place = np.zeros(0, dtype=np.int64)
+        self._twist_count = np.zeros(0, dtype=np.int64)
+        self._pending: list[tuple[Patches, int]] = []
+        # the window run last: (window, base, first message, its patches)
+        self._window: tuple[Window, int, int, Patches] | None = None
         self._setup_solver()
 
     # ---------------------------------------------------------------- solver
@@ -442,7 +470,22 @@ class Batch:
         """Apply the rules to messages ``lo:hi`` of a window; return their patches.
 
         ``base``: messages of the bag before the window (arrival order).
+        The runs of a window come in order (``lo`` where the last ended):
+        the first applies the rules to the rest of the window at once (one
+        run of numpy and compiled loops instead of one per diagnostics) and
+        the others return their rows of it.
         """
+        done = self._window
+        if done is None or done[0] is not w or done[1] != base or lo < done[2]:
+            done = self._window = (w, base, lo, self._run(w, lo, len(w), base))
+        p = done[3]
+        if hi >= len(w):   # the window's last run: its buffers go with it
+            self._window = None
+        r0, r1 = np.searchsorted(p.index, (lo, hi), "left").tolist()
+        return p if r0 == 0 and r1 == p.index.size else p.rows(r0, r1)
+
+    def _run(self, w: Window, lo: int, hi: int, base: int) -> Patches:
+        """Apply the rules to messages ``lo:hi`` of a window (see :meth:`run`)."""
         t0 = time.perf_counter()
         channel = w.channel[lo:hi]
         known = channel < self.kind.size
@@ -454,6 +497,8 @@ class Batch:
         at = index[kind == 2]
         contact_of = self.of_contact[w.channel[at]]
         p, groups, singles = self._decode(w, at, contact_of)
+        p.place = base + at
+        p.solve_time = np.full(at.size, np.nan)
         t1 = time.perf_counter()
         todo = self._kinematics(p, base)
         t2 = time.perf_counter()
@@ -463,6 +508,7 @@ class Batch:
         self._old_stamps(p)
         t3 = time.perf_counter()
         self._advance(p)
+        self._pending.append((p, 0))
         t4 = time.perf_counter()
         self.timing.decode += t1 - t0
         self.timing.kinematics += t2 - t1
@@ -524,9 +570,13 @@ class Batch:
             hist.stamp = np.concatenate((hist.stamp, stamp[taken]))
             hist.value = np.concatenate((hist.value, value[taken]))
             hist.arrival = np.concatenate((hist.arrival, base + at[taken]))
-            self.pipeline.kinematics_counts["wheel" if which == 0 else "rail"] += int(taken.size)
-        for r in ("nonfinite", "wrong_frame", "old_stamp", "malformed"):
-            self.pipeline.kinematics_counts[r] += int(np.count_nonzero(reason == r))
+            reason[taken] = _TWIST_COUNTS[which]
+        counted = reason != ""
+        code = np.array([_TWIST_CODE[r] for r in reason[counted].tolist()], dtype=np.int64)
+        place = np.concatenate((self._twist_place, base + at[counted]))
+        count = np.concatenate((self._twist_count, code))
+        order = np.argsort(place, kind="stable")   # the wheel's and the rail's, by place
+        self._twist_place, self._twist_count = place[order], count[order]
 
     # ---------------------------------------------------------------- patches
 
@@ -624,6 +674,8 @@ class Batch:
             i = good[j]  # rows or columns running backwards: the adapter's orientation
             pressure[i] = np.ascontiguousarray(pressure[i][::y_order[~bad][j],
                                                            ::x_order[~bad][j]])
+        if good.size == n:   # every patch to solve: the array as it is (no copy)
+            return _Group(r, pressure), rest
         keep = np.zeros(n, dtype=np.bool_)
         keep[good] = True
         return _Group(r, pressure[keep]), rest
@@ -663,7 +715,10 @@ class Batch:
         Run after the patches' own verdicts: the old ones among them (solved
         or rejected for a later check) become ``old_stamp``, as the pipeline's
         check before the others makes them; a rejected patch does not move
-        the last stamp (the pipeline's rule).
+        the last stamp (the pipeline's rule).  The last stamp before a patch
+        is the largest of the taken ones before it (and the contact's last
+        before the run): a taken patch that is old is older than that
+        largest, so counting it changes nothing.
         """
         st = self.state
         parsed = p.parsed & (p.status != _WRONG_FRAME)
@@ -671,16 +726,19 @@ class Batch:
             mine = np.flatnonzero((p.contact == c) & parsed)
             if mine.size == 0:
                 continue
-            last = int(st.last_stamp[c]) if st.has_stamp[c] else None
-            stamps = p.stamp[mine].tolist()
-            taken = np.isin(p.status[mine], (_SOLVED, _EMPTY)).tolist()
-            for i, s, ok in zip(mine.tolist(), stamps, taken):
-                if last is not None and s < last:
-                    p.status[i] = _OLD
-                    p.detail[i] = f"old_stamp: stamp {s} ns is older than the last, {last} ns"
-                elif ok:
-                    last = s
-            if last is not None:
+            first = int(st.last_stamp[c]) if st.has_stamp[c] else _FIRST
+            stamps = p.stamp[mine]
+            status = p.status[mine]
+            taken = (status == _SOLVED) | (status == _EMPTY)
+            newest = np.maximum.accumulate(np.where(taken, stamps, _FIRST))
+            before = np.maximum(np.concatenate(([first], newest[:-1])), first)
+            old = stamps < before
+            for i, s, last in zip(mine[old].tolist(), stamps[old].tolist(),
+                                  before[old].tolist()):
+                p.status[i] = _OLD
+                p.detail[i] = f"old_stamp: stamp {s} ns is older than the last, {last} ns"
+            last = max(first, int(newest[-1]))
+            if last != _FIRST:
                 st.last_stamp[c] = last
                 st.has_stamp[c] = True
 
@@ -806,29 +864,29 @@ class Batch:
                 p.status[rows[j]] = CODE["nonfinite"]
                 p.detail[rows[j]] = "nonfinite: the solve gave a non-finite force"
             if not self.allow_implausible:
-                self._implausible(p, rows[ok & finite], ps[ok & finite], grid[ok & finite])
+                self._implausible(p, rows, ps, grid, np.flatnonzero(ok & finite))
         elapsed = time.perf_counter() - t0
         done = np.concatenate(solved)
         self.timing.solves += done.size
         if done.size:
-            mean = elapsed / done.size
-            for c, k in zip(*np.unique(p.contact[done], return_counts=True)):
-                times = self.state.solve_times[int(c)]
-                times += [mean] * int(k)
-                del times[:-SOLVE_TIME_WINDOW]
+            p.solve_time[done] = elapsed / done.size
 
-    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats) -> None:
+    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats,
+                     solved: Ints) -> None:
         """``implausible``: the pipeline's rule (:func:`fastsim_ros.pipeline.implausible`).
 
-        Its bounds tested on every row at once (the grid's span, the largest
-        pressure, the creepages); the rows that fail one get the pipeline's
-        own words from :func:`~fastsim_ros.plausibility.stream_problem`.
+        On items ``solved`` of a solve (``rows``, ``ps``, ``grid``: its
+        patches' rows, pressures and grids).  Its bounds tested on every row
+        at once (the grid's span, the largest pressure, the creepages); the
+        rows that fail one get the pipeline's own words from
+        :func:`~fastsim_ros.plausibility.stream_problem`.
         """
-        if rows.size == 0:
+        if solved.size == 0:
             return
         table = plausibility.PLAUSIBLE
         ny, nx = ps.shape[1], ps.shape[2]
-        peak = ps.max(axis=(1, 2))
+        peak = ps.reshape(ps.shape[0], -1).max(axis=1)[solved]
+        rows, grid = rows[solved], grid[solved]
         creep = p.creep[rows]
         suspect = ((nx * grid[:, 2] > table["patch_extent"].high)
                    | (ny * grid[:, 3] > table["patch_extent"].high)
@@ -837,7 +895,7 @@ class Batch:
                    | ~(np.abs(creep[:, 1]) <= table["creepage"].high)
                    | ~(np.abs(creep[:, 2]) <= table["spin"].high))
         for j in np.flatnonzero(suspect).tolist():
-            ex, ey = patch_extent(ps[j], float(grid[j, 2]), float(grid[j, 3]))
+            ex, ey = patch_extent(ps[solved[j]], float(grid[j, 2]), float(grid[j, 3]))
             why = plausibility.stream_problem(ex, ey, float(peak[j]), float(creep[j, 0]),
                                               float(creep[j, 1]), float(creep[j, 2]))
             if why is not None:
@@ -853,25 +911,62 @@ class Batch:
                         st.last_marker, st.has_marker, st.wrench_stamp, st.wrench,
                         st.has_wrench, st.last_sum, p.changed, p.marker, p.cycle, p.cycle_stamp,
                         p.cycle_wrench)
-        rejected = p.status >= len((SOLVED, NO_CONTACT))
+
+    def _count(self, upto: int | None) -> None:
+        """Count the verdicts of the messages before place ``upto`` in the bag (None: all)."""
+        twists = self._twist_place.size if upto is None else int(
+            np.searchsorted(self._twist_place, upto, "left"))
+        if twists:
+            counts = np.bincount(self._twist_count[:twists], minlength=len(_TWIST_ORDER))
+            for name, k in zip(_TWIST_ORDER, counts.tolist()):
+                if k:
+                    self.pipeline.kinematics_counts[name] += k
+            self._twist_place = self._twist_place[twists:]
+            self._twist_count = self._twist_count[twists:]
+        left: list[tuple[Patches, int]] = []
+        for p, r0 in self._pending:
+            r1 = p.place.size if upto is None else int(np.searchsorted(p.place, upto, "left"))
+            if r1 > r0:
+                self._count_rows(p, r0, r1)
+            if r1 < p.place.size:
+                left.append((p, r1))
+        self._pending = left
+
+    def _count_rows(self, p: Patches, r0: int, r1: int) -> None:
+        """Count patch rows ``r0:r1`` of a run: statuses, rate windows, rejections, solve times."""
+        st = self.state
+        status, contact = p.status[r0:r1], p.contact[r0:r1]
+        rejected = status >= len((SOLVED, NO_CONTACT))
+        parsed = p.parsed[r0:r1]
+        timed = np.isfinite(p.solve_time[r0:r1])
         for c in range(len(self.contacts)):
-            mine = p.contact == c
-            st.counts[c] += np.bincount(p.status[mine], minlength=len(STATUSES))
-            windowed = np.flatnonzero(mine & p.parsed)   # a PointCloud2: in the rate window
+            mine = contact == c
+            st.counts[c] += np.bincount(status[mine], minlength=len(STATUSES))
+            windowed = np.flatnonzero(mine & parsed)   # a PointCloud2: in the rate window
             if windowed.size:
                 st.window_inputs[c] += windowed.size
                 if st.window_first[c] is None:
-                    st.window_first[c] = int(p.stamp[windowed[0]])
-                st.window_last[c] = int(p.stamp[windowed[-1]])
+                    st.window_first[c] = int(p.stamp[r0 + windowed[0]])
+                st.window_last[c] = int(p.stamp[r0 + windowed[-1]])
                 st.window_rejected[c] += int(np.count_nonzero(rejected[windowed]))
             last = np.flatnonzero(mine & rejected)
             if last.size:
-                st.last_detail[c] = p.detail[int(last[-1])]
+                st.last_detail[c] = p.detail[r0 + int(last[-1])]
+            solved = np.flatnonzero(mine & timed)
+            if solved.size:
+                times = st.solve_times[c]
+                times += p.solve_time[r0 + solved].tolist()
+                del times[:-SOLVE_TIME_WINDOW]
 
     # ---------------------------------------------------------------- the pipeline
 
-    def store(self) -> None:
-        """Write the counters, rate windows, last rejections and solve times to the pipeline."""
+    def store(self, upto: int | None = None) -> None:
+        """Write the counters, rate windows, last rejections and solve times to the pipeline.
+
+        As they stand after the messages before place ``upto`` in the bag
+        (None: every message run so far).
+        """
+        self._count(upto)
         st = self.state
         contacts = self.pipeline._contacts
         for c, name in enumerate(self.contacts):

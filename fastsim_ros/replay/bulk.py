@@ -175,7 +175,7 @@ class IndexedReplay:
         counts = np.bincount(channel, minlength=1)
         for c in np.flatnonzero(counts).tolist():
             self.seen[c] = self.seen.get(c, 0) + int(counts[c])
-        if not np.isin(channel, list(self.skip)).any():
+        if not self.skip or not np.isin(channel, list(self.skip)).any():
             self.writer.copy_chunk(chunk, raw, {c: int(counts[c]) for c in
                                                 np.flatnonzero(counts).tolist()})
             self.result.messages_out += int(channel.size)
@@ -218,18 +218,9 @@ class IndexedReplay:
                     if j > lo:
                         self._messages(w, lo, j, base)
                     if j < n:
-                        t0 = time.perf_counter()
                         stamp = int(log[j])
-                        if self.batch is not None:
-                            self.batch.store()
-                        msg = self.pipeline.diagnostics(stamp)
-                        if self.batch is not None:
-                            self.batch.reported()
-                        self.writer.write(self.channel(diagnostics), stamp,
-                                          serialize_message(msg))
-                        self.result.messages_out += 1
+                        self._diagnostics(diagnostics, stamp, base + j)
                         next_diag += ((stamp - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
-                        self.phases["diagnostics"] += time.perf_counter() - t0
                     lo = j
                 base += n
                 last = int(log[-1])
@@ -246,8 +237,7 @@ class IndexedReplay:
         t0 = time.perf_counter()
         if self.batch is not None:
             self.batch.store()
-        self.writer.write(self.channel(diagnostics), last,
-                          serialize_message(self.pipeline.diagnostics(last)))
+        self.writer.write(self.channel(diagnostics), last, self.pipeline.diagnostics_cdr(last))
         self.result.messages_out += 1
         self.phases["diagnostics"] += time.perf_counter() - t0
         return first, last
@@ -273,6 +263,18 @@ class IndexedReplay:
         self.writer.abort()
 
     # ---------------------------------------------------------------- messages
+
+    def _diagnostics(self, topic: str, stamp: int, place: int) -> None:
+        """Write the diagnostics array at ``stamp``: counts of the messages before ``place``."""
+        t0 = time.perf_counter()
+        if self.batch is not None:
+            self.batch.store(place)
+        data = self.pipeline.diagnostics_cdr(stamp)
+        if self.batch is not None:
+            self.batch.reported()
+        self.writer.write(self.channel(topic), stamp, data)
+        self.result.messages_out += 1
+        self.phases["diagnostics"] += time.perf_counter() - t0
 
     def _messages(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
         if self.batch is not None:
@@ -389,6 +391,9 @@ class IndexedReplay:
                     out.series[c].add(tt, nan, nan, nan, 0.0, 0.0, 0.0, mu)
 
     def _write(self, parts: list[Any], log: Ints) -> None:
+        parts = [part for part in parts if part[1].size]
+        if not parts:
+            return
         keys = np.concatenate([k for k, _, _, _ in parts])
         order = np.argsort(keys, kind="stable")
         sizes = np.concatenate([np.full(r.shape[0], r.shape[1] + 31, dtype=np.int64)

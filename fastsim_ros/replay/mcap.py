@@ -186,10 +186,20 @@ class IndexedMcap:
     channels: dict[int, Channel]
     chunks: list[ChunkIndex]
     file: BinaryIO
+    #: by channel id, whether the file defines it (:meth:`channel_table`)
+    known: NDArray[np.bool_] | None = None
 
     def close(self) -> None:
         """Close the file."""
         self.file.close()
+
+    def channel_table(self) -> NDArray[np.bool_]:
+        """Return, by channel id, whether the file defines that channel (made once)."""
+        if self.known is None:
+            self.known = np.zeros(max(self.channels, default=-1) + 1, dtype=np.bool_)
+            self.known[np.fromiter(self.channels, dtype=np.int64,
+                                   count=len(self.channels))] = True
+        return self.known
 
     def read_chunk(self, chunk: ChunkIndex) -> tuple[bytes, bytes]:
         """Return ``(raw, records)``: the chunk's bytes in the file and its records.
@@ -341,8 +351,9 @@ def _check_chunk(mcap: IndexedMcap, chunk: ChunkIndex, arrays: Arrays) -> None:
     channel, log_time = arrays[0], arrays[1]
     if not channel.size:
         return
-    unknown = ~np.isin(channel, np.fromiter(mcap.channels, dtype=np.int64,
-                                            count=len(mcap.channels)))
+    known = mcap.channel_table()
+    unknown = (channel < 0) | (channel >= known.size)
+    unknown[~unknown] = ~known[channel[~unknown]]
     if unknown.any():
         bad = int(channel[unknown][0])
         raise McapError(f"chunk at byte {chunk.offset}: a message on channel {bad}, which "
