@@ -10,8 +10,8 @@ updates, the slope ``dF/dmu_s`` from the march's own derivative), and one
 (the model before it had the derivative); and, on a contaminated rail
 (the modified FastSim, ``k0`` 0.6, ``alpha_inf`` 0.5, ``beta`` 0.3), one
 ``on`` with that reduction given and one estimating ``k0`` with ``mu_s``
-(``friction_estimate_slope_reduction``: three solves per contact, the
-prior and a forward difference in each state).  One timed call is one rig
+(``friction_estimate_slope_reduction``: the published solve and one
+solve per contact for the forward difference in each state).  One timed call is one rig
 cycle: the wheelset twist, (the measured wrench,) both patches, as CDR
 bytes, through the pipeline's handlers.  They are interleaved in rounds
 (``bench_fastsim.per_call``).  Also timed: one

@@ -473,7 +473,7 @@ class Pipeline:
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
         # online friction estimation (None: off); the measured wrenches (stamp, force)
-        self._ekf: FrictionEkf | None = None
+        self._ekf: FrictionEkf | FrictionSlopeEkf | None = None
         self._measured: deque[tuple[int, tuple[float, float, float]]] = deque(
             maxlen=TWIST_HISTORY)
         self._measured_used_ns: int | None = None
@@ -855,8 +855,9 @@ class Pipeline:
         The model: the configured solver under the law at ``mu_s`` with the
         reduction ``SlopeReduction(k0, alpha_inf, beta)`` (the modified
         FastSim, no knee factor), the contacts' forces projected on the
-        wheelset's ``x`` (:meth:`CreepModel.predict`): three solves per
-        contact (the prior and a forward difference in each state).
+        wheelset's ``x`` (:meth:`CreepModel.predict`).  The model at the prior
+        is the published forces (solved under that very law and reduction);
+        the forward difference in each state is one solve per contact more.
         Returns the cycle's status.
         """
         config = self.config
@@ -873,8 +874,10 @@ class Pipeline:
             creep = CreepModel(self._solver, *law, knee=False,  # type: ignore[arg-type]
                                reduction=None if reduction.identity else reduction)
             return float(creep.predict(samples, mu_s)[0])
+        predicted = math.fsum(p.frame.axes[0][0] * f.fx + p.frame.axes[1][0] * f.fy
+                              for p, _, f in solved)
         try:
-            step = ekf.update(measured, model, load)
+            step = ekf.update(measured, model, load, predicted)
         except ContactError:  # the solver refused a perturbed state: hold
             return "unobservable"
         self.estimation_counts["steps"] += int(step.step_seen)

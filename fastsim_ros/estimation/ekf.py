@@ -443,7 +443,7 @@ class FrictionSlopeEkf:
         self.P = np.diag([min(_positive("sigma", sigma), self.sigma_max) ** 2, var_k0])
 
     def predict(self, dt: float) -> None:
-        """Advance by ``dt`` seconds: each variance grows by its ``q dt`` (up to ``sigma_max^2``)."""
+        """Advance by ``dt`` s: each variance grows by its ``q dt`` (up to ``sigma_max^2``)."""
         if not (dt >= 0.0 and math.isfinite(dt)):
             dt = _positive("dt", dt, zero_ok=True)  # raises
         top = self.sigma_max ** 2
@@ -475,7 +475,7 @@ class FrictionSlopeEkf:
         return self._correct(z - h0, h, load)
 
     def _correct(self, y: float, h: FloatArray, load: float) -> SlopeEkfStep:
-        """Apply the consider update of innovation ``y`` (N) and slope ``h`` (the class docstring)."""
+        """Apply the consider update of innovation ``y`` (N), slope ``h`` (class docstring)."""
         r_mu, r_k0 = abs(h[0]) / load, abs(h[1]) / load
         observable = np.array([r_mu >= self.min_sensitivity and r_mu > NO_SENSITIVITY,
                                r_k0 >= self.min_sensitivity and r_k0 > NO_SENSITIVITY])
