@@ -96,7 +96,7 @@ CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "traction": "sensor_msgs/msg/PointCloud2"}
 #: a contact's wear and fatigue topics (parameter wear_outputs; docs/guide_wear.md):
 #: energy = (T-gamma N, T-gamma/A Pa, frictional power W), damage = (wear rate kg/(m m^2),
-#: RCF damage per passage, frictional power / (T-gamma |V|))
+#: RCF damage per passage, frictional power / (T-gamma ``|V|``))
 WEAR_OUTPUTS = {"energy": "geometry_msgs/msg/Vector3Stamped",
                 "damage": "geometry_msgs/msg/Vector3Stamped"}
 
