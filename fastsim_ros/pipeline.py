@@ -1366,8 +1366,11 @@ class Pipeline:
         """
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
         if self._ekf is not None:  # the estimator's state, shared by the contacts
+            slope = ((("friction_estimation/k0", f"{self._ekf.k0:.6g}"),
+                      ("friction_estimation/sigma_k0", f"{self._ekf.sigma_k0:.3g}"))
+                     if isinstance(self._ekf, FrictionSlopeEkf) else ())
             twists += (("friction_estimation/mu", f"{self._ekf.mu:.6g}"),
-                       ("friction_estimation/sigma", f"{self._ekf.sigma:.3g}")) + tuple(
+                       ("friction_estimation/sigma", f"{self._ekf.sigma:.3g}")) + slope + tuple(
                 (f"friction_estimation/{key}", str(v))
                 for key, v in self.estimation_counts.items()) + tuple(
                 (f"measured_wrench/{key}", str(v)) for key, v in self.wrench_counts.items())

@@ -199,6 +199,9 @@ def test_node_fed_contaminated_rig_estimates_mu_and_k0_as_the_replay_does(tmp_pa
                                    and len(slopes) >= k // 2 + 1, 10.0)
         got_mu = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in estimates}
         got_k0 = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in slopes}
+        last_k0 = got_k0[max(got_k0)][0]
+        assert client.wait_for(lambda: client.diagnostic_values("left").get(
+            "friction_estimation/k0") == f"{last_k0:.6g}", 20.0)
         got_fx = {(c, stamp_ns(w)): w.wrench.force.x for c, ws in client.wrenches.items()
                   for w in ws}
     finally:
