@@ -7,7 +7,11 @@ constant friction: one with ``friction_estimation: off``, one ``on`` (fed a
 measured wrench each cycle, creepage beyond the linear range so every cycle
 updates, the slope ``dF/dmu_s`` from the march's own derivative), and one
 ``on`` whose slope is the forward difference of a second solve per contact
-(the model before it had the derivative).  One timed call is one rig
+(the model before it had the derivative); and, on a contaminated rail
+(the modified FastSim, ``k0`` 0.6, ``alpha_inf`` 0.5, ``beta`` 0.3), one
+``on`` with that reduction given and one estimating ``k0`` with ``mu_s``
+(``friction_estimate_slope_reduction``: the published solve and one
+solve per contact for the forward difference in each state).  One timed call is one rig
 cycle: the wheelset twist, (the measured wrench,) both patches, as CDR
 bytes, through the pipeline's handlers.  They are interleaved in rounds
 (``bench_fastsim.per_call``).  Also timed: one
@@ -98,14 +102,21 @@ def rig_cycle(pipe: Pipeline, *, xi: float = 4e-3, speed: float = 20.0,
     return run
 
 
-def cycle_runner(estimation: str, differenced: bool = False, cycles: int = 100_000):
+#: a contaminated rail's slope reduction (modified FastSim)
+REDUCED = {"slope_reduction_k0": 0.6, "slope_reduction_alpha_inf": 0.5,
+           "slope_reduction_beta": 0.3}
+
+
+def cycle_runner(estimation: str, differenced: bool = False, cycles: int = 100_000,
+                 **extra: object):
     """Return a function that runs the next rig cycle through a pipeline, and the pipeline.
 
     ``differenced``: the estimator's slope a forward difference (a second
-    solve per contact), beside the march's own derivative.
+    solve per contact), beside the march's own derivative; ``extra``: more
+    parameters.
     """
     pipe = Pipeline(PipelineConfig.from_values(
-        {"contacts": ["left", "right"], "friction_estimation": estimation}))
+        {"contacts": ["left", "right"], "friction_estimation": estimation, **extra}))
     if differenced:
         object.__setattr__(pipe._creep_model, "_marched_slope", False)
     return rig_cycle(pipe, measured=estimation == "on", cycles=cycles), pipe
@@ -121,6 +132,9 @@ def main() -> None:
     off, _ = cycle_runner("off")
     on, pipe_on = cycle_runner("on", cycles=cycles)
     differenced, _ = cycle_runner("on", differenced=True, cycles=cycles)
+    reduced, _ = cycle_runner("on", cycles=cycles, **REDUCED)
+    with_k0, pipe_k0 = cycle_runner("on", cycles=cycles, **REDUCED,
+                                    friction_estimate_slope_reduction=True)
     area = samples.flange_root_patch(cells=30)
     solver = CalibratedMaeSolver(0.28, 8e10)
 
@@ -138,7 +152,9 @@ def main() -> None:
         march(area.pressure, area.x0, area.y0, area.dx, area.dy, 4e-3, 0.0, 0.0, law, 20.0,
               True)
     times = per_call({"cycle, estimation off": off, "cycle, estimation on": on,
-                      "on, slopes differenced": differenced, "one solve_arrays": solve,
+                      "on, slopes differenced": differenced,
+                      "on, reduction given": reduced, "on, k0 estimated too": with_k0,
+                      "one solve_arrays": solve,
                       "one kernel call": kernel, "one slope kernel call": slope}, args.calls)
     print(f"machine: {machine()}")
     for name, (p50, p99) in times.items():
@@ -147,8 +163,12 @@ def main() -> None:
         extra = times[name][0] - times["cycle, estimation off"][0]
         print(f"estimator per cycle ({name}; difference of medians): {extra:.1f} us = "
               f"{extra / times['one solve_arrays'][0]:.2f} solves")
-    print(f"updates {pipe_on.estimation_counts['updated']}, "
-          f"unobservable {pipe_on.estimation_counts['unobservable']}")
+    extra = times["on, k0 estimated too"][0] - times["on, reduction given"][0]
+    print(f"k0 estimated beside the reduction given (difference of medians): {extra:.1f} us = "
+          f"{extra / times['one solve_arrays'][0]:.2f} solves")
+    for name, pipe in (("mu_s", pipe_on), ("mu_s and k0", pipe_k0)):
+        print(f"{name}: updates {pipe.estimation_counts['updated']}, "
+              f"unobservable {pipe.estimation_counts['unobservable']}")
 
 
 if __name__ == "__main__":

@@ -250,6 +250,19 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "samples the model gets wrong weigh little and sigma covers it; 0: the "
                   "model taken as exact (only the load cell's noise)",
                   low=0.0, high=10.0, dynamic=True),
+    ParameterSpec("friction_estimate_slope_reduction", "bool", False,
+                  "with friction_estimation on, estimate the creep-slope reduction's k0 "
+                  "together with mu_s (a two-state filter; slope_reduction_alpha_inf and "
+                  "_beta held; k0 is observable in the linear range, mu_s in full slip, both "
+                  "at the knee): friction/slope_estimate is published and every wrench uses "
+                  "the estimated k0 (slope_reduction_k0 is its start; "
+                  "docs/guide_estimation.md)"),
+    ParameterSpec("friction_slope_sigma", "double", 0.2,
+                  "standard deviation of k0 at the start of its estimation",
+                  low=1.0e-6, high=1.0, dynamic=True),
+    ParameterSpec("friction_slope_process_noise", "double", 1.0e-4,
+                  "q (1/s): variance of k0 added per second (how fast the rail's slope may "
+                  "change)", low=0.0, high=10.0, dynamic=True),
     ParameterSpec("rolling", "string", "steady",
                   "steady (each cycle at the steady state) or transient (each contact keeps "
                   "its traction between cycles, convected by |V| dt: Kalker's non-steady "
@@ -396,6 +409,14 @@ def checked(values: Mapping[str, Any]) -> dict[str, Any]:
                              "slope_reduction_alpha_inf < 1 with slope_reduction_beta > 0) "
                              "applies to steady rolling only: set rolling steady, or k0 1 "
                              "and alpha_inf 1")
+    if out["friction_estimate_slope_reduction"]:
+        for name, bad, why in (("method", out["method"] == "polach",
+                                "Polach's slope is reduced by polach_ka and polach_ks"),
+                               ("rolling", out["rolling"] == "transient",
+                                "the creep-slope reduction applies to steady rolling only")):
+            if bad:
+                raise ParameterError("parameter 'friction_estimate_slope_reduction': the "
+                                     f"estimate of k0 refuses {name} {out[name]!r}: {why}")
     if out["method"] == "polach":
         if out["polach_ks"] > out["polach_ka"]:
             raise ParameterError("parameters 'polach_ka', 'polach_ks': Polach's factors need "

@@ -45,7 +45,9 @@ from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.polach import PolachSolver
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.errors import ParameterError
+from fastsim_ros.contact.slope_reduction import SlopeReduction
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
+from fastsim_ros.estimation.ekf import FrictionSlopeEkf
 from fastsim_ros.estimation.model import model_error
 from fastsim_ros.contact import kernels as contact_kernels
 from fastsim_ros.contact.transient import (RESET_REASONS, ContactMemory, TransientSolver,
@@ -84,6 +86,9 @@ IMPLAUSIBLE_FORCE = 1.0
 #: online friction estimation (parameter friction_estimation): the measured wrench in, the
 #: estimate out (Vector3Stamped: x = mu_s, y = its standard deviation, z = adhesion utilisation)
 MEASURED_WRENCH_TOPIC, FRICTION_ESTIMATE_TOPIC = "wheelset/measured_wrench", "friction/estimate"
+#: the creep-slope reduction's estimate (friction_estimate_slope_reduction): Vector3Stamped, x =
+#: k0, y = its standard deviation, z = the correlation of the mu_s and k0 estimates' errors
+SLOPE_ESTIMATE_TOPIC = "friction/slope_estimate"
 #: output topics of a contact: relative name -> message type
 CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
                    "creepage": "geometry_msgs/msg/Vector3Stamped",
@@ -187,6 +192,9 @@ class FrictionEstimate:
     ``implausible`` (the measured creep force beyond the friction any rail
     gives the cycle's load: held, :data:`IMPLAUSIBLE_FORCE`) or
     ``no_measurement`` (no fresh ``wheelset/measured_wrench``: held).
+    With the slope reduction estimated (``friction_estimate_slope_reduction``):
+    ``k0`` its estimate, ``sigma_k0`` its standard deviation, ``correlation``
+    that of the two estimates' errors (else NaN).
     """
 
     stamp_ns: int
@@ -194,6 +202,9 @@ class FrictionEstimate:
     sigma: float
     utilisation: float
     status: str
+    k0: float = math.nan
+    sigma_k0: float = math.nan
+    correlation: float = math.nan
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -462,7 +473,7 @@ class Pipeline:
         self.kinematics_counts = {"wheel": 0, "rail": 0, "nonfinite": 0, "wrong_frame": 0,
                                   "old_stamp": 0, "malformed": 0}
         # online friction estimation (None: off); the measured wrenches (stamp, force)
-        self._ekf: FrictionEkf | None = None
+        self._ekf: FrictionEkf | FrictionSlopeEkf | None = None
         self._measured: deque[tuple[int, tuple[float, float, float]]] = deque(
             maxlen=TWIST_HISTORY)
         self._measured_used_ns: int | None = None
@@ -507,7 +518,7 @@ class Pipeline:
                                        str(config["friction_law"]),
                                        float(config["friction_limit_ratio"]),
                                        float(config["friction_decay"]), str(self._bound),
-                                       reduction=slope_reduction_of(config))
+                                       reduction=self._reduction(config))
         mu = self._ekf.mu if self._ekf is not None else float(config["friction_coefficient"])
         self._use_mu(mu, config)
 
@@ -518,7 +529,7 @@ class Pipeline:
         law = friction_law(str(config["friction_law"]), self._mu,
                            limit_ratio=float(config["friction_limit_ratio"]),
                            decay=float(config["friction_decay"]),
-                           reduction=slope_reduction_of(config))
+                           reduction=self._reduction(config))
         self._law: FrictionLaw | None = (law if law.slip_dependent or law.reduces_slope
                                          else None)
         # the compiled path (pipeline_kernels.solve_cloud): the MAE methods without
@@ -542,6 +553,20 @@ class Pipeline:
                               self._law is not None, solver._calibrated, solver._pair_knots,
                               solver._pair_values, solver._knee_for(self._bound))
 
+    def _reduction(self, config: PipelineConfig) -> SlopeReduction | None:
+        """Return the creep-slope reduction in force: the parameters', ``k0`` the estimate's.
+
+        With ``friction_estimate_slope_reduction`` the estimated ``k0`` with
+        the configured ``alpha_inf`` and ``beta`` (None where that is no
+        reduction), else :func:`~fastsim_ros.params.slope_reduction_of`.
+        """
+        ekf = self._ekf
+        if not isinstance(ekf, FrictionSlopeEkf):
+            return slope_reduction_of(config)
+        reduction = SlopeReduction(ekf.k0, float(config["slope_reduction_alpha_inf"]),
+                                   float(config["slope_reduction_beta"]))
+        return None if reduction.identity else reduction
+
     def _apply_estimation(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
         """Start the friction estimator (estimation on), or retune the running one.
 
@@ -557,11 +582,32 @@ class Pipeline:
         q, r = float(config["friction_process_noise"]), float(config["friction_measurement_noise"])
         gate = float(config["friction_min_sensitivity"])
         mu, sigma = float(config["friction_coefficient"]), float(config["friction_estimate_sigma"])
+        spec = parameters.SPECS["friction_coefficient"]
+        assert spec.low is not None and spec.high is not None
+        if config["friction_estimate_slope_reduction"]:
+            k0, sigma_k0 = (float(config["slope_reduction_k0"]),
+                            float(config["friction_slope_sigma"]))
+            q_k0 = float(config["friction_slope_process_noise"])
+            ekf = self._ekf
+            if not isinstance(ekf, FrictionSlopeEkf):
+                k0_spec = parameters.SPECS["slope_reduction_k0"]
+                assert k0_spec.low is not None and k0_spec.high is not None
+                self._ekf = FrictionSlopeEkf(
+                    mu, k0, sigma, sigma_k0, process_noise=q, process_noise_k0=q_k0,
+                    measurement_noise=r, min_sensitivity=gate,
+                    mu_bounds=(spec.low, spec.high), k0_bounds=(k0_spec.low, k0_spec.high))
+                return
+            ekf.process_noise, ekf.process_noise_k0, ekf.measurement_noise = q, q_k0, r
+            ekf.min_sensitivity = gate
+            if any(n in changed for n in ("friction_coefficient", "friction_estimate_sigma",
+                                          "slope_reduction_k0", "friction_slope_sigma")):
+                ekf.restart(sigma, mu if "friction_coefficient" in changed else None,
+                            sigma_k0=sigma_k0,
+                            k0=k0 if "slope_reduction_k0" in changed else None)
+            return
         if self._ekf is None:
             # the estimate ranges over the parameter's own range: a friction_coefficient
             # the node takes is never clamped unseen (the filter's default was 0.01 to 2)
-            spec = parameters.SPECS["friction_coefficient"]
-            assert spec.low is not None and spec.high is not None
             self._ekf = FrictionEkf(mu, sigma, process_noise=q, measurement_noise=r,
                                     min_sensitivity=gate, mu_bounds=(spec.low, spec.high))
             return
@@ -576,7 +622,7 @@ class Pipeline:
         values.update(changes)
         config = PipelineConfig.from_values(values)
         for name in ("contacts", "wheelset_frame", "shear_modulus", "poisson_ratio",
-                     "friction_estimation"):
+                     "friction_estimation", "friction_estimate_slope_reduction"):
             if config[name] != self.config[name]:
                 raise ParameterError(f"parameter {name!r} is set at start only")
         self._apply(config, tuple(changes))
@@ -586,6 +632,8 @@ class Pipeline:
         topics = output_topics(self.config.contacts, wear=self._wear)
         if self._ekf is not None:
             topics[FRICTION_ESTIMATE_TOPIC] = "geometry_msgs/msg/Vector3Stamped"
+        if isinstance(self._ekf, FrictionSlopeEkf):
+            topics[SLOPE_ESTIMATE_TOPIC] = "geometry_msgs/msg/Vector3Stamped"
         return topics
 
     def inputs(self) -> tuple[InputTopic, ...]:
@@ -742,6 +790,8 @@ class Pipeline:
             # (plus ten of the load cell's sigmas): a fault of the measurement, which as a
             # step of mu would drive the estimate to its bound and every wrench with it
             status = "implausible"
+        elif isinstance(ekf, FrictionSlopeEkf):
+            status = self._estimate_with_slope(ekf, solved, measured[0] - normal_x, load)
         else:
             model, share = self._creep_model, self._model_error_share
             # the model's samples only where a solve beyond the published one is asked
@@ -779,17 +829,59 @@ class Pipeline:
             except ContactError:  # the solver refused the perturbed mu: hold
                 status = "unobservable"
         self.estimation_counts[status] += 1
+        if isinstance(ekf, FrictionSlopeEkf):
+            reduction = self._law.reduction if self._law is not None else None
+            if ekf.mu != mu or (reduction.k0 if reduction is not None else 1.0) != ekf.k0:
+                self._use_mu(ekf.mu, self.config)  # the law and the compiled path anew
+            return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status,
+                                 ekf.k0, ekf.sigma_k0, ekf.correlation)
         if ekf.mu != mu:  # as _use_mu, which gives the same law and tuple, for less
             self._mu = ekf.mu
             if self._law is not None:
                 self._law = friction_law(str(self.config["friction_law"]), self._mu,
                                          limit_ratio=float(self.config["friction_limit_ratio"]),
                                          decay=float(self.config["friction_decay"]),
-                                         reduction=slope_reduction_of(self.config))
+                                         reduction=self._reduction(self.config))
             c = self._compiled
             if c is not None:  # only mu_s (slot 7) depends on mu
                 self._compiled = c[:7] + (self._mu,) + c[8:]
         return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
+
+    def _estimate_with_slope(self, ekf: FrictionSlopeEkf,
+                             solved: list[tuple[ContactPatch, Creepage, ContactForces]],
+                             measured: float, load: float) -> str:
+        """Update ``(mu_s, k0)`` with the cycle's measured creep force ``measured`` (N, x).
+
+        The model: the configured solver under the law at ``mu_s`` with the
+        reduction ``SlopeReduction(k0, alpha_inf, beta)`` (the modified
+        FastSim, no knee factor), the contacts' forces projected on the
+        wheelset's ``x`` (:meth:`CreepModel.predict`).  The model at the prior
+        is the published forces (solved under that very law and reduction);
+        the forward difference in each state is one solve per contact more.
+        Returns the cycle's status.
+        """
+        config = self.config
+        samples = [ContactSample(p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi, c.eta, c.phi,
+                                 c.speed, ((p.frame.axes[0][0], p.frame.axes[1][0]),))
+                   for p, c, _ in solved]
+        alpha_inf, beta = (float(config["slope_reduction_alpha_inf"]),
+                           float(config["slope_reduction_beta"]))
+        law = (str(config["friction_law"]), float(config["friction_limit_ratio"]),
+               float(config["friction_decay"]), str(self._bound))
+
+        def model(mu_s: float, k0: float) -> float:
+            reduction = SlopeReduction(k0, alpha_inf, beta)
+            creep = CreepModel(self._solver, *law, knee=False,  # type: ignore[arg-type]
+                               reduction=None if reduction.identity else reduction)
+            return float(creep.predict(samples, mu_s)[0])
+        predicted = math.fsum(p.frame.axes[0][0] * f.fx + p.frame.axes[1][0] * f.fy
+                              for p, _, f in solved)
+        try:
+            step = ekf.update(measured, model, load, predicted)
+        except ContactError:  # the solver refused a perturbed state: hold
+            return "unobservable"
+        self.estimation_counts["steps"] += int(step.step_seen)
+        return step.status
 
     @staticmethod
     def _knee_corrected(model: CreepModel,
@@ -1246,6 +1338,9 @@ class Pipeline:
         if e is not None and FRICTION_ESTIMATE_TOPIC in wanted:
             msgs.append((FRICTION_ESTIMATE_TOPIC, stamped_doubles(
                 e.stamp_ns, frame_id, (e.mu, e.sigma, e.utilisation))))
+        if e is not None and SLOPE_ESTIMATE_TOPIC in wanted and not math.isnan(e.k0):
+            msgs.append((SLOPE_ESTIMATE_TOPIC, stamped_doubles(
+                e.stamp_ns, frame_id, (e.k0, e.sigma_k0, e.correlation))))
         return msgs
 
     def wear(self, outcome: Outcome) -> WearIndicators | None:
@@ -1278,8 +1373,11 @@ class Pipeline:
         """Return the diagnostics' statuses (each contact's report starts a new rate window)."""
         twists = tuple((f"twists/{key}", str(v)) for key, v in self.kinematics_counts.items())
         if self._ekf is not None:  # the estimator's state, shared by the contacts
+            slope = ((("friction_estimation/k0", f"{self._ekf.k0:.6g}"),
+                      ("friction_estimation/sigma_k0", f"{self._ekf.sigma_k0:.3g}"))
+                     if isinstance(self._ekf, FrictionSlopeEkf) else ())
             twists += (("friction_estimation/mu", f"{self._ekf.mu:.6g}"),
-                       ("friction_estimation/sigma", f"{self._ekf.sigma:.3g}")) + tuple(
+                       ("friction_estimation/sigma", f"{self._ekf.sigma:.3g}")) + slope + tuple(
                 (f"friction_estimation/{key}", str(v))
                 for key, v in self.estimation_counts.items()) + tuple(
                 (f"measured_wrench/{key}", str(v)) for key, v in self.wrench_counts.items())

@@ -840,6 +840,127 @@ def adhesion_truth_text() -> str:
     return "\n".join(lines) + "\n"
 
 
+#: contaminated_rig's truth (also in its params file, section ``truth``): the modified FastSim's
+#: alpha_inf and beta, the steps of mu_s and of k0 (from t, value: each steps while the other
+#: holds), the spell of pure rolling (neither observable), the load cell's noise and its seed
+CONTAMINATED_REDUCTION = {"slope_reduction_alpha_inf": 0.5, "slope_reduction_beta": 0.3}
+CONTAMINATED_MU_STEPS = ((0.0, 0.4), (2.0, 0.25))
+CONTAMINATED_K0_STEPS = ((0.0, 0.6), (1.0, 0.35), (3.0, 0.6))
+CONTAMINATED_ROLLING = ((0.5, 0.8),)
+CONTAMINATED_NOISE = 250.0
+CONTAMINATED_SEED = 47
+#: the creepage's sweep: log-uniform from XI_LOW to XI_HIGH and back in SWEEP_PERIOD s
+CONTAMINATED_XI_LOW, CONTAMINATED_XI_HIGH, CONTAMINATED_SWEEP_PERIOD = 3.0e-4, 6.0e-2, 0.2
+
+
+def stepped(steps: tuple[tuple[float, float], ...], t: float) -> float:
+    """Return the value at ``t`` (s) of a staircase ``((from, value), ...)``."""
+    return [v for start, v in steps if t >= start][-1]
+
+
+def contaminated_xi(t: float) -> float:
+    """Return contaminated_rig's creepage at ``t`` (s): a log sweep up and down, a rolling spell.
+
+    From :data:`CONTAMINATED_XI_LOW` (the linear range: only k0 observable)
+    to :data:`CONTAMINATED_XI_HIGH` (full slip: only mu_s) and back in
+    :data:`CONTAMINATED_SWEEP_PERIOD`, through the knee (both) twice a
+    sweep; 0 (pure rolling: neither) in :data:`CONTAMINATED_ROLLING`.
+    """
+    if any(a <= t < b for a, b in CONTAMINATED_ROLLING):
+        return 0.0
+    phase = (t % CONTAMINATED_SWEEP_PERIOD) / CONTAMINATED_SWEEP_PERIOD
+    up = 2.0 * phase if phase < 0.5 else 2.0 * (1.0 - phase)
+    return CONTAMINATED_XI_LOW * (CONTAMINATED_XI_HIGH / CONTAMINATED_XI_LOW) ** up
+
+
+def contaminated_rig() -> tuple[Bag, dict[str, Any]]:
+    """Build (i): a traction rig on a contaminated rail, mu_s and the slope reduction stepping.
+
+    adhesion_rig's wheelset (Hertzian treads, 50 kN each, 20 x 20 cells,
+    20 m/s, 100 Hz), 4 s, the creepage of :func:`contaminated_xi`; the
+    measured wrench the modified FastSim's (the calibrated MAE under
+    Coulomb's law at ``mu_s`` with the reduction ``k0``,
+    :data:`CONTAMINATED_REDUCTION`'s ``alpha_inf`` and ``beta``: the
+    estimator's own model, :class:`~fastsim_ros.estimation.CreepModel`
+    without the knee factor) on the patches and creepages the node converts
+    from these messages, ``mu_s`` and ``k0`` stepping at different times
+    (:data:`CONTAMINATED_MU_STEPS`, :data:`CONTAMINATED_K0_STEPS`), plus a
+    load cell's Gaussian noise of 250 N on ``force.x`` (seeded).
+    """
+    from fastsim_ros.contact.slope_reduction import SlopeReduction
+    from fastsim_ros.estimation import ContactSample, CreepModel
+    from fastsim_ros.estimation.model import solver_for
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+
+    dur, v0 = 4.0, 20.0
+    bag = Bag("contaminated_rig")
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/measured_wrench", WRENCH)
+    for c in ("left", "right"):
+        bag.topic(f"/contact/{c}/patch", CLOUD)
+    area = hertz_area(R, 0.3, 5.0e4, 20)
+    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
+           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
+    converter = Pipeline(PipelineConfig.from_values(dict(BASE_PARAMS, method="mae_calibrated")))
+    solver = solver_for("mae_calibrated", NU, G)
+    twists = {}
+    for t in twist_times(dur):
+        msg = twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, contaminated_xi(t), R), 0))
+        twists[stamp_ns(t)] = msg
+        bag.add("/wheelset/twist", stamp_ns(t), msg)
+    rng = np.random.default_rng(CONTAMINATED_SEED)
+    for t in patch_times(dur):
+        ns = stamp_ns(t)
+        newest = max(k for k in twists if k <= ns)
+        converter.on_wheel_twist(TYPESTORE.serialize_cdr(twists[newest], TWIST))
+        samples, normal = [], np.zeros(3)
+        for c in ("left", "right"):
+            cloud = cloud_msg(ns, pts[c])
+            out = converter.on_patch(c, TYPESTORE.serialize_cdr(cloud, CLOUD))
+            assert out.status == "solved", out.status
+            p, cr = out.patch, out.creepage
+            samples.append(ContactSample(p.pressure, p.x0, p.y0, p.dx, p.dy, cr.xi, cr.eta,
+                                         cr.phi, cr.speed,
+                                         ((p.frame.axes[0][0], p.frame.axes[1][0]),)))
+            normal += p.frame.to_wheelset((0.0, 0.0, p.load))
+            bag.add(f"/contact/{c}/patch", ns, cloud)
+        model = CreepModel(solver, knee=False, reduction=SlopeReduction(
+            stepped(CONTAMINATED_K0_STEPS, t),
+            CONTAMINATED_REDUCTION["slope_reduction_alpha_inf"],
+            CONTAMINATED_REDUCTION["slope_reduction_beta"]))
+        fx = float(model.predict(samples, stepped(CONTAMINATED_MU_STEPS, t))[0]) + normal[0]
+        w = T[WRENCH](
+            header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
+                force=vec((fx + rng.normal(0.0, CONTAMINATED_NOISE), 0.0, normal[2])),
+                torque=vec((0.0, 0.0, 0.0))))
+        bag.add("/wheelset/measured_wrench", ns, w)
+    return bag, {"method": "mae_calibrated", "friction_coefficient": 0.3,
+                 "slope_reduction_k0": 0.8, **CONTAMINATED_REDUCTION,
+                 "friction_estimation": "on", "friction_estimate_slope_reduction": True,
+                 "friction_measurement_noise": CONTAMINATED_NOISE,
+                 "friction_estimate_sigma": 0.1, "friction_slope_sigma": 0.2}
+
+
+def contaminated_truth_text() -> str:
+    """Return the ``truth`` section of contaminated_rig's params file (tests read it)."""
+    lines = ["# The truth the measured wrench was made from (scripts/make_bags.py; no node of",
+             "# this name: the tests read it): the calibrated MAE under Coulomb's law with the",
+             "# modified FastSim's reduction (alpha_inf, beta below), mu_s = mu_static[i] from",
+             "# t = mu_from[i] s and k0 = k0[i] from t = k0_from[i] s (after the first stamp),",
+             "# pure rolling (neither observable) in the spells, the load cell's noise (N).",
+             "truth:", "  ros__parameters:", '    solver: "mae_calibrated"',
+             '    friction_law: "constant"']
+    lines += [f"    {k}: {_yaml_value(v)}" for k, v in CONTAMINATED_REDUCTION.items()]
+    lines += [f"    mu_from: {_yaml_value([float(a) for a, _ in CONTAMINATED_MU_STEPS])}",
+              f"    mu_static: {_yaml_value([float(m) for _, m in CONTAMINATED_MU_STEPS])}",
+              f"    k0_from: {_yaml_value([float(a) for a, _ in CONTAMINATED_K0_STEPS])}",
+              f"    k0: {_yaml_value([float(m) for _, m in CONTAMINATED_K0_STEPS])}",
+              f"    rolling_from: {_yaml_value([float(a) for a, _ in CONTAMINATED_ROLLING])}",
+              f"    rolling_to: {_yaml_value([float(b) for _, b in CONTAMINATED_ROLLING])}",
+              f"    load_cell_noise: {_yaml_value(CONTAMINATED_NOISE)}"]
+    return "\n".join(lines) + "\n"
+
+
 # ------------------------------------------------------------------ params, main
 
 SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
@@ -851,6 +972,7 @@ SCENARIOS: dict[str, Callable[[], tuple[Bag, dict[str, Any]]]] = {
     "mbench_a22": mbench_a22,
     "transient_step": transient_step,
     "adhesion_rig": adhesion_rig,
+    "contaminated_rig": contaminated_rig,
 }
 
 BASE_PARAMS: dict[str, Any] = {
@@ -906,7 +1028,9 @@ def build(name: str, out: Path) -> Path:
     params = dict(BASE_PARAMS, **extra)
     path = bag.write(out)
     (out / f"{name}.params.yaml").write_text(
-        params_text(name, params) + (adhesion_truth_text() if name == "adhesion_rig" else ""))
+        params_text(name, params) + (adhesion_truth_text() if name == "adhesion_rig" else
+                                     contaminated_truth_text() if name == "contaminated_rig"
+                                     else ""))
     if bag.tags:
         outcomes = classify_bag(path, params)
         for contact in sorted({c for c, _, _ in outcomes}):

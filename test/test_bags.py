@@ -42,6 +42,10 @@ EXPECTED = {
                    "/wheelset/pose": (POSE, 21)},
     "adhesion_rig": {"/wheelset/twist": (TWIST, 800), "/wheelset/measured_wrench": (WRENCH, 400),
                      "/contact/left/patch": (CLOUD, 400), "/contact/right/patch": (CLOUD, 400)},
+    "contaminated_rig": {"/wheelset/twist": (TWIST, 800),
+                         "/wheelset/measured_wrench": (WRENCH, 400),
+                         "/contact/left/patch": (CLOUD, 400),
+                         "/contact/right/patch": (CLOUD, 400)},
 }
 #: made from hundreds of exact solves (seconds): shipped, never rebuilt by the tests
 SLOW = ("adhesion_rig",)
@@ -225,7 +229,8 @@ def _check_layout(msg):
 
 
 #: the bags of hand-made patches (20 to 30 cells a side); flange_shift's come from profiles
-SYNTHETIC = ("hertz_ramp", "semi_ellipses_spin", "roller_rig", "adhesion_rig")
+SYNTHETIC = ("hertz_ramp", "semi_ellipses_spin", "roller_rig", "adhesion_rig",
+             "contaminated_rig")
 
 
 @pytest.mark.parametrize("name", [n for n in sorted(EXPECTED)

@@ -19,7 +19,7 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import friction_law
 from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
-from fastsim_ros.estimation.ekf import UNOBSERVABLE, UPDATED
+from fastsim_ros.estimation.ekf import UNOBSERVABLE, UPDATED, FrictionSlopeEkf
 from fastsim_ros.estimation.fit import fit_friction
 
 NU, G = 0.28, 8.0e10
@@ -995,3 +995,113 @@ def test_a_patch_too_fine_for_the_default_exact_model_is_one_line(capsys, tmp_pa
                      "--b", "4e-3", "--load", "5e4", "--cells", "200"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "estimate's exact model (the default) takes at most" in err
+
+
+# ----------------------------------------------------------- mu_s and the slope reduction's k0
+
+def linear_model(a_mu: float, a_k0: float):
+    """Return a model ``h = a_mu mu + a_k0 k0`` (N) and its slopes."""
+    return lambda mu, k0: a_mu * mu + a_k0 * k0
+
+
+def test_two_state_update_with_both_observable_is_the_kalman_filters():
+    """Both sensitivities above the threshold: K = P H / (H P H + R), Joseph-form P."""
+    ekf = FrictionSlopeEkf(0.3, 0.6, 0.1, 0.2, process_noise=0.0, process_noise_k0=0.0,
+                           measurement_noise=NOISE)
+    h = np.array([0.5 * LOAD, 0.3 * LOAD])
+    model = linear_model(*h)
+    z = model(0.35, 0.5)
+    step = ekf.update(z, model, LOAD)
+    p = np.diag([0.01, 0.04])
+    s = h @ p @ h + NOISE ** 2
+    k = p @ h / s
+    want = np.array([0.3, 0.6]) + k * (z - model(0.3, 0.6))
+    assert step.status == UPDATED and step.updated == "mu+k0" and not step.step_seen
+    assert (ekf.mu, ekf.k0) == pytest.approx(tuple(want), rel=1e-6)
+    a = np.eye(2) - np.outer(k, h)
+    assert ekf.P == pytest.approx(a @ p @ a.T + NOISE ** 2 * np.outer(k, k), rel=1e-5)
+
+
+def test_an_unobservable_state_is_frozen_and_its_variance_grows():
+    """The linear range (dh/dmu_s ~ 0): mu_s holds to the bit, k0 moves; sigma_mu grows by q dt."""
+    ekf = FrictionSlopeEkf(0.3, 0.6, 0.1, 0.2, process_noise=1e-3, process_noise_k0=0.0,
+                           measurement_noise=NOISE, min_sensitivity=0.02)
+    model = linear_model(0.001 * LOAD, 0.3 * LOAD)  # r_mu = 0.001: below the threshold
+    rng = np.random.default_rng(3)
+    sigmas = []
+    for _ in range(50):
+        ekf.predict(0.01)
+        step = ekf.update(model(0.3, 0.5) + rng.normal(0.0, NOISE), model, LOAD)
+        assert step.updated == "k0" and ekf.mu == 0.3
+        sigmas.append(ekf.sigma)
+    assert np.all(np.diff(sigmas) > 0.0)
+    assert abs(ekf.k0 - 0.5) < 3.0 * ekf.sigma_k0 and ekf.sigma_k0 < 0.01
+
+
+def test_neither_observable_holds_both_estimates_to_the_bit():
+    """Pure rolling (no creep force depends on either): no update, both held, sigmas grow."""
+    ekf = FrictionSlopeEkf(0.3, 0.6, 0.05, 0.05, process_noise=1e-3, process_noise_k0=1e-3,
+                           measurement_noise=NOISE)
+    before = (ekf.mu, ekf.k0, ekf.sigma, ekf.sigma_k0)
+    ekf.predict(0.01)
+    step = ekf.update(2.0 * NOISE, lambda mu, k0: 0.0, LOAD)
+    assert step.status == UNOBSERVABLE and step.updated == ""
+    assert (ekf.mu, ekf.k0) == before[:2]
+    assert ekf.sigma > before[2] and ekf.sigma_k0 > before[3] and ekf.skipped == 1
+
+
+def test_a_step_in_full_slip_moves_mu_alone():
+    """Full slip (dh/dk0 = 0): a step of mu_s opens the gate and is taken within a cycle."""
+    ekf = FrictionSlopeEkf(0.4, 0.6, 0.002, 0.01, process_noise=0.0, process_noise_k0=0.0,
+                           measurement_noise=NOISE)
+    model = linear_model(0.9 * LOAD, 0.0)
+    step = ekf.update(model(0.25, 0.6), model, LOAD)
+    assert step.step_seen and step.updated == "mu" and ekf.steps == 1
+    assert ekf.mu == pytest.approx(0.25, rel=0.01) and ekf.k0 == 0.6
+
+
+def test_on_the_modified_fastsim_mu_and_k0_are_recovered(hertz):
+    """The CreepModel under the reduction as measurement: a sweep through the knee finds both."""
+    from fastsim_ros.contact.slope_reduction import SlopeReduction
+    solver = CalibratedMaeSolver(0.28, 8e10)
+
+    def model_at(mu, k0, xi):
+        creep = CreepModel(solver, knee=False, reduction=SlopeReduction(k0, 0.5, 0.3))
+        sample = ContactSample(hertz.pressure, hertz.x0, hertz.y0, hertz.dx, hertz.dy, xi,
+                               0.0, 0.0, 20.0, ((1.0, 0.0),))
+        return float(creep.predict([sample], mu)[0])
+    ekf = FrictionSlopeEkf(0.3, 0.8, 0.1, 0.2, process_noise=0.0, process_noise_k0=0.0,
+                           measurement_noise=100.0)
+    rng = np.random.default_rng(7)
+    load = hertz.load
+    for xi in np.tile(np.geomspace(3e-4, 6e-2, 12), 4):
+        ekf.update(model_at(0.35, 0.45, xi) + rng.normal(0.0, 100.0),
+                   lambda mu, k0, xi=xi: model_at(mu, k0, xi), load)
+    assert abs(ekf.mu - 0.35) < 0.01 * 0.35 and abs(ekf.k0 - 0.45) < 0.03 * 0.45
+    assert abs(ekf.mu - 0.35) < 3.0 * ekf.sigma and abs(ekf.k0 - 0.45) < 3.0 * ekf.sigma_k0
+    assert -1.0 <= ekf.correlation <= 1.0
+
+
+@pytest.mark.parametrize("values, match", [
+    ({"friction_estimate_slope_reduction": True, "method": "polach"}, "method"),
+    ({"friction_estimate_slope_reduction": True, "rolling": "transient"}, "rolling")])
+def test_the_slope_estimate_refuses_what_the_reduction_refuses(values, match):
+    from fastsim_ros.params import ParameterError, checked
+    with pytest.raises(ParameterError, match=match):
+        checked(values)
+
+
+def test_without_the_slope_estimate_the_pipeline_is_unchanged():
+    """Off (the default): the one-state filter, no slope topic; on: the two-state one."""
+    from fastsim_ros.pipeline import SLOPE_ESTIMATE_TOPIC, Pipeline, PipelineConfig
+    base = {"contacts": ["left"], "friction_estimation": "on"}
+    off = Pipeline(PipelineConfig.from_values(base))
+    assert isinstance(off._ekf, FrictionEkf) and SLOPE_ESTIMATE_TOPIC not in off.outputs()
+    on = Pipeline(PipelineConfig.from_values(dict(
+        base, friction_estimate_slope_reduction=True, slope_reduction_k0=0.7)))
+    assert isinstance(on._ekf, FrictionSlopeEkf) and SLOPE_ESTIMATE_TOPIC in on.outputs()
+    assert on._ekf.k0 == 0.7
+    on.update({"slope_reduction_k0": 0.5, "friction_slope_sigma": 0.05})
+    assert on._ekf.k0 == 0.5 and on._ekf.sigma_k0 == pytest.approx(0.05)
+    with pytest.raises(Exception, match="start only"):
+        on.update({"friction_estimate_slope_reduction": False})

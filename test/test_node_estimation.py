@@ -5,12 +5,16 @@ until the node counted both, then the patch; the node's ``friction/estimate``
 and wrenches must equal those of an in-process :class:`~fastsim_ros.pipeline.
 Pipeline` fed the same messages in the same order (the replay's code), and
 the estimate must move towards the friction the measurement came from.
-The bag ``adhesion_rig`` (the exact theory's forces) played to the node: its
-estimates and wrenches equal the offline replay's.
+The bags ``adhesion_rig`` (the exact theory's forces) and
+``contaminated_rig`` (the modified FastSim's, mu_s and the slope
+reduction's k0 estimated together) played to the node: its estimates and
+wrenches equal the offline replay's, and on contaminated_rig meet the
+truth's targets.
 """
 
 import numpy as np
 import pytest
+import yaml
 from geometry_msgs.msg import Vector3Stamped, WrenchStamped
 from rclpy.serialization import deserialize_message
 from rosbags.rosbag2 import Reader
@@ -87,14 +91,14 @@ def test_node_estimates_as_the_pipeline_does(tmp_path):
         proc.stop()
 
 
-def offline_estimates(out):
-    """Return {stamp: (mu, sigma, utilisation)} and {(contact, stamp): Fx} of the replay."""
-    assert replay.main([str(BAGS / "adhesion_rig"), "-o", str(out), "--params",
-                        str(BAGS / "adhesion_rig.params.yaml"), "--no-progress"]) == 0
+def offline_estimates(out, name="adhesion_rig", topic="/friction/estimate"):
+    """Return {stamp: topic's (x, y, z)} and {(contact, stamp): Fx} of the replay of ``name``."""
+    assert replay.main([str(BAGS / name), "-o", str(out), "--params",
+                        str(BAGS / f"{name}.params.yaml"), "--no-progress"]) == 0
     estimates, fx = {}, {}
-    with Reader(out / "adhesion_rig") as reader:
+    with Reader(out / name) as reader:
         for conn, _, raw in reader.messages():
-            if conn.topic == "/friction/estimate":
+            if conn.topic == topic:
                 m = deserialize_message(raw, Vector3Stamped)
                 estimates[stamp_ns(m)] = (m.vector.x, m.vector.y, m.vector.z)
             elif conn.topic.startswith("/contact/") and conn.topic.endswith("/wrench"):
@@ -152,3 +156,83 @@ def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
     assert got_fx.keys() == want_fx.keys()
     for key, value in want_fx.items():
         assert got_fx[key] == pytest.approx(value, rel=1e-12), key
+
+
+def test_node_fed_contaminated_rig_estimates_mu_and_k0_as_the_replay_does(tmp_path):
+    """contaminated_rig over DDS: friction/estimate and friction/slope_estimate as the replay's.
+
+    The node's estimates of mu_s and k0 equal the replay's to 1e-12 at every
+    cycle, and meet the bag's targets: from 0.2 s after each step to the
+    next, mu_s within 2% and k0 within 5% of the truth, 2 sigma covering it
+    at least 95% of the time.
+    """
+    want_mu, want_fx = offline_estimates(tmp_path / "offline", "contaminated_rig")
+    want_k0, _ = offline_estimates(tmp_path / "offline_k0", "contaminated_rig",
+                                   "/friction/slope_estimate")
+    with Reader(BAGS / "contaminated_rig") as reader:
+        messages = [(conn.topic, bytes(raw)) for conn, _, raw in reader.messages()]
+    first = [m for m in messages if m[0].endswith(("/twist", "/measured_wrench"))]
+    patches = [m for m in messages if m[0].endswith("/patch")]
+    assert len(first) + len(patches) == len(messages) and len(first) <= 2 * TWIST_HISTORY
+    wrenches = sum(m[0].endswith("/measured_wrench") for m in first)
+    proc = NodeProcess("--params-file", str(BAGS / "contaminated_rig.params.yaml"),
+                       "-p", "patch_reliability:=reliable", "-p", "qos_depth:=1000",
+                       log_dir=tmp_path)
+    client = Client(("left", "right"), name="player")
+    try:
+        pubs = {"/wheelset/twist": client.twist,
+                "/wheelset/measured_wrench": client.publisher(WrenchStamped,
+                                                              "wheelset/measured_wrench")}
+        pubs.update({f"/contact/{c}/patch": p for c, p in client.patch.items()})
+        estimates = client.subscribe(Vector3Stamped, "friction/estimate")
+        slopes = client.subscribe(Vector3Stamped, "friction/slope_estimate")
+        client.wait_connected(proc)
+        for topic, raw in first:
+            pubs[topic].publish(raw)
+        client.wait_twists_handled(len(first) - wrenches)
+        assert client.wait_for(lambda: int(client.diagnostic_values("left").get(
+            "friction_estimation/measured", "0")) >= wrenches, 20.0)
+        for k in range(0, len(patches), 2):  # a cycle at a time: both patches, then its estimate
+            for topic, raw in patches[k:k + 2]:
+                pubs[topic].publish(raw)
+            assert client.wait_for(lambda k=k: len(estimates) >= k // 2 + 1
+                                   and len(slopes) >= k // 2 + 1, 10.0)
+        got_mu = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in estimates}
+        got_k0 = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in slopes}
+        last_k0 = got_k0[max(got_k0)][0]
+        assert client.wait_for(lambda: client.diagnostic_values("left").get(
+            "friction_estimation/k0") == f"{last_k0:.6g}", 20.0)
+        got_fx = {(c, stamp_ns(w)): w.wrench.force.x for c, ws in client.wrenches.items()
+                  for w in ws}
+    finally:
+        client.close()
+        assert proc.stop() == 0
+    assert len(want_mu) == len(want_k0) == 400
+    assert got_mu.keys() == want_mu.keys() and got_k0.keys() == want_k0.keys()
+    for stamp in want_mu:
+        assert got_mu[stamp] == pytest.approx(want_mu[stamp], rel=1e-12), stamp
+        assert got_k0[stamp] == pytest.approx(want_k0[stamp], rel=1e-12), stamp
+    assert got_fx.keys() == want_fx.keys()
+    for key, value in want_fx.items():
+        assert got_fx[key] == pytest.approx(value, rel=1e-12), key
+    # the targets, on the node's own estimates
+    truth = yaml.safe_load((BAGS / "contaminated_rig.params.yaml").read_text())
+    truth = truth["truth"]["ros__parameters"]
+    stamps = sorted(got_mu)
+    t = (np.array(stamps) - stamps[0] + 2_500_000) * 1e-9
+    events = sorted(set(truth["mu_from"]) | set(truth["k0_from"]) | set(truth["rolling_to"]))
+    settled = [x >= max(e for e in events if e <= x) + 0.2 for x in t]
+    errors = {"mu": [], "k0": []}
+    covered = {"mu": [], "k0": []}
+    for x, stamp, ok in zip(t, stamps, settled):
+        if not ok:
+            continue
+        for key, got, values in (("mu", got_mu, truth["mu_static"]),
+                                 ("k0", got_k0, truth["k0"])):
+            true = [v for a, v in zip(truth[f"{key}_from"], values) if x >= a][-1]
+            est, sigma, _ = got[stamp]
+            errors[key].append(abs(est - true) / true)
+            covered[key].append(abs(est - true) <= 2.0 * sigma)
+    assert len(errors["mu"]) >= 250
+    assert max(errors["mu"]) < 0.02 and max(errors["k0"]) < 0.05
+    assert np.mean(covered["mu"]) >= 0.95 and np.mean(covered["k0"]) >= 0.95

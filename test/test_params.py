@@ -59,10 +59,12 @@ def test_methods_and_the_default():
 def test_bag_parameter_files_load(path):
     # the bags' golden outputs are their method's: each file names it explicitly (the
     # paper's MAE, but mbench_a22: the default method of the benchmark's report, and
-    # adhesion_rig: the friction estimator's model, validated in docs/validation_estimation.md)
+    # adhesion_rig: the friction estimator's model, validated in docs/validation_estimation.md,
+    # and contaminated_rig: the modified FastSim its measured wrench was made with)
     load_params_file(path)
     assert '    method: "mae"' in path.read_text() or (
-        path.name in ("mbench_a22.params.yaml", "adhesion_rig.params.yaml")
+        path.name in ("mbench_a22.params.yaml", "adhesion_rig.params.yaml",
+                      "contaminated_rig.params.yaml")
         and '    method: "mae_calibrated"' in path.read_text())
 
 

@@ -316,3 +316,192 @@ class FrictionEkf:
         self.updates += 1
         return EkfStep(UPDATED, mu0, sigma0, self.mu, self.sigma, slope, sensitivity,
                        innovation, step_seen, g, self.model_bound)
+
+
+class SlopeEkfStep(NamedTuple):
+    """One update of :class:`FrictionSlopeEkf`: status, estimates, sigmas, sensitivities.
+
+    ``status``: :data:`UPDATED` (one state or both moved) or
+    :data:`UNOBSERVABLE` (neither: held); ``mu``, ``k0`` and their sigmas
+    after the update; ``sensitivity_mu`` ``|dh/dmu_s| / N`` and
+    ``sensitivity_k0`` ``|dh/dk0| / N``; ``updated``: which states moved
+    (``"mu"``, ``"k0"``, ``"mu+k0"`` or ``""``); ``step_seen``: the step
+    gate opened; ``innovation`` (N).
+    """
+
+    status: str
+    mu: float
+    k0: float
+    sigma_mu: float
+    sigma_k0: float
+    sensitivity_mu: float
+    sensitivity_k0: float
+    updated: str
+    step_seen: bool
+    innovation: float
+
+
+class FrictionSlopeEkf:
+    """Extended Kalman filter on ``(mu_s, k0)``: friction and the creep-slope reduction.
+
+    State ``x = (mu_s, k0)``: the static coefficient and the modified
+    FastSim's slope reduction at vanishing creepage
+    (:class:`~fastsim_ros.contact.slope_reduction.SlopeReduction`, its
+    ``alpha_inf`` and ``beta`` held at configured values), each a random
+    walk (``q_mu``, ``q_k0`` in 1/s).  Measurement: ``z = h(mu_s, k0) + v``,
+    ``h`` the solver under that reduction, ``v`` the load cell's noise
+    (:attr:`measurement_noise`, N, white).  ``H = (dh/dmu_s, dh/dk0)`` by
+    forward differences (one solve per contact each, beyond the one at the
+    prior).
+
+    Observability.  In the linear range FastSim's force is ``k C w``: it
+    fixes ``k0`` (``dh/dk0 = h / k0``, sizeable) and not ``mu_s``
+    (``dh/dmu_s ~ 0``); in full slip it is ``mu N``: ``mu_s`` and not
+    ``k0`` (``dh/dk0 = 0``: every cell on the bound); at the knee both
+    (one component a cycle: the two are told apart as the creepage moves
+    along the curve).  A state whose sensitivity ``|H_i| / N`` is below
+    :attr:`min_sensitivity` is frozen for the cycle: its gain is zero (the
+    Schmidt-Kalman "consider" update: its uncertainty still enters the
+    innovation's variance ``S = H P H^T + R`` and the Joseph-form
+    covariance, ``P+ = (I - K H) P (I - K H)^T + K R K^T``, holds for that
+    gain), so a state the cycle does not inform never drifts with the
+    noise, and its variance grows by ``q dt`` per cycle.  Neither
+    observable: no update at all, the estimates hold to the bit.
+
+    Steps.  An innovation beyond :attr:`step_gate` sigmas of ``sqrt(S)``
+    is a change of the rail: each observable state's variance grows by the
+    square of the step it alone would explain, ``(y / H_i)^2`` (at most
+    ``sigma_max^2``), before the gain: the next cycles, at other creepages,
+    tell which state it was.
+    """
+
+    def __init__(self, mu: float, k0: float, sigma_mu: float, sigma_k0: float, *,
+                 process_noise: float, process_noise_k0: float, measurement_noise: float,
+                 min_sensitivity: float = 0.02, mu_bounds: tuple[float, float] = (0.01, 2.0),
+                 k0_bounds: tuple[float, float] = (0.02, 1.0), sigma_max: float = 1.0,
+                 relative_step: float = 0.01, step_gate: float = 4.0) -> None:
+        for name, (lo, hi) in (("mu_bounds", mu_bounds), ("k0_bounds", k0_bounds)):
+            if not (0.0 < lo < hi and math.isfinite(hi)):
+                raise InvalidInputError(f"{name} must satisfy 0 < low < high, got {(lo, hi)}")
+        self.mu_bounds = (float(mu_bounds[0]), float(mu_bounds[1]))
+        self.k0_bounds = (float(k0_bounds[0]), float(k0_bounds[1]))
+        self.sigma_max = _positive("sigma_max", sigma_max)
+        self.x = np.array([min(max(_positive("mu", mu), self.mu_bounds[0]), self.mu_bounds[1]),
+                           min(max(_positive("k0", k0), self.k0_bounds[0]),
+                               self.k0_bounds[1])])
+        self.P = np.diag([min(_positive("sigma_mu", sigma_mu), self.sigma_max) ** 2,
+                          min(_positive("sigma_k0", sigma_k0), self.sigma_max) ** 2])
+        self.process_noise = _positive("process_noise", process_noise, zero_ok=True)
+        self.process_noise_k0 = _positive("process_noise_k0", process_noise_k0, zero_ok=True)
+        self.measurement_noise = _positive("measurement_noise", measurement_noise)
+        self.min_sensitivity = _positive("min_sensitivity", min_sensitivity, zero_ok=True)
+        self.relative_step = _positive("relative_step", relative_step)
+        self.step_gate = _positive("step_gate", step_gate) if step_gate != math.inf \
+            else math.inf
+        self.updates = 0
+        self.skipped = 0
+        self.steps = 0
+
+    @property
+    def mu(self) -> float:
+        """Return the estimate of ``mu_s``."""
+        return float(self.x[0])
+
+    @property
+    def k0(self) -> float:
+        """Return the estimate of ``k0``."""
+        return float(self.x[1])
+
+    @property
+    def sigma(self) -> float:
+        """Return the standard deviation of ``mu_s``."""
+        return math.sqrt(self.P[0, 0])
+
+    @property
+    def sigma_k0(self) -> float:
+        """Return the standard deviation of ``k0``."""
+        return math.sqrt(self.P[1, 1])
+
+    @property
+    def correlation(self) -> float:
+        """Return the correlation coefficient of the two estimates' errors (1)."""
+        d = math.sqrt(self.P[0, 0] * self.P[1, 1])
+        return float(self.P[0, 1] / d) if d > 0.0 else 0.0
+
+    def restart(self, sigma: float, mu: float | None = None, *, sigma_k0: float | None = None,
+                k0: float | None = None) -> None:
+        """Start again from ``mu``, ``k0`` (None: as they are) with the sigmas given.
+
+        ``sigma_k0`` None: ``k0``'s variance stays; the correlation is dropped.
+        """
+        if mu is not None:
+            self.x[0] = min(max(_positive("mu", mu), self.mu_bounds[0]), self.mu_bounds[1])
+        if k0 is not None:
+            self.x[1] = min(max(_positive("k0", k0), self.k0_bounds[0]), self.k0_bounds[1])
+        var_k0 = self.P[1, 1] if sigma_k0 is None else \
+            min(_positive("sigma_k0", sigma_k0), self.sigma_max) ** 2
+        self.P = np.diag([min(_positive("sigma", sigma), self.sigma_max) ** 2, var_k0])
+
+    def predict(self, dt: float) -> None:
+        """Advance by ``dt`` s: each variance grows by its ``q dt`` (up to ``sigma_max^2``)."""
+        if not (dt >= 0.0 and math.isfinite(dt)):
+            dt = _positive("dt", dt, zero_ok=True)  # raises
+        top = self.sigma_max ** 2
+        self.P[0, 0] = min(self.P[0, 0] + self.process_noise * dt, top)
+        self.P[1, 1] = min(self.P[1, 1] + self.process_noise_k0 * dt, top)
+
+    def update(self, measured: float, model: Callable[[float, float], float],
+               load: float, predicted: float | None = None) -> SlopeEkfStep:
+        """Take one measured component ``measured`` (N) of ``model(mu_s, k0)`` (N).
+
+        ``load``: the cycle's total normal load (N, for the sensitivities);
+        ``predicted``: ``model(mu, k0)`` at the prior if known (saves a solve).
+        """
+        z = float(measured)
+        if not math.isfinite(z):
+            raise InvalidInputError("measured forces must be finite")
+        if not (load > 0.0 and math.isfinite(load)):
+            load = _positive("load", load)
+        mu0, k00 = self.mu, self.k0
+        h0 = float(model(mu0, k00) if predicted is None else predicted)
+        step_mu = self.relative_step * mu0
+        if mu0 + step_mu > self.mu_bounds[1]:
+            step_mu = -step_mu
+        step_k0 = self.relative_step * k00
+        if k00 + step_k0 > self.k0_bounds[1]:
+            step_k0 = -step_k0  # k0 <= 1: stay inside the range the solver takes
+        h = np.array([(float(model(mu0 + step_mu, k00)) - h0) / step_mu,
+                      (float(model(mu0, k00 + step_k0)) - h0) / step_k0])
+        return self._correct(z - h0, h, load)
+
+    def _correct(self, y: float, h: FloatArray, load: float) -> SlopeEkfStep:
+        """Apply the consider update of innovation ``y`` (N), slope ``h`` (class docstring)."""
+        r_mu, r_k0 = abs(h[0]) / load, abs(h[1]) / load
+        observable = np.array([r_mu >= self.min_sensitivity and r_mu > NO_SENSITIVITY,
+                               r_k0 >= self.min_sensitivity and r_k0 > NO_SENSITIVITY])
+        if not observable.any():
+            self.skipped += 1
+            return SlopeEkfStep(UNOBSERVABLE, self.mu, self.k0, self.sigma, self.sigma_k0,
+                                r_mu, r_k0, "", False, y)
+        noise = self.measurement_noise ** 2
+        P = self.P
+        s = float(h @ P @ h) + noise
+        step_seen = abs(y) > self.step_gate * math.sqrt(s)
+        if step_seen:  # the rail changed: each observable state may carry the step
+            top = self.sigma_max ** 2
+            for i in (0, 1):
+                if observable[i]:
+                    P[i, i] = min(P[i, i] + (y / h[i]) ** 2, top)
+            s = float(h @ P @ h) + noise
+            self.steps += 1
+        gain = np.where(observable, (P @ h) / s, 0.0)
+        a = np.eye(2) - np.outer(gain, h)
+        self.P = a @ P @ a.T + noise * np.outer(gain, gain)
+        self.P = 0.5 * (self.P + self.P.T)
+        x = self.x + gain * y
+        self.x = np.array([min(max(x[0], self.mu_bounds[0]), self.mu_bounds[1]),
+                           min(max(x[1], self.k0_bounds[0]), self.k0_bounds[1])])
+        self.updates += 1
+        which = "+".join(n for n, o in zip(("mu", "k0"), observable) if o)
+        return SlopeEkfStep(UPDATED, self.mu, self.k0, self.sigma, self.sigma_k0, r_mu, r_k0,
+                            which, step_seen, y)
