@@ -280,6 +280,7 @@ def main() -> None:
           f"G = {G:g} Pa, nu = {NU}; times in us, median / p99 over {args.calls} calls\n")
     mae = MaeSolver(NU, G)
     calibrated = CalibratedMaeSolver(NU, G)
+    own_knee = CalibratedMaeSolver(NU, G, knee=False)
     baseline = EquivalentEllipseSolver(NU, G)
     transient = TransientSolver(calibrated)
     local = TransientSolver(calibrated, far_field=False)
@@ -292,7 +293,7 @@ def main() -> None:
             f"{'solve_arrays':>13}  {'geometry':>8}{'share':>7}  {'numpy ref':>10}  "
             f"{'equivalent':>13}{'eq/mae':>7}  {'calibrated':>13}{'cal/mae':>8}"
             f"  {'transient':>13}{'tr/cal':>7}  {'local':>6}{'lo/cal':>7}  {'stepping':>13}"
-            f"{'st/cal':>7}")
+            f"{'st/cal':>7}  {'own knee':>13}{'cal/own':>8}")
     print(head)
     print("-" * len(head))
     rates = []
@@ -325,6 +326,7 @@ def main() -> None:
                 "arrays": lambda: mae.solve_arrays(p, *grid, xi, eta, phi, MU),
                 "equivalent": lambda: baseline.solve(ar, xi, eta, phi, mu=MU),
                 "calibrated": lambda: calibrated.solve(ar, xi, eta, phi, mu=MU),
+                "own_knee": lambda: own_knee.solve(ar, xi, eta, phi, mu=MU),
                 "transient": step, "local": step_local, "stepping": stepping}, args.calls)
             t_solve, t_arrays, t_eq = t["solve"], t["arrays"], t["equivalent"]
             t_cal, t_tr = t["calibrated"], t["transient"]
@@ -344,7 +346,9 @@ def main() -> None:
                   f"  {t_tr[0]:>6.1f} /{t_tr[1]:>5.1f}{t_tr[0] / t_cal[0]:>7.2f}"
                   f"  {t['local'][0]:>6.1f}{t['local'][0] / t_cal[0]:>7.2f}"
                   f"  {t['stepping'][0]:>6.1f} /{t['stepping'][1]:>5.1f}"
-                  f"{t['stepping'][0] / t_cal[0]:>7.2f}")
+                  f"{t['stepping'][0] / t_cal[0]:>7.2f}"
+                  f"  {t['own_knee'][0]:>6.1f} /{t['own_knee'][1]:>5.1f}"
+                  f"{t_cal[0] / t['own_knee'][0]:>8.2f}")
             # batches: distinct patches (load and a fore-aft tilt of the pressure vary
             # smoothly from patch to patch, as from a normal solver) and creepages
             b = args.batch
@@ -364,7 +368,9 @@ def main() -> None:
           "cells from the last state\n(the same creepages: the steady state, one sweep), "
           "tr/cal its median over CalibratedMaeSolver.solve's;\nlocal: the same without the "
           "far field (Kalker's local model); stepping: the far field\nwith a creepage step "
-          "every call (its secant every time).\n")
+          "every call (its secant every time); own knee: CalibratedMaeSolver(knee=False).solve "
+          "(FastSim's own knee),\ncal/own: the default's median over it (the cost of the "
+          "strips' knee factors).\n")
     transient_table(args.calls)
     real_rails_table(args.calls, args.grids)
     print(f"batched throughput, patch solves per second on one core (batches of {args.batch})")
