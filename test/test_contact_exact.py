@@ -8,7 +8,7 @@ import scipy.special
 
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact import exact, normal, partial_slip
-from fastsim_ros.contact.errors import GridTooLargeError, InvalidInputError
+from fastsim_ros.contact.errors import ConvergenceError, GridTooLargeError, InvalidInputError
 from fastsim_ros.contact.friction import ExponentialFriction
 from fastsim_ros.contact.traction import rigid_slip
 
@@ -426,3 +426,26 @@ def test_a_steeply_falling_law_converges_by_continuation_in_the_speed():
     assert 0 < np.count_nonzero(sol.slip) < np.count_nonzero(ar.mask)
     assert np.allclose(tau[sol.slip], bound[sol.slip], rtol=1e-3,
                        atol=1e-3 * 0.37 * ar.pressure.max())
+
+
+def test_where_the_whole_area_newton_cycles_the_dense_reference_answers():
+    """The long narrow validation patch at half the saturating eta: the FFT Newton cycles.
+
+    ``coulomb`` then solves with the dense reference (within its cell limit),
+    so the caller gets the answer, not a ConvergenceError.
+    """
+    from fastsim_ros.contact import samples
+    mu, g, nu, load = 0.3, samples.STEEL_G, samples.STEEL_NU, 5.0e4
+    ar = samples.long_narrow_patch(cells=40, scale=0.01, load=load)
+    eta = 0.5 * mu * load / (g * (ar.area / math.pi) * 4.0)
+    op = exact.SteadyRollingOperator.of(ar, nu=nu, shear_modulus=g)
+    with pytest.raises(ConvergenceError, match="did not converge"):
+        partial_slip.solve_area(op, (0.0, eta, 0.0), (0.0, 0.0), mu_s=mu, tol=1e-9)
+    sol = exact.coulomb(ar, 0.0, eta, 0.0, mu=mu, nu=nu, shear_modulus=g, operator=op)
+    dense = exact.coulomb(ar, 0.0, eta, 0.0, mu=mu, nu=nu, shear_modulus=g, solver="dense")
+    assert (sol.fx, sol.fy, sol.mz) == (dense.fx, dense.fy, dense.mz)
+    # partial slip, opposing eta, the bound held
+    assert -mu * load < sol.fy < 0.0
+    assert 0 < np.count_nonzero(sol.slip) < np.count_nonzero(ar.mask)
+    bound = mu * ar.pressure
+    assert np.all(np.hypot(sol.tau_x, sol.tau_y) <= bound * (1 + 1e-6) + 1e-6 * bound.max())
