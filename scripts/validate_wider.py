@@ -232,6 +232,19 @@ def _extrapolated(make: AreaMaker) -> dict[str, float]:
     return out
 
 
+def polach_coefficients(ar: areas.GridArea, tab: Any) -> Any:
+    """Return Polach's coefficients: his forces at vanishing creepage (Kalker's C, kA = kS = 1).
+
+    Full adhesion by a friction coefficient far above any force the unit
+    creepages make (``G`` = 1 Pa on a unit area); Polach has no spin moment,
+    so only ``C11``, ``C22``, ``C23``, ``C13`` are read.
+    """
+    from fastsim_ros.contact.coefficients import coefficients_of_solver
+    pol = PolachSolver(NU, 1.0)
+    return coefficients_of_solver(ar.area, lambda xi, eta, phi: pol.solve(
+        ar, xi, eta, phi, mu=1e9))
+
+
 def coefficients_of(make: AreaMaker) -> dict[str, Any]:
     """Return the linear-range coefficients about each area's origin: exact and the methods."""
     t = coefficient_table(NU)
@@ -246,7 +259,8 @@ def coefficients_of(make: AreaMaker) -> dict[str, Any]:
     for m, f in (("mae_calibrated", calibrated), ("mae", mae_fastsim_coefficients),
                  ("fastrip", fastrip_coefficients), ("ellipse", equivalent_coefficients),
                  ("mae_own", own), ("dlm", lambda a, tab: dlm_coefficients(a, nu=NU)),
-                 ("asm", lambda a, tab: asm_fastsim_coefficients(a, nu=NU))):
+                 ("asm", lambda a, tab: asm_fastsim_coefficients(a, nu=NU)),
+                 ("polach", polach_coefficients)):
         try:
             c = f(ar, t)
             out[m] = {k: getattr(c, k) for k in ("C11", "C22", "C23", "C13")}
@@ -608,7 +622,7 @@ def report(res: dict[str, Any]) -> None:
         for k, m in enumerate(METHODS):
             head = (f"| {name} | {ex['C11']:.3f} | {ex['C22']:.3f} | {ex['C23']:.3f} |"
                     f" {ex['C13']:.3f} |" if k == 0 else "| | | | | |")
-            c = co[m]
+            c = co.get(m)
             if c is None:
                 add(head + f" {LABELS[m]} | n/a | n/a | n/a | n/a |")
                 continue
@@ -1185,6 +1199,12 @@ def main() -> int:
     args = parser.parse_args()
     if args.report_only:
         res = json.loads(DATA.read_text())
+        unit = area_makers(False)
+        for name, entry in res["areas"].items():
+            co = entry["coefficients"]
+            if "polach" not in co:  # a run before Polach's coefficients were computed
+                c = polach_coefficients(unit[name](ONLINE_CELLS), None)
+                co["polach"] = {k: getattr(c, k) for k in ("C11", "C22", "C23", "C13")}
         if "cost_ratio" not in res:
             warm_up()
             res["cost_ratio"] = cost_ratio()
