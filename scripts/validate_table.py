@@ -469,8 +469,9 @@ def report(r: dict[str, Any]) -> str:
             "## The default method along the pose near zero shift",
             "",
             "The right wheel's tread patch at -0.48..-0.44 mm, yaw 0 (a 15 mm long conformal "
-            "patch with a wide end: its longest chord at one end, where MAE's split rules "
-            "once switched), solved as a node every 2 um and through the same pipeline: its "
+            "patch with a wide end: its longest chord at one end, where a split rule that "
+            "switches on a threshold jumps), solved as a node every 2 um and through the same "
+            "pipeline: its "
             "Fx (track frame) changes by at most "
             f"**{100 * step.max():.2f}% of mu N** between shifts 2 um apart "
             f"({int(np.sum(step > 0.005))} changes above 0.5% in {step.size} steps). MAE's "
