@@ -902,8 +902,9 @@ def tractions_knee(out_x, out_y, shape, outer, inner, env, x0, y0, dx, dy, xp, y
     |F_j^st|^2`` within ``[0, 1]``: ``1 + (kappa_j - 1) w_j``.  The knee
     factor is a property of the steady saturation; a strip still building
     up its force after a step is not at its knee (taken at once, the
-    factor overshot the exact transient theory by 5% of mu N during a
-    step's build-up, test_contact_transient), and in the steady state
+    factor puts the force about 5% of mu N beyond the exact transient
+    theory's during a step's build-up: scripts and test_contact_transient
+    measure it), and in the steady state
     ``w_j = 1`` and the forces are the steady solve's.  ``yr``: the strips'
     ``y - yp`` (m).  ``kappa_out`` as :func:`strip_knee`'s.
     """
