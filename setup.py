@@ -11,7 +11,8 @@ setup(
     name=package_name,
     version='0.6.0',
     packages=[package_name, package_name + '.contact', package_name + '.geometry',
-              package_name + '.replay', package_name + '.estimation', 'msg_adapters'],
+              package_name + '.estimation', package_name + '.pipeline', package_name + '.cli',
+              package_name + '.ros', package_name + '.replay', 'msg_adapters'],
     package_data={package_name: ['data/*.csv', 'data/profiles/*', 'data/mbench/*']},
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
@@ -32,8 +33,8 @@ setup(
     entry_points={
         'console_scripts': [
             'fastsim_contact = fastsim_ros.cli:main',
-            'fastsim_node = fastsim_ros.entry:node',
-            'fastsim_lifecycle_node = fastsim_ros.entry:lifecycle_node',
+            'fastsim_node = fastsim_ros.ros.entry:node',
+            'fastsim_lifecycle_node = fastsim_ros.ros.entry:lifecycle_node',
             'fastsim_replay = fastsim_ros.replay:main',
         ],
     },

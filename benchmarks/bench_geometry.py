@@ -46,8 +46,8 @@ from fastsim_ros.geometry.placement import Pose  # noqa: E402
 from fastsim_ros.geometry.planar import planar_grid  # noqa: E402
 from machine import machine  # noqa: E402  (the one machine line of every benchmark)
 from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
-from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
-from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
+from fastsim_ros.pipeline.profiles import ProfilePipeline  # noqa: E402
+from fastsim_ros.cli.wheelset import wheel_twist  # noqa: E402
 from msg_adapters.patch import patch_from_cloud  # noqa: E402
 from msg_adapters.profile_msgs import StampedPose, patch_cloud, quaternion  # noqa: E402
 
@@ -70,7 +70,7 @@ def table_rows(poses: int, per_pose: int, windows: bool = False) -> None:
     ``windows``: the poses drawn inside the table's yaw-refined windows (a
     rig dwelling at a flange's take-over) instead of over A-2.2's range.
     """
-    from fastsim_ros.params import load_params_file
+    from fastsim_ros.ros.params import load_params_file
     from msg_adapters.cdr import StampedTwist
 
     values = load_params_file(ROOT / "config" / "profiles_track_table.yaml")

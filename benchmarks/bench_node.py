@@ -256,7 +256,7 @@ def target_command(target: str, names: list[str], executor: str,
         return [sys.executable, str(FLOOR), "--solve", "--contacts", *names]
     if target == "baseline":  # the node of another checkout's sources (BASELINE)
         return [sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv.pop(1)); "
-                "from fastsim_ros.node import main; sys.exit(main())", str(BASELINE),
+                "from fastsim_ros.ros.node import main; sys.exit(main())", str(BASELINE),
                 "--ros-args", "-p", f"executor:={executor}", "-p",
                 "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]", *node_args]
     return [str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",

@@ -85,7 +85,7 @@ from fastsim_ros.contact import compiled  # noqa: E402
 from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
 from fastsim_ros.contact.compiled import EquivalentEllipseSolver, MaeSolver  # noqa: E402
 from fastsim_ros.contact.friction import friction_law  # noqa: E402
-from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.ros.params import load_params_file  # noqa: E402
 from fastsim_ros.replay import batch  # noqa: E402
 from msg_adapters import patch as patch_adapter  # noqa: E402
 

@@ -3,7 +3,7 @@
 ``rolling: transient`` keeps each contact's traction between cycles
 (:class:`fastsim_ros.contact.transient.ContactMemory`).  Where the state is
 carried over (no reset rule applies, the same grid) the pipeline solves on
-its compiled path (:func:`fastsim_ros.pipeline_kernels.solve_cloud` with the
+its compiled path (:func:`fastsim_ros.pipeline.kernels.solve_cloud` with the
 memory); the resets stay on the Python path.  Three pipelines, two contacts
 (``left``, ``right``) of the 30-cell flange-root patch, the default method, a
 1 kHz rig at 2 m/s (2 mm rolled a cycle), ``xi = 2e-3``: steady rolling,

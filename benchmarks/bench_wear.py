@@ -37,7 +37,7 @@ from fastsim_ros.contact import slip_power
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, MaeSolver, warm_up
 from fastsim_ros.machine import machine
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
-from fastsim_ros.pipeline_kernels import warm_up as warm_pipeline
+from fastsim_ros.pipeline.kernels import warm_up as warm_pipeline
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "test"))
 from ros_messages import cdr, cloud_msg, rolling_twist  # noqa: E402

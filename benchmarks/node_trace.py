@@ -3,7 +3,7 @@
     python benchmarks/node_trace.py OUT.npz [CHECKOUT] --ros-args ...
 
 The node of this checkout's sources (or of ``CHECKOUT``'s), run as its
-console script runs it (``fastsim_ros.node.main``), with four kinds of
+console script runs it (``fastsim_ros.ros.node.main``), with four kinds of
 event recorded on ``time.perf_counter`` (CLOCK_MONOTONIC, the clock of
 every process on the machine, so the driver's send and receive times line
 up with them):
@@ -137,7 +137,7 @@ def main() -> int:
         sys.path.insert(0, str(Path(sys.argv.pop(1)).resolve()))
     else:
         sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from fastsim_ros import node
+    from fastsim_ros.ros import node
     timeline = Timeline()
     install(timeline, node)
     try:

@@ -3,7 +3,7 @@
 Build: ``.venv/bin/python -m sphinx -W -b html docs docs/_build/html`` from the
 package root (``test/test_docs.py`` builds it the same way into a temporary
 directory).  The pages are Markdown (MyST); the parameters table is generated
-at build time from :data:`fastsim_ros.params.PARAMETERS` by ``_ext/params_table.py``.
+at build time from :data:`fastsim_ros.ros.params.PARAMETERS` by ``_ext/params_table.py``.
 """
 
 from __future__ import annotations

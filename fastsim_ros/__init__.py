@@ -34,7 +34,7 @@ def _numba_cache_dir() -> str:
 #: the sources the compiled kernels are built from: numba checks only the time
 #: stamp of the file a kernel is defined in, not of what it compiles in from
 #: elsewhere (``rules.py`` into ``kernels.py``, ``transient.py`` into
-#: ``pipeline_kernels.py``, ``msg_adapters/patch.py``'s constants), so the cache
+#: ``pipeline/kernels.py``, ``msg_adapters/patch.py``'s constants), so the cache
 #: directory this package chooses is keyed on their contents and a changed formula
 #: can never load a stale kernel from it (``test_pipeline_kernels`` checks the list
 #: against the sources: every module with compiled functions, and what they import,
@@ -44,7 +44,7 @@ def _numba_cache_dir() -> str:
 _KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/knee.py",
                    "contact/slip_power.py",
                    "contact/transient.py",
-                   "pipeline_kernels.py", "replay/kernels.py",
+                   "pipeline/kernels.py", "replay/kernels.py",
                    "../msg_adapters/patch_kernels.py", "../msg_adapters/patch.py")
 
 

@@ -1,6 +1,6 @@
 """Atomic file writes: a temporary file beside the target, renamed onto it once complete.
 
-Shared by the command lines and the plots (:mod:`fastsim_ros.cli_wheelset`,
+Shared by the command lines and the plots (:mod:`fastsim_ros.cli.wheelset`,
 :mod:`fastsim_ros.geometry.sweep_plot`), so that a reader never sees a
 half-written file and an interrupted run leaves nothing behind.
 """

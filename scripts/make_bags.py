@@ -406,7 +406,7 @@ def flange_shift() -> tuple[Bag, dict[str, Any]]:
     """
     from fastsim_ros.geometry.placement import Pose
     from fastsim_ros.pipeline import PipelineConfig
-    from fastsim_ros.profile_pipeline import ProfilePipeline, contact_name
+    from fastsim_ros.pipeline.profiles import ProfilePipeline, contact_name
     from msg_adapters.cdr import StampedTwist
 
     dur, v0, hold = 4.0, 20.0, 0.4

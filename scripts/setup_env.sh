@@ -47,4 +47,4 @@ done
     'from fastsim_ros.contact import compiled; compiled.warm_up()
 from msg_adapters import patch; patch.warm_up()
 from fastsim_ros.replay import batch; batch.warm_up()
-from fastsim_ros import pipeline_kernels; pipeline_kernels.warm_up()')
+from fastsim_ros.pipeline import kernels; kernels.warm_up()')

@@ -39,7 +39,8 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from fastsim_ros import cli, cli_wheelset  # noqa: E402
+from fastsim_ros import cli  # noqa: E402
+from fastsim_ros.cli import wheelset as cli_wheelset  # noqa: E402
 from fastsim_ros.contact import exact  # noqa: E402
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402

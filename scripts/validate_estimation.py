@@ -36,7 +36,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from fastsim_ros import params  # noqa: E402
+from fastsim_ros.ros import params  # noqa: E402
 from fastsim_ros.contact import exact  # noqa: E402
 from fastsim_ros.contact.area import ellipse  # noqa: E402
 from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402

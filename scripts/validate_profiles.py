@@ -5,7 +5,7 @@ For both wheels and the 21 poses of A-2.2 (S1002 on UIC60 1:40, shift 0..10
 mm with yaw 0..24 mrad, the poses' roll and axle spin as CONTACT's .inp
 files give them, 10 kN per wheel, V = 2 m/s, mu = 0.3, G = 82 GPa, nu =
 0.28, 0.2 mm cells) the package's profile path
-(:mod:`fastsim_ros.cli_wheelset`, the node's own pipeline) is run with the
+(:mod:`fastsim_ros.cli.wheelset`, the node's own pipeline) is run with the
 exact solver, the calibrated MAE (the default), the paper's MAE and the
 equivalent ellipse, each with its own vertical load balance, and compared
 with CONTACT's published exact results (``fastsim_ros/data/mbench``) and,
@@ -57,7 +57,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 from benchmarks.machine import machine  # noqa: E402  (the one machine line)
 from fastsim_ros import cli  # noqa: E402
-from fastsim_ros.cli_wheelset import result_of, solve_pose, wheel_twist  # noqa: E402
+from fastsim_ros.cli.wheelset import result_of, solve_pose, wheel_twist  # noqa: E402
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.placement import rotation  # noqa: E402
 from msg_adapters.kinematics import creepages  # noqa: E402

@@ -44,7 +44,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
+from fastsim_ros.cli.wheelset import wheel_twist  # noqa: E402
 from fastsim_ros.contact import exact, kernels  # noqa: E402
 from fastsim_ros.contact.area import GridArea  # noqa: E402
 from fastsim_ros.contact import area as areas  # noqa: E402
@@ -54,9 +54,9 @@ from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,  #
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry.wheelset import Pose  # noqa: E402
 from benchmarks.machine import machine  # noqa: E402  (the one machine line)
-from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.ros.params import load_params_file  # noqa: E402
 from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
-from fastsim_ros.profile_pipeline import ProfilePipeline  # noqa: E402
+from fastsim_ros.pipeline.profiles import ProfilePipeline  # noqa: E402
 from msg_adapters.cdr import StampedTwist  # noqa: E402
 from msg_adapters.profile_msgs import StampedPose, quaternion  # noqa: E402
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """The contact table of profiles mode against CONTACT and the per-pose solve: validation_table.md.
 
-Three comparisons, all through :class:`~fastsim_ros.profile_pipeline.ProfilePipeline`
+Three comparisons, all through :class:`~fastsim_ros.pipeline.profiles.ProfilePipeline`
 (the node's own code) with the default method (the calibrated MAE) and the
 table of ``config/profiles_track_table.yaml`` (built into its cache if it is
 not there: a few minutes on 2 cores):
@@ -47,14 +47,14 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.machine import machine  # noqa: E402  (the one machine line)
-from fastsim_ros.cli_wheelset import wheel_twist  # noqa: E402
+from fastsim_ros.cli.wheelset import wheel_twist  # noqa: E402
 from fastsim_ros.geometry import benchmark  # noqa: E402
 from fastsim_ros.geometry import table as table_module  # noqa: E402
 from fastsim_ros.geometry.table import ContactTable, TableGrid, solve_node  # noqa: E402
 from fastsim_ros.geometry.placement import Pose, rotation  # noqa: E402
-from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.ros.params import load_params_file  # noqa: E402
 from fastsim_ros.pipeline import PipelineConfig  # noqa: E402
-from fastsim_ros.profile_pipeline import ProfilePipeline, table_grid_of  # noqa: E402
+from fastsim_ros.pipeline.profiles import ProfilePipeline, table_grid_of  # noqa: E402
 from msg_adapters.cdr import StampedTwist  # noqa: E402
 from msg_adapters.profile_msgs import StampedPose, quaternion  # noqa: E402
 

@@ -309,7 +309,7 @@ def test_seed_methods_forces_saturate_and_refuse_bad_input(capsys, method):
 
 def test_every_tools_defaults_are_the_nodes_and_shown_in_the_help(capsys):
     """One set of defaults, the node's parameters; coefficients' method is the exact theory."""
-    from fastsim_ros.params import SPECS
+    from fastsim_ros.ros.params import SPECS
     parser = cli.build_parser()
     forces = parser.parse_args(["forces", "--shape", "ellipse", "--a", "6e-3", "--b", "4e-3",
                                 "--xi", "0", "--eta", "0", "--phi", "0", "--mu", "0.3"])

@@ -75,7 +75,7 @@ def test_no_correction_is_named_none(capsys, made_by_the_calibrated_mae, extra, 
 
 
 def test_the_defaults_are_the_nodes_and_shown_in_the_help(capsys):
-    from fastsim_ros.params import SPECS
+    from fastsim_ros.ros.params import SPECS
     args = cli.build_parser().parse_args(estimate("m.csv"))
     assert args.mu == SPECS["friction_coefficient"].default
     assert args.nu == SPECS["poisson_ratio"].default

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from fastsim_ros import cli
+from fastsim_ros.cli import patch_files
 from fastsim_ros.contact import area as areas
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "fastsim_ros" / "data" / "example_patch.csv"
@@ -46,7 +47,7 @@ def replaced(argv, **flags):
 
 def scaled_patch(path, length=1.0, pressure=1.0):
     """Write the example patch, its coordinates times ``length``, pressures times ``pressure``."""
-    ar = cli.read_patch(EXAMPLE)
+    ar = patch_files.read_patch(EXAMPLE)
     jj, ii = np.nonzero(ar.mask)
     rows = [f"{float(ar.x[i]) * length!r},{float(ar.y[j]) * length!r},"
             f"{float(ar.pressure[j, i]) * pressure!r}" for j, i in zip(jj, ii)]
@@ -196,7 +197,7 @@ def test_right_uses_give_the_solvers_numbers(capsys, files):
     assert (f["Fx"], f["Fy"], f["Mz"]) == (ref.fx, ref.fy, ref.mz)
     assert f["N"] == pytest.approx(6e4, rel=1e-12)
     f = json.loads(run(capsys, "forces", "--patch", EXAMPLE, *CREEP, "--json")[1])
-    ref = solver.solve(cli.read_patch(EXAMPLE), 1e-3, 0.0, 0.1, mu=0.3)
+    ref = solver.solve(patch_files.read_patch(EXAMPLE), 1e-3, 0.0, 0.1, mu=0.3)
     assert (f["Fx"], f["Fy"], f["Mz"]) == (ref.fx, ref.fy, ref.mz)
     assert f["N"] == pytest.approx(5e4, rel=1e-9)
     # the file in metres and pascals, written back from the scaled one: the same numbers

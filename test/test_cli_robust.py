@@ -17,6 +17,8 @@ import numpy as np
 import pytest
 
 from fastsim_ros import cli
+from fastsim_ros.cli import options, patch_files
+from fastsim_ros.cli.patch import FORCE_KEYS
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.errors import GridTooLargeError
 
@@ -226,7 +228,7 @@ def test_unreadable_patch_files(tmp_path, capsys, monkeypatch):
     assert_refused(*run(capsys, "forces", "--patch", tmp_path / "none.csv", *CREEP),
                    "cannot read patch file")
     assert_refused(*run(capsys, "forces", "--patch", tmp_path, *CREEP), "cannot read patch file")
-    monkeypatch.setattr(cli, "MAX_PATCH_BYTES", 100)
+    monkeypatch.setattr(patch_files, "MAX_PATCH_BYTES", 100)
     path = write(tmp_path / "big.csv", ["x,y,pressure", *cell_rows(hertz())])
     assert_refused(*run(capsys, "forces", "--patch", path, *CREEP), "larger than")
 
@@ -247,13 +249,13 @@ def test_a_stray_cell_far_away_is_refused_by_the_grid_bound(tmp_path, capsys, mo
     path = write(tmp_path / "stray.csv", ["x,y,pressure", *cell_rows(ar), row])
 
     def no_big_arrays(shape, *args, **kwargs):
-        assert int(np.prod(shape)) <= cli.MAX_PATCH_CELLS, "allocated before the bound"
+        assert int(np.prod(shape)) <= patch_files.MAX_PATCH_CELLS, "allocated before the bound"
         return real_zeros(shape, *args, **kwargs)
 
     real_zeros = np.zeros
     monkeypatch.setattr(areas.np, "zeros", no_big_arrays)
     rc, out, err = run(capsys, "forces", "--patch", path, *CREEP)
-    assert_refused(rc, out, err, f"more than the {cli.MAX_PATCH_CELLS:,} allowed")
+    assert_refused(rc, out, err, f"more than the {patch_files.MAX_PATCH_CELLS:,} allowed")
 
 
 def test_grid_bound_of_the_library_is_checked_before_allocation(monkeypatch):
@@ -318,7 +320,7 @@ def test_one_cell_in_contact_gives_valid_json(tmp_path, capsys, method, bound):
                              "--bound", bound, "--json"))
     assert f["N"] == pytest.approx(1e3)
     assert math.hypot(f["Fx"], f["Fy"]) <= 0.3 * f["N"] * (1 + 1e-9)
-    coefficients = method if method in cli.COEFFICIENT_METHODS else "mae"
+    coefficients = method if method in options.COEFFICIENT_METHODS else "mae"
     c = assert_answered(*run(capsys, "coefficients", "--patch", path, "--method",
                              coefficients, "--json"))
     assert c["C11"] > 0.0
@@ -330,12 +332,12 @@ def test_one_cell_in_contact_gives_valid_json(tmp_path, capsys, method, bound):
 @pytest.mark.parametrize("bound", ["given", "parabolic"])
 def test_every_method_gives_the_same_keys(capsys, bound):
     keys = None
-    for method in cli.FORCE_METHODS:
+    for method in options.FORCE_METHODS:
         if method in ("exact", "fastrip") and bound == "parabolic":
             continue
         f = assert_answered(*run(capsys, "forces", "--patch", EXAMPLE, *CREEP, "--method",
                                  method, "--bound", bound, "--json"))
-        common = set(cli.FORCE_KEYS) | {"method", "bound", "cells"}
+        common = set(FORCE_KEYS) | {"method", "bound", "cells"}
         assert common <= f.keys()
         assert 0.0 <= f["slip_fraction"] <= 1.0
         keys = common if keys is None else keys
@@ -347,7 +349,7 @@ def text_keys(out):
     return re.findall(r"(?m)^\s+(\w+) = ", out)
 
 
-@pytest.mark.parametrize("method", cli.FORCE_METHODS)
+@pytest.mark.parametrize("method", options.FORCE_METHODS)
 @pytest.mark.parametrize("area, extra", [
     ("patch", []), ("ellipse", []),
     ("ellipse", ["--friction-law", "exponential", "--friction-limit-ratio", "0.5",
@@ -375,7 +377,7 @@ def test_the_readable_table_carries_every_field_of_the_json(capsys, method, area
                                             ("fastsim_ellipse", "EquivalentEllipseSolver")])
 def test_forces_run_the_compiled_path(capsys, method, solver):
     from fastsim_ros.contact import compiled
-    ar = cli.read_patch(EXAMPLE)
+    ar = patch_files.read_patch(EXAMPLE)
     ref = getattr(compiled, solver)(0.28, 8.0e10).solve(ar, 1e-3, 0.0, 0.1, mu=0.3)
     f = assert_answered(*run(capsys, "forces", "--patch", EXAMPLE, *CREEP, "--method", method,
                              "--json"))

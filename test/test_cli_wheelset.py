@@ -11,11 +11,11 @@ import pytest
 
 from fastsim_ros import cli
 from fastsim_ros.geometry.wheelset import LOAD_TOLERANCE
-from fastsim_ros.profile_pipeline import ProfilePipeline
+from fastsim_ros.pipeline.profiles import ProfilePipeline
 from fastsim_ros.pipeline import PipelineConfig
 from msg_adapters.cdr import StampedTwist
 from msg_adapters.profile_msgs import StampedPose, quaternion
-from fastsim_ros.cli_wheelset import wheel_twist
+from fastsim_ros.cli.wheelset import wheel_twist
 from fastsim_ros.geometry.placement import Pose
 
 
@@ -255,7 +255,7 @@ def test_a_sweep_target_that_cannot_be_written_is_refused_before_the_poses(tmp_p
     It was found after the sweep (minutes on a real one) as an internal error,
     exit 1, and a bad --plot left the CSV written.
     """
-    from fastsim_ros import cli_wheelset
+    from fastsim_ros.cli import wheelset as cli_wheelset
     (tmp_path / "adir.csv").mkdir()
     (tmp_path / "adir.png").mkdir()
 

@@ -118,7 +118,8 @@ SHIFTS = tuple(round(-0.490e-3 + 2e-6 * k, 9) for k in range(6)) + tuple(
 
 @pytest.fixture(scope="module")
 def wheelset_patches() -> list[tuple[GridArea, tuple[float, float, float]]]:
-    from fastsim_ros import cli, cli_wheelset
+    from fastsim_ros import cli
+    from fastsim_ros.cli import wheelset as cli_wheelset
     out = []
     for dy in SHIFTS:
         args = cli.build_parser().parse_args(

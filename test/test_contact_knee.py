@@ -235,7 +235,8 @@ def wheelset_patch(wheel: str, xi: float | None = None):
     sets the axle spin (default: the longitudinal creepage the sweep of
     ``docs/validation_accuracy.md`` has, 4e-4 on the right wheel).
     """
-    from fastsim_ros import cli, cli_wheelset
+    from fastsim_ros import cli
+    from fastsim_ros.cli import wheelset as cli_wheelset
     from fastsim_ros.contact.area import GridArea
     spin = 4.3438 if xi is None else 2.0 * (1.0 - xi / 2.0) / (1.0 + xi / 2.0) / 0.46
     args = cli.build_parser().parse_args(["wheelset", "--dy", "-0.000414", "--yaw", "0",

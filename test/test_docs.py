@@ -2,7 +2,7 @@
 
 The build runs into a temporary directory (``sphinx -W -b html docs OUT``),
 as a user builds it.  The parameters page is generated from
-``fastsim_ros.params.PARAMETERS`` at build time: every declared parameter
+``fastsim_ros.ros.params.PARAMETERS`` at build time: every declared parameter
 appears in it with its default.  Nothing in the repository cites a file
 outside it.
 """
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from fastsim_ros.params import PARAMETERS
+from fastsim_ros.ros.params import PARAMETERS
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
@@ -52,7 +52,7 @@ def test_the_guide_builds_without_warnings(site: Path) -> None:
         assert (site / f"{page}.html").is_file(), page
     api = (site / "api.html").read_text(encoding="utf-8")
     # autodoc read the physics core and a ROS front end (its ROS imports mocked)
-    assert "CalibratedMaeSolver" in api and "fastsim_ros.node" in api
+    assert "CalibratedMaeSolver" in api and "fastsim_ros.ros.node" in api
 
 
 @needs_sphinx

@@ -633,7 +633,7 @@ def test_the_estimate_keeps_to_the_parameters_range_not_a_narrower_one(hertz, mu
 
 def test_estimation_is_taken_in_both_patch_sources():
     # profiles mode too (test_profile_estimation.py runs it)
-    from fastsim_ros.params import checked
+    from fastsim_ros.ros.params import checked
     assert checked({"patch_source": "profiles",
                     "friction_estimation": "on"})["friction_estimation"] == "on"
     assert checked({"friction_estimation": "on"})["friction_estimation"] == "on"
@@ -1086,7 +1086,7 @@ def test_on_the_modified_fastsim_mu_and_k0_are_recovered(hertz):
     ({"friction_estimate_slope_reduction": True, "method": "polach"}, "method"),
     ({"friction_estimate_slope_reduction": True, "rolling": "transient"}, "rolling")])
 def test_the_slope_estimate_refuses_what_the_reduction_refuses(values, match):
-    from fastsim_ros.params import ParameterError, checked
+    from fastsim_ros.ros.params import ParameterError, checked
     with pytest.raises(ParameterError, match=match):
         checked(values)
 

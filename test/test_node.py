@@ -295,7 +295,7 @@ def test_every_bad_input_is_rejected_and_the_next_good_one_served(run_node):
 
 
 def test_throttled_log_builds_no_message_while_suppressed():
-    from fastsim_ros.node import ThrottledLog
+    from fastsim_ros.ros.node import ThrottledLog
 
     class Logger:
         def __init__(self):
@@ -470,7 +470,7 @@ def test_publishers_on_a_patch_topic_of_no_contact_are_named_in_diagnostics(run_
                    for k in client.diagnostic_values("left"))
     # logged once for the topic, however many looks at the graph find it: the node's
     # diagnostics count its time, a look at most every GRAPH_PERIOD
-    from fastsim_ros.node import GRAPH_PERIOD
+    from fastsim_ros.ros.node import GRAPH_PERIOD
     seen, periods = len(client.diagnostics), 2 * math.ceil(GRAPH_PERIOD / DIAGNOSTICS_PERIOD)
     assert client.wait_for(lambda: len(client.diagnostics) >= seen + periods, 30.0)
     assert key in client.diagnostic_values("left")

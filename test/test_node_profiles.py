@@ -242,9 +242,9 @@ def test_a_recorded_rig_replays_to_the_node_as_offline(node, tmp_path):
 def test_the_node_with_the_contact_table_gives_the_pipelines_wrenches(node, tmp_path):
     # a small table (shift -2..2 mm by 1 mm, yaw 0), built by the node at start into a cache
     # of this test's own; the same pipeline in this process reads it from there
-    from fastsim_ros.params import load_params_file
+    from fastsim_ros.ros.params import load_params_file
     from fastsim_ros.pipeline import PipelineConfig
-    from fastsim_ros.profile_pipeline import ProfilePipeline
+    from fastsim_ros.pipeline.profiles import ProfilePipeline
     from msg_adapters.cdr import StampedTwist
     from msg_adapters.profile_msgs import StampedPose
 

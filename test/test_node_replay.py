@@ -22,7 +22,7 @@ from rosbags.rosbag2 import Reader
 from sensor_msgs.msg import PointCloud2
 
 from fastsim_ros import replay
-from fastsim_ros.params import load_params_file
+from fastsim_ros.ros.params import load_params_file
 from fastsim_ros.pipeline import TWIST_HISTORY
 from msg_adapters.cdr import read_cloud, read_twist
 from ros_harness import NODE_SCRIPT, PACKAGE_ROOT, Client, NodeProcess, stamp_ns

@@ -1,6 +1,6 @@
 """Every bad start of the installed ``fastsim_node``: one line naming the parameter, exit 2.
 
-Table-driven over :data:`fastsim_ros.params.PARAMETERS`: each
+Table-driven over :data:`fastsim_ros.ros.params.PARAMETERS`: each
 parameter with a value out of its range or its choices, each kind with a
 value of the wrong type, every profile parameter with a missing file and an
 unreadable one, and the combinations the table cannot state alone
@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-from fastsim_ros.params import PARAMETERS, ParameterSpec
+from fastsim_ros.ros.params import PARAMETERS, ParameterSpec
 from ros_harness import NODE_SCRIPT
 
 pytestmark = pytest.mark.skipif(not NODE_SCRIPT.exists(),
@@ -172,7 +172,7 @@ def test_a_signal_while_the_node_is_importing_ends_it_with_exit_0(signum):
     The console script imported the node's module (rclpy, numpy, numba: about
     half a second) before any handler of the node's was in place: a SIGINT
     printed a KeyboardInterrupt traceback (or rclpy's "C extension isn't
-    present"), a SIGTERM killed the process (-15).  ``fastsim_ros.entry``
+    present"), a SIGTERM killed the process (-15).  ``fastsim_ros.ros.entry``
     imports it with quiet handlers in place.
     """
     proc = subprocess.Popen([str(NODE_SCRIPT), "--ros-args", "-p", "contacts:=[left]"],
@@ -228,7 +228,7 @@ def test_a_refused_construction_destroys_its_half_built_node(managed):
     """
     import rclpy
 
-    from fastsim_ros.node import FastsimLifecycleNode, FastsimNode, StartupError
+    from fastsim_ros.ros.node import FastsimLifecycleNode, FastsimNode, StartupError
 
     with in_process("-p", "wheelset_frame:=[1, 2]", "-p", "executor:=threads",
                     collector=False) as (context, nodes):
@@ -249,7 +249,7 @@ def test_a_destroyed_lifecycle_node_leaves_the_graph_at_once():
     """
     import rclpy
 
-    from fastsim_ros.node import FastsimLifecycleNode
+    from fastsim_ros.ros.node import FastsimLifecycleNode
 
     with in_process(collector=False) as (context, nodes):
         node = FastsimLifecycleNode(context=context)
@@ -270,7 +270,7 @@ def test_a_value_of_the_wrong_type_at_run_time_names_the_parameter_and_its_range
     """
     from rclpy.parameter import Parameter
 
-    from fastsim_ros.node import FastsimLifecycleNode
+    from fastsim_ros.ros.node import FastsimLifecycleNode
 
     with in_process() as (context, nodes):
         node = FastsimLifecycleNode(context=context)

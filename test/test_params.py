@@ -2,8 +2,8 @@
 
 import pytest
 
-from fastsim_ros import params
-from fastsim_ros.params import SPECS, ParameterError, load_params_file
+from fastsim_ros.ros import params
+from fastsim_ros.ros.params import SPECS, ParameterError, load_params_file
 from ros_harness import PACKAGE_ROOT
 
 CONFIG = PACKAGE_ROOT / "config"

@@ -14,7 +14,7 @@ from fastsim_ros.contact import samples
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
 from fastsim_ros.contact.friction import ExponentialFriction, SlopeReduction
 from fastsim_ros.contact.polach import PolachSolver
-from fastsim_ros.params import METHODS, ParameterError
+from fastsim_ros.ros.params import METHODS, ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from ros_messages import WHEEL_RADIUS as R
 from ros_messages import cdr, cloud_msg, contact_normal, in_plane_area, rolling_twist, twist_msg
@@ -560,9 +560,9 @@ def out_values(pipe):
 
 WARM_PATH_PROBE = """
 import numba
-from fastsim_ros import pipeline_kernels
+from fastsim_ros.pipeline import kernels as pipeline_kernels
 from fastsim_ros.contact import compiled, kernels, samples, slip_power
-from fastsim_ros.params import METHODS
+from fastsim_ros.ros.params import METHODS
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from msg_adapters import patch, patch_kernels
 from ros_messages import cdr, cloud_msg, rolling_twist

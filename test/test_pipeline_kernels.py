@@ -1,6 +1,6 @@
 """The pipeline's compiled path gives every number of its Python path, to the bit.
 
-:func:`fastsim_ros.pipeline_kernels.solve_cloud` replaces, for a patch that
+:func:`fastsim_ros.pipeline.kernels.solve_cloud` replaces, for a patch that
 is solved, the adapter's Python checks, the creepages, the solver's wrapper
 and the wheelset wrench: a pipeline with it and one without (the Python
 path alone) are fed the same messages and must give equal outcomes, field by
@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fastsim_ros import pipeline_kernels
+from fastsim_ros.pipeline import kernels as pipeline_kernels
 from fastsim_ros.contact import samples
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from ros_messages import WHEEL_RADIUS as R
@@ -195,7 +195,7 @@ def test_warm_up_compiles_every_words_type():
 def test_the_fast_builders_make_the_dataclasses_own_instances():
     import dataclasses
 
-    from fastsim_ros import pipeline
+    from fastsim_ros.pipeline import steady as pipeline
     from fastsim_ros.contact.compiled import ContactForces
     from msg_adapters.kinematics import Creepage
     from msg_adapters.patch import ContactFrame, ContactPatch
@@ -296,7 +296,7 @@ def test_transient_rolling_on_the_bundled_bags_equals_the_python_path(bag):
 
     from rosbags.highlevel import AnyReader
 
-    from fastsim_ros.params import load_params_file
+    from fastsim_ros.ros.params import load_params_file
     bags = Path(__file__).resolve().parent.parent / "bags"
     values = load_params_file(bags / f"{bag}.params.yaml")
     values["rolling"] = "transient"

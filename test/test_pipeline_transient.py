@@ -6,7 +6,7 @@ import pytest
 from fastsim_ros.contact import area as areas
 from fastsim_ros.contact.compiled import CalibratedMaeSolver
 from fastsim_ros.contact.transient import ContactMemory, TransientSolver
-from fastsim_ros.params import ParameterError
+from fastsim_ros.ros.params import ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from ros_messages import cdr, cloud_msg, in_plane_area, rolling_twist
 

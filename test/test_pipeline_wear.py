@@ -9,7 +9,7 @@ from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import PointCloud2
 
 from fastsim_ros.contact.wear import BURSTOW_RCF, SHEFFIELD_WEAR, t_gamma
-from fastsim_ros.params import METHODS, ParameterError
+from fastsim_ros.ros.params import METHODS, ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
 from msg_adapters import outputs
 from ros_messages import cdr, contact_normal, in_plane_area, rolling_twist, twist_msg

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from fastsim_ros import plausibility
+from fastsim_ros.ros import plausibility
 from fastsim_ros.contact.errors import ContactError, InvalidInputError
-from fastsim_ros.params import SPECS
-from fastsim_ros.plausibility import (PLAUSIBILITY, PLAUSIBLE, ImplausibleValueError, check,
-                                      check_patch, message)
+from fastsim_ros.ros.params import SPECS
+from fastsim_ros.ros.plausibility import (PLAUSIBILITY, PLAUSIBLE, ImplausibleValueError, check,
+                                          check_patch, message)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -122,7 +122,7 @@ def test_a_patch_in_metres_and_pascals_is_plausible_and_a_load_leaves_its_pressu
 
 
 def test_pure_python_without_ros_or_numpy():
-    code = ("import sys, fastsim_ros.plausibility; "
+    code = ("import sys, fastsim_ros.ros.plausibility; "
             "print(sorted(m for m in sys.modules if m.split('.')[0] in "
             "('rclpy', 'numpy', 'scipy', 'numba')))")
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

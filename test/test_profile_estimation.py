@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from fastsim_ros.pipeline import FRICTION_ESTIMATE_TOPIC, MEASURED_WRENCH_TOPIC, PipelineConfig
-from fastsim_ros.profile_pipeline import ProfilePipeline
+from fastsim_ros.pipeline.profiles import ProfilePipeline
 from msg_adapters.cdr import StampedTwist
 from msg_adapters.profile_msgs import StampedPose, quaternion
 

@@ -9,9 +9,9 @@ import pytest
 
 from fastsim_ros.geometry.placement import rotation
 from fastsim_ros.geometry.wheelset import LOAD_TOLERANCE
-from fastsim_ros.params import PROFILE_CONTACTS, ParameterError
+from fastsim_ros.ros.params import PROFILE_CONTACTS, ParameterError
 from fastsim_ros.pipeline import Pipeline, PipelineConfig
-from fastsim_ros.profile_pipeline import BALANCE_TOLERANCE, ProfilePipeline
+from fastsim_ros.pipeline.profiles import BALANCE_TOLERANCE, ProfilePipeline
 from msg_adapters.cdr import StampedTwist
 from msg_adapters.errors import RejectedInput
 from msg_adapters.profile_msgs import StampedPose, quaternion

@@ -7,7 +7,7 @@ import pytest
 
 from fastsim_ros.geometry.placement import rotation
 from fastsim_ros.pipeline import PipelineConfig
-from fastsim_ros.profile_pipeline import ProfilePipeline
+from fastsim_ros.pipeline.profiles import ProfilePipeline
 from msg_adapters.cdr import StampedTwist
 from msg_adapters.profile_msgs import StampedPose, quaternion
 

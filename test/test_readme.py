@@ -15,7 +15,7 @@ exist, the files it names exist, and every ``-p name:=value`` is a declared
 parameter with a value the node accepts.  What a run block prints is checked
 where it carries physics (the friction fit recovers the friction the README's
 curve was made with).  The README's parameter table is checked against the
-declarations in ``fastsim_ros/params.py``, its links against the files.
+declarations in ``fastsim_ros/ros/params.py``, its links against the files.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from fastsim_ros.params import SPECS
+from fastsim_ros.ros.params import SPECS
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"

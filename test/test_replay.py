@@ -41,7 +41,7 @@ from fastsim_ros.replay import batch  # noqa: E402
 from fastsim_ros.contact.compiled import MaeSolver  # noqa: E402
 from fastsim_ros.contact.normal import hertz_ellipse  # noqa: E402
 from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
-from fastsim_ros.params import load_params_file  # noqa: E402
+from fastsim_ros.ros.params import load_params_file  # noqa: E402
 from msg_adapters.cdr import read_cloud  # noqa: E402
 from msg_adapters.errors import REJECTION_REASONS  # noqa: E402
 from msg_adapters.patch import patch_from_cloud  # noqa: E402

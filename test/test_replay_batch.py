@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from fastsim_ros import replay  # noqa: E402
 from fastsim_ros.contact import samples  # noqa: E402
 from fastsim_ros.contact.area import ellipse  # noqa: E402
-from fastsim_ros.params import checked, load_params_file  # noqa: E402
+from fastsim_ros.ros.params import checked, load_params_file  # noqa: E402
 from fastsim_ros.pipeline import InputTopic, Pipeline, PipelineConfig  # noqa: E402
 from fastsim_ros.replay import batch, encode  # noqa: E402
 from msg_adapters import outputs  # noqa: E402

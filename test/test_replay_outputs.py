@@ -287,7 +287,7 @@ def test_patch_topics_of_contacts_not_configured_are_named(tmp_path, path):
 
 
 def _params_of(path):
-    from fastsim_ros.params import load_params_file
+    from fastsim_ros.ros.params import load_params_file
     return load_params_file(path)
 
 

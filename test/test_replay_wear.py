@@ -19,7 +19,7 @@ import yaml
 
 from fastsim_ros import replay
 from fastsim_ros.contact.wear import BURSTOW_RCF, SHEFFIELD_WEAR
-from fastsim_ros.params import load_params_file
+from fastsim_ros.ros.params import load_params_file
 from fastsim_ros.replay.records import WEAR_COLUMNS
 from test_replay import (ATOL, BAGS, RTOL, VECTOR, bag_contents, golden_rows, read_csv_text,
                          run)

@@ -1,7 +1,7 @@
 """Sphinx directive ``fastsim-parameters``: the node's parameters as a table.
 
 The table is built at documentation build time from
-:data:`fastsim_ros.params.PARAMETERS`, the declarations the node and the
+:data:`fastsim_ros.ros.params.PARAMETERS`, the declarations the node and the
 replay check against, so the guide cannot drift from the code.  Options:
 ``:start: prefix`` keeps the parameters whose name starts with one of the
 space-separated prefixes; ``:names: a b c`` keeps those names in that order.
@@ -41,14 +41,14 @@ def _row(cells: list[nodes.Node | str]) -> nodes.row:
 
 
 class ParametersTable(Directive):
-    """Emit the table of ``fastsim_ros.params.PARAMETERS`` (name, type, default, allowed, ...)."""
+    """Emit the table of ``fastsim_ros.ros.params.PARAMETERS`` (name, type, default, ...)."""
 
     has_content = False
     option_spec = {"start": directives.unchanged, "names": directives.unchanged}
 
     def run(self) -> list[nodes.Node]:
         """Build the table node."""
-        from fastsim_ros.params import PARAMETERS, SPECS
+        from fastsim_ros.ros.params import PARAMETERS, SPECS
 
         specs = list(PARAMETERS)
         if "names" in self.options:

@@ -55,8 +55,8 @@ from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import CalibratedMaeSolver, EquivalentEllipseSolver, MaeSolver
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
 from fastsim_ros.contact.friction import friction_law
-from fastsim_ros import plausibility
-from fastsim_ros.params import slope_reduction_of
+from fastsim_ros.ros import plausibility
+from fastsim_ros.ros.params import slope_reduction_of
 from fastsim_ros.pipeline import (FRAME_TOLERANCE, NO_CONTACT, SOLVE_TIME_WINDOW, SOLVED,
                                   TWIST_HISTORY, Pipeline, PipelineConfig, patch_extent)
 from fastsim_ros.replay import kernels
@@ -879,7 +879,7 @@ class Batch:
         patches' rows, pressures and grids).  Its bounds tested on every row
         at once (the grid's span, the largest pressure, the creepages); the
         rows that fail one get the pipeline's own words from
-        :func:`~fastsim_ros.plausibility.stream_problem`.
+        :func:`~fastsim_ros.ros.plausibility.stream_problem`.
         """
         if solved.size == 0:
             return

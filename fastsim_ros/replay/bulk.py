@@ -28,7 +28,7 @@ from rosbags.rosbag2.metadata import dump_qos_v9
 
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, WHEELSET_WRENCH_TOPIC,
                                   Outcome, Pipeline)
-from fastsim_ros.profile_pipeline import AnyPipeline
+from fastsim_ros.pipeline.profiles import AnyPipeline
 from fastsim_ros.replay import bagio, batch, encode, faults, kernels, mcap
 from fastsim_ros.replay.bagio import resolve
 from fastsim_ros.replay.errors import BadInput, McapError

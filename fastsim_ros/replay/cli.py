@@ -11,9 +11,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from fastsim_ros.params import ParameterError, defaults, load_params_file
+from fastsim_ros.ros.params import ParameterError, defaults, load_params_file
 from fastsim_ros.pipeline import PipelineConfig
-from fastsim_ros.profile_pipeline import table_of, wheelset_of
+from fastsim_ros.pipeline.profiles import table_of, wheelset_of
 from fastsim_ros.replay.bagio import input_name
 from fastsim_ros.replay.executors import Executor, InProcess, LocalPool
 from fastsim_ros.replay import storage

@@ -35,12 +35,12 @@ import numpy as np
 from rclpy.serialization import serialize_message
 
 from fastsim_ros.contact.area import turned_grid
-from fastsim_ros.params import SPECS, ParameterError
+from fastsim_ros.ros.params import SPECS, ParameterError
 from fastsim_ros.contact.wear import WearIndicators
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC,
                                   MEASURED_WRENCH_TOPIC, FrictionEstimate, Outcome, Pipeline,
                                   PipelineConfig)
-from fastsim_ros.profile_pipeline import LOAD_TOPIC, POSE_TOPIC, AnyPipeline, make_pipeline
+from fastsim_ros.pipeline.profiles import LOAD_TOPIC, POSE_TOPIC, AnyPipeline, make_pipeline
 from fastsim_ros.replay import bagio, bulk, faults, heap, storage
 from fastsim_ros.replay.errors import BadInput, OutputError, problem
 from fastsim_ros.replay.plot import write_plot

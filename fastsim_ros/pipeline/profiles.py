@@ -47,7 +47,7 @@ from typing import Any, Literal, Protocol
 
 import numpy as np
 
-from fastsim_ros import plausibility
+from fastsim_ros.ros import plausibility
 from fastsim_ros.contact.errors import ContactError
 from fastsim_ros.geometry.errors import DerailmentError, GeometryError, NoContactError
 from fastsim_ros.geometry.placement import Placement, Pose, rotation
@@ -57,9 +57,10 @@ from fastsim_ros.geometry.table import (ContactTable, TableError, TableGrid, Tab
 from fastsim_ros.geometry.table import warm_up as table_warm_up
 from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Wheelset,
                                            WheelsetContact)
-from fastsim_ros.params import PROFILE_CONTACTS, SPECS, ParameterError
-from fastsim_ros.pipeline import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic, Outcome,
-                                  Pipeline, PipelineConfig, Solved, output_topics, patch_topic)
+from fastsim_ros.ros.params import PROFILE_CONTACTS, SPECS, ParameterError
+from fastsim_ros.pipeline.steady import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic,
+                                         Outcome, Pipeline, PipelineConfig, Solved,
+                                         output_topics, patch_topic)
 from msg_adapters.cdr import Cloud, StampedTwist
 from msg_adapters.errors import MalformedMessageError, RejectedInput
 from msg_adapters.patch import (MIN_CONTACT_CELLS, ContactFrame, ContactPatch, contact_axes,

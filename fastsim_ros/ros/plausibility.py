@@ -15,7 +15,7 @@ These are plausibility bounds, not validity bounds: inside the hard limits
 of each tool (``fastsim_ros.cli.LIMITS``, the node's parameter ranges) a
 solver answers any value, and ``allow=True`` (the command line's
 ``--allow-implausible``) accepts it.  The friction coefficient's range is
-the node's parameter range (:data:`fastsim_ros.params.PARAMETERS`), read
+the node's parameter range (:data:`fastsim_ros.ros.params.PARAMETERS`), read
 from there so that there is one source.
 
 Pure Python (no ROS, no numpy): callers compute a patch's extent and peak
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 
 from fastsim_ros.contact.errors import InvalidInputError
-from fastsim_ros.params import SPECS
+from fastsim_ros.ros.params import SPECS
 
 #: how the command line accepts an implausible value; the node and the replay pass theirs
 OVERRIDE_FLAG = "--allow-implausible"
@@ -75,7 +75,7 @@ class Plausible:
 
 
 def _node_range(parameter: str) -> tuple[float, float]:
-    """Return a node parameter's range (:data:`fastsim_ros.params.PARAMETERS`)."""
+    """Return a node parameter's range (:data:`fastsim_ros.ros.params.PARAMETERS`)."""
     spec = SPECS[parameter]
     if spec.low is None or spec.high is None:
         raise LookupError(f"parameter {parameter!r} has no numeric range")
@@ -134,7 +134,7 @@ PLAUSIBILITY: tuple[Plausible, ...] = (
         "friction_coefficient", "friction coefficient", "", *_FRICTION,
         below="a fraction divided by 100 as if it were a percentage",
         above="a percentage typed where the fraction belongs (30 % is 0.3)",
-        why="the node's parameter range friction_coefficient (fastsim_ros.params); "
+        why="the node's parameter range friction_coefficient (fastsim_ros.ros.params); "
         "wheel-rail friction is 0.05-0.6"),
     Plausible(
         "shear_modulus", "combined shear modulus", "Pa", 1.0e9, 5.0e11,

@@ -181,7 +181,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "accumulated 1), linear between, held beyond the ends", dynamic=True),
     ParameterSpec("allow_implausible", "bool", False,
                   "accept patches and loads that wheel-rail contact does not have in SI units "
-                  "(fastsim_ros/plausibility.py: a patch over 0.1 m across, pressures under "
+                  "(fastsim_ros/ros/plausibility.py: a patch over 0.1 m across, pressures under "
                   "1e5 Pa, |xi| or |eta| over 0.1, |phi| over 50 1/m, a wheel load outside "
                   "100 N..1 MN): a scaled rig, a full-slip test; otherwise they are rejected "
                   "as 'implausible', a likely unit mistake"),

@@ -9,7 +9,7 @@ a clock for anything it outputs: stamps come from the messages, so a replay
 is deterministic (only the solve-time statistics use ``perf_counter``).
 No ``rclpy.node`` here: the node and ``fastsim_replay`` are thin front ends.
 A patch that is solved takes the compiled path
-(:func:`fastsim_ros.pipeline_kernels.solve_cloud`: the adapter's loop, the
+(:func:`fastsim_ros.pipeline.kernels.solve_cloud`: the adapter's loop, the
 creepages, the MAE solve and the wheelset wrench in one call, equal to the
 bit to the Python path, which decides every rejection); its solve time is
 that call's.
@@ -32,10 +32,10 @@ from typing import Any
 
 import numpy as np
 
-from fastsim_ros import params as parameters
-from fastsim_ros import plausibility
-from fastsim_ros.params import slope_reduction_of
-from fastsim_ros import pipeline_kernels as fast
+from fastsim_ros.ros import params as parameters
+from fastsim_ros.ros import plausibility
+from fastsim_ros.ros.params import slope_reduction_of
+from fastsim_ros.pipeline import kernels as fast
 from fastsim_ros.contact import compiled
 from fastsim_ros.contact.area import nearest_cells, regridded, turned_grid
 from fastsim_ros.contact.checks import check_bound
@@ -153,7 +153,7 @@ def _on_patch_cells(f: ContactForces, patch: ContactPatch) -> ContactForces:
 
 @dataclass(frozen=True)
 class PipelineConfig:
-    """The checked parameters (see :mod:`fastsim_ros.params`)."""
+    """The checked parameters (see :mod:`fastsim_ros.ros.params`)."""
 
     values: Mapping[str, Any]
 
@@ -266,7 +266,7 @@ def implausible(pressure: np.ndarray, dx: float, dy: float, load: float, cells: 
                 creep: Creepage) -> str | None:
     """Return why a solved patch is a likely unit mistake (one line), or None.
 
-    :func:`fastsim_ros.plausibility.stream_problem` on the patch's extent,
+    :func:`fastsim_ros.ros.plausibility.stream_problem` on the patch's extent,
     its mean pressure (its largest where the mean is under the table's
     bound) and its creepages: the replay's batch applies the same rule.
     """
@@ -558,7 +558,7 @@ class Pipeline:
 
         With ``friction_estimate_slope_reduction`` the estimated ``k0`` with
         the configured ``alpha_inf`` and ``beta`` (None where that is no
-        reduction), else :func:`~fastsim_ros.params.slope_reduction_of`.
+        reduction), else :func:`~fastsim_ros.ros.params.slope_reduction_of`.
         """
         ekf = self._ekf
         if not isinstance(ekf, FrictionSlopeEkf):

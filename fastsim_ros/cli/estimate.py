@@ -17,7 +17,7 @@ with ``model_correction_note`` in words, also in the readable table): the
 correction the fit's model applies to the method's force.  Bad files and
 flags: one line on stderr, exit status 2 (the checks and messages of
 :mod:`fastsim_ros.cli`); so are values implausible for wheel-rail contact
-(:mod:`fastsim_ros.plausibility`: the area, ``--load``, ``--mu``,
+(:mod:`fastsim_ros.ros.plausibility`: the area, ``--load``, ``--mu``,
 ``--shear-modulus`` and the measured creepages) unless
 ``--allow-implausible``.  Material, friction and bound default to the
 node's parameters.
@@ -44,7 +44,9 @@ from typing import Any
 
 import numpy as np
 
-from fastsim_ros import cli
+from fastsim_ros.cli import options
+from fastsim_ros.cli.patch import check_exact_grid, check_plausible_area, force_area
+from fastsim_ros.cli.patch_files import csv_rows, number, text_lines
 from fastsim_ros.contact.checks import BOUNDS
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.errors import UsageError
@@ -67,13 +69,13 @@ HEADERS = (["xi", "eta", "phi", "Fx"], ["xi", "eta", "phi", "Fx", "Fy"])
 def add_parser(sub: Any, finite: Any) -> None:
     """Add ``estimate`` to the subcommands of ``fastsim_contact``."""
     p = sub.add_parser("estimate", help="fit the friction law to measured creep forces")
-    cli._add_area(p, forces=True)
+    options.add_area(p, forces=True)
     p.add_argument("--measured", type=Path, required=True,
                    help="CSV with header xi,eta,phi,Fx[,Fy] (1, 1, 1/m, N, N)")
     p.add_argument("--friction-law", choices=("constant", "exponential"), default="constant",
                    help="constant (fit mu_s) or exponential (fit mu_s, A, B of mu(v) = "
                    "mu_s ((1 - A) exp(-B v) + A))")
-    p.add_argument("--mu", type=finite, default=cli.node_default("friction_coefficient"),
+    p.add_argument("--mu", type=finite, default=options.node_default("friction_coefficient"),
                    help="starting mu_s (default %(default)g, the node's friction_coefficient)")
     # the fit's starting point of A and B, not the node's (A = 1 would leave B unseen)
     p.add_argument("--friction-limit-ratio", type=finite, default=0.5, metavar="A",
@@ -83,22 +85,22 @@ def add_parser(sub: Any, finite: Any) -> None:
     p.add_argument("--speed", type=finite, metavar="V",
                    help="rolling speed V (m/s; its magnitude is used), for the exponential law")
     p.add_argument("--load", type=finite, help="normal load N (N)")
-    cli.add_slope_reduction(p, finite)
+    options.add_slope_reduction(p, finite)
     p.add_argument("--fit-slope-reduction", action="store_true",
                    help="fit the slope reduction k0, alpha_inf, beta with the law (from "
                    "--slope-*, or from 0.8, 0.5, 1 when those are no reduction; a fast "
                    "method): a contaminated rail's reduced slope")
-    cli.add_material(p, finite)
+    options.add_material(p, finite)
     p.add_argument("--method", choices=METHODS, default="exact",
                    help="the measurement model: exact (default: Kalker's exact theory, the "
                    "reference, as for coefficients; seconds to a minute), mae_calibrated "
                    "(the node's method times the knee factor, the node's estimator's "
                    "model; fast), mae or fastsim_ellipse (times the knee factor too), or "
                    "polach (Polach's closed form, kA = kS = 1)")
-    p.add_argument("--bound", choices=BOUNDS, default=cli.node_default("traction_bound"),
+    p.add_argument("--bound", choices=BOUNDS, default=options.node_default("traction_bound"),
                    help="traction bound: mu p as given, or parabolic; default %(default)s, "
                    "the node's")
-    cli.add_allow_implausible(p)
+    options.add_allow_implausible(p)
 
 
 def read_measured(path: Path, *,
@@ -111,9 +113,9 @@ def read_measured(path: Path, *,
     that is not a finite number, a creepage beyond the command line's limits,
     more than :data:`MAX_SAMPLES` rows, no row; and, unless
     ``allow_implausible``, a creepage implausible for wheel-rail contact
-    (:mod:`fastsim_ros.plausibility`: a percentage typed as a fraction).
+    (:mod:`fastsim_ros.ros.plausibility`: a percentage typed as a fraction).
     """
-    rows = cli._rows(path, cli._patch_lines(path, "measured file"))
+    rows = csv_rows(path, text_lines(path, "measured file"))
     first = next(rows, None)
     if first is None:
         raise InvalidInputError(f"{path}: empty (no header xi,eta,phi,Fx[,Fy])")
@@ -124,20 +126,20 @@ def read_measured(path: Path, *,
                                 f"or xi,eta,phi,Fx,Fy, not {shown!r}")
     width = len(header)
     values: list[list[float]] = []
-    creep_max, spin_max = cli.LIMITS["creepage"][1], cli.LIMITS["spin"][1]
+    creep_max, spin_max = options.LIMITS["creepage"][1], options.LIMITS["spin"][1]
     for line, fields in rows:
         if len(fields) != width:
             raise InvalidInputError(f"{path}, line {line}: {len(fields)} values where "
                                     f"{','.join(header)} needs {width}")
-        row = [cli._value(path, line, name, text) for name, text in zip(header, fields)]
+        row = [number(path, line, name, text) for name, text in zip(header, fields)]
         if max(abs(row[0]), abs(row[1])) > creep_max or abs(row[2]) > spin_max:
             raise InvalidInputError(f"{path}, line {line}: creepages beyond the command line's "
                                     f"limits (|xi|, |eta| <= {creep_max:g}, |phi| <= "
                                     f"{spin_max:g} 1/m)")
         if max(abs(v) for v in row[3:]) > 1e12:
             raise InvalidInputError(f"{path}, line {line}: a force beyond 1e12 N")
-        cli.check_plausible_creepages(row[0], row[1], row[2], allow=allow_implausible,
-                                      where=f"{path}, line {line}: ")
+        options.check_plausible_creepages(row[0], row[1], row[2], allow=allow_implausible,
+                                          where=f"{path}, line {line}: ")
         values.append(row)
         if len(values) > MAX_SAMPLES:
             raise InvalidInputError(f"{path}: more than {MAX_SAMPLES:,} samples")
@@ -152,30 +154,30 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
     from fastsim_ros.estimation.fit import MU_RANGE, fit_friction
     from fastsim_ros.estimation.model import solver_for
 
-    cli._check_material(args.nu, args.shear_modulus)
-    cli._in_range("--mu", args.mu, "mu", open_low=True)
-    cli.check_plausible_material(args)
+    options.check_material_flags(args.nu, args.shear_modulus)
+    options.in_range("--mu", args.mu, "mu", open_low=True)
+    options.check_plausible_material(args)
     if args.load is not None and not args.load > 0.0:
         raise InvalidInputError(f"--load must be positive, got {args.load:g}")
     exponential = args.friction_law == "exponential"
     if exponential:
         if args.speed is None:
             raise UsageError("--friction-law exponential requires --speed")
-        cli._speed(args.speed)
+        options.check_speed(args.speed)
         if not 0.0 < args.friction_limit_ratio <= 1.0:
             raise InvalidInputError("--friction-limit-ratio must lie in (0, 1], got "
                                     f"{args.friction_limit_ratio:g}")
         if not 0.0 <= args.friction_decay <= 1e4:
             raise InvalidInputError("--friction-decay must lie in [0, 1e4] s/m, got "
                                     f"{args.friction_decay:g}")
-    reduction = cli.slope_reduction(args)
+    reduction = options.slope_reduction(args)
     if (reduction is not None or args.fit_slope_reduction) and args.method == "exact":
-        raise cli.UsageError("--method exact is Kalker's exact theory, its slope in full: "
-                             "the --slope-* reduction needs a fast method")
+        raise UsageError("--method exact is Kalker's exact theory, its slope in full: "
+                         "the --slope-* reduction needs a fast method")
     creepages, measured = read_measured(args.measured,
                                         allow_implausible=args.allow_implausible)
-    patch = cli._force_area(args)
-    cli.check_plausible_area(args, patch)   # before any solve
+    patch = force_area(args)
+    check_plausible_area(args, patch)   # before any solve
     solver: Any
     if args.method == "exact":
         from fastsim_ros.estimation.model import ExactSolver
@@ -186,8 +188,8 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
             raise InvalidInputError(f"--method exact (the default) takes at most "
                                     f"{MAX_EXACT_SAMPLES} samples, got {creepages.shape[0]}: "
                                     "give fewer, or --method mae_calibrated")
-        cli._check_exact_grid(patch, forces=True,
-                              command="estimate's exact model (the default)")
+        check_exact_grid(patch, forces=True,
+                         command="estimate's exact model (the default)")
         solver = ExactSolver(args.nu, args.shear_modulus)
     else:
         solver = solver_for(args.method, args.nu, args.shear_modulus)
@@ -261,7 +263,7 @@ def run(args: argparse.Namespace) -> dict[str, Any]:
                       sigma_friction_limit_ratio=finite_or_none(fit.sigmas["limit_ratio"]),
                       sigma_friction_decay=finite_or_none(fit.sigmas["decay"]),
                       speed=abs(args.speed))
-    cli._finite_result(result, ("mu_static", "worst_error_percent_mu_N",
+    options.check_finite_result(result, ("mu_static", "worst_error_percent_mu_N",
                                 "rms_error_percent_mu_N"))
     return result
 

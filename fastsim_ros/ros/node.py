@@ -1,7 +1,7 @@
 """``fastsim_node``: the ROS 2 node (default name ``fastsim``), a thin front end of the pipeline.
 
 Topics, frames and parameters: docs/guide_node.md.  The node declares every
-parameter of :mod:`fastsim_ros.params` with its descriptor and range,
+parameter of :mod:`fastsim_ros.ros.params` with its descriptor and range,
 builds one :class:`~fastsim_ros.pipeline.Pipeline` and wires topics to it:
 it subscribes to every input of the pipeline's one
 table (:meth:`~fastsim_ros.pipeline.Pipeline.inputs`: a topic, its type and
@@ -55,15 +55,15 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
 from sensor_msgs.msg import PointCloud2
 from visualization_msgs.msg import MarkerArray
 
-from fastsim_ros import params as parameters
-from fastsim_ros import pipeline_kernels
+from fastsim_ros.ros import params as parameters
+from fastsim_ros.pipeline import kernels as pipeline_kernels
 from fastsim_ros.contact import compiled
 from fastsim_ros.errors import ParameterError, StartupError
 from msg_adapters import patch as patch_adapter
 from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
                                   WHEELSET_WRENCH_TOPIC, InputTopic, Outcome, PipelineConfig,
                                   patch_topic)
-from fastsim_ros.profile_pipeline import AnyPipeline, ProfilePipeline, make_pipeline
+from fastsim_ros.pipeline.profiles import AnyPipeline, ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
 _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
@@ -257,7 +257,7 @@ class _FrontEnd:
         as ``-p friction_coeficient:=0.4``), and a params file's section that
         matches no node name never reaches the node (``fastsim_node:`` for a
         node named ``fastsim``): both are found by the rule the replay refuses
-        them with (:func:`fastsim_ros.params.unmatched`), on the overrides
+        them with (:func:`fastsim_ros.ros.params.unmatched`), on the overrides
         the node was given and on the ``--params-file`` files of ``argv``
         (its ROS arguments; None: only the overrides).
         """

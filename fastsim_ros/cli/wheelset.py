@@ -4,7 +4,7 @@ docs/guide_profiles.md:
 the wheelset is placed at a pose, each wheel's patches are found and their
 normal problem solved (:mod:`fastsim_ros.geometry`), and the creep forces
 come from the node's own pipeline in profiles mode
-(:class:`~fastsim_ros.profile_pipeline.ProfilePipeline`): the same code, the
+(:class:`~fastsim_ros.pipeline.profiles.ProfilePipeline`): the same code, the
 same creepage formula, so the node answers a pose with these numbers.
 
 The wheelset's twist is built from the flags in the wheelset frame: the
@@ -30,7 +30,8 @@ from typing import Any
 
 import numpy as np
 
-from fastsim_ros import cli, plausibility
+from fastsim_ros.cli import options
+from fastsim_ros.ros import plausibility
 from fastsim_ros.atomic import check_target, write_atomically
 from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.compiled import ContactForces
@@ -39,9 +40,9 @@ from fastsim_ros.geometry.errors import GeometryError
 from fastsim_ros.geometry.placement import Pose, rotation
 from fastsim_ros.geometry.wheelset import WheelsetContact
 from fastsim_ros.geometry.profiles import S1002, UIC60
-from fastsim_ros.params import ParameterError
+from fastsim_ros.ros.params import ParameterError
 from fastsim_ros.pipeline import PipelineConfig
-from fastsim_ros.profile_pipeline import ProfileCycle, ProfilePipeline, contact_name
+from fastsim_ros.pipeline.profiles import ProfileCycle, ProfilePipeline, contact_name
 from msg_adapters.cdr import StampedTwist
 from msg_adapters.profile_msgs import StampedPose, quaternion
 
@@ -87,7 +88,7 @@ def add_parser(sub: Any, finite: Any) -> None:
     g.add_argument("--rail", default=UIC60, help="rail profile (.prr or two-column y z)")
     g.add_argument("--right-wheel", default="", help="right wheel profile (default: mirror)")
     g.add_argument("--right-rail", default="", help="right rail profile (default: mirror)")
-    g.add_argument("--smooth", type=finite, default=cli.node_default("profile_smoothing"),
+    g.add_argument("--smooth", type=finite, default=options.node_default("profile_smoothing"),
                    help="profile smoothing wavelength L_filt (m, 0: none; default %(default)g)")
     q = p.add_argument_group("pose and load")
     q.add_argument("--dy", type=finite, help="lateral shift (m, positive left)")
@@ -103,33 +104,33 @@ def add_parser(sub: Any, finite: Any) -> None:
     k.add_argument("--lateral-speed", type=finite, default=0.0, help="lateral speed (m/s)")
     k.add_argument("--yaw-rate", type=finite, default=0.0, help="yaw rate (rad/s)")
     m = p.add_argument_group("material and solver")
-    m.add_argument("--mu", type=finite, default=cli.node_default("friction_coefficient"),
+    m.add_argument("--mu", type=finite, default=options.node_default("friction_coefficient"),
                    help="friction coefficient (default %(default)g, the node's)")
-    cli.add_material(m, finite)
-    m.add_argument("--method", choices=METHODS, default=cli.node_default("method"),
+    options.add_material(m, finite)
+    m.add_argument("--method", choices=METHODS, default=options.node_default("method"),
                    help="creep force method: the node's methods or exact; default "
                    "%(default)s, the node's")
     m.add_argument("--bound", choices=("given", "parabolic"),
-                   default=cli.node_default("traction_bound"),
+                   default=options.node_default("traction_bound"),
                    help="traction bound of the fast methods (default %(default)s, the node's)")
-    m.add_argument("--cell", type=finite, default=cli.node_default("cell_size"),
+    m.add_argument("--cell", type=finite, default=options.node_default("cell_size"),
                    help="cell size of the potential contact grid (m, default %(default)g, "
                    "the node's cell_size)")
-    cli.add_allow_implausible(m, ("wheel_load", "friction_coefficient", "shear_modulus"))
+    options.add_allow_implausible(m, ("wheel_load", "friction_coefficient", "shear_modulus"))
     t = p.add_argument_group("placement (default: the Manchester benchmark, the node's)")
-    t.add_argument("--gauge-width", type=finite, default=cli.node_default("gauge_width"),
+    t.add_argument("--gauge-width", type=finite, default=options.node_default("gauge_width"),
                    help="track gauge (m, default %(default)g)")
-    t.add_argument("--gauge-height", type=finite, default=cli.node_default("gauge_height"),
+    t.add_argument("--gauge-height", type=finite, default=options.node_default("gauge_height"),
                    help="gauge measuring depth below the rail top (m, default %(default)g)")
-    t.add_argument("--cant", type=finite, default=cli.node_default("cant"),
+    t.add_argument("--cant", type=finite, default=options.node_default("cant"),
                    help="rail inclination added to the profile's (rad, default %(default)g)")
     t.add_argument("--flange-back-distance", type=finite,
-                   default=cli.node_default("flange_back_distance"),
+                   default=options.node_default("flange_back_distance"),
                    help="(m, default %(default)g)")
     t.add_argument("--flange-back-position", type=finite,
-                   default=cli.node_default("flange_back_position"),
+                   default=options.node_default("flange_back_position"),
                    help="flange back in wheel profile coordinates (m, default %(default)g)")
-    t.add_argument("--nominal-radius", type=finite, default=cli.node_default("nominal_radius"),
+    t.add_argument("--nominal-radius", type=finite, default=options.node_default("nominal_radius"),
                    help="(m, default %(default)g)")
     s = p.add_argument_group("sweep (instead of one pose)")
     s.add_argument("--sweep-dy", type=finite, nargs=3, metavar=("Y0", "Y1", "STEP"),
@@ -144,14 +145,14 @@ def add_parser(sub: Any, finite: Any) -> None:
 def check_plausible(args: argparse.Namespace) -> None:
     """Refuse ``--load``, ``--mu`` or ``--shear-modulus`` implausible for wheel-rail contact.
 
-    Before any pose is solved (:mod:`fastsim_ros.plausibility`); the node's
+    Before any pose is solved (:mod:`fastsim_ros.ros.plausibility`); the node's
     parameter ranges still bound what ``--allow-implausible`` accepts.
     """
     if args.load is not None and math.isfinite(args.load) and args.load > 0.0:
         # a load that is no load at all is refused by its own check, naming its range
         plausibility.check("wheel_load", args.load, what="--load",
                            allow=args.allow_implausible)
-    cli.check_plausible_material(args)
+    options.check_plausible_material(args)
 
 
 def _config(args: argparse.Namespace) -> PipelineConfig:
