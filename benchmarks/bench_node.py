@@ -255,8 +255,12 @@ def target_command(target: str, names: list[str], executor: str,
     if target == "floor+solve":
         return [sys.executable, str(FLOOR), "--solve", "--contacts", *names]
     if target == "baseline":  # the node of another checkout's sources (BASELINE)
+        # its node module where that checkout has it (fastsim_ros/ros/, or the package's top
+        # level in a checkout from before the front ends had their package)
         return [sys.executable, "-c", "import sys; sys.path.insert(0, sys.argv.pop(1)); "
-                "from fastsim_ros.ros.node import main; sys.exit(main())", str(BASELINE),
+                "import importlib, importlib.util as u; sys.exit(importlib.import_module("
+                "'fastsim_ros.ros.node' if u.find_spec('fastsim_ros.ros') else "
+                "'fastsim_ros.node').main())", str(BASELINE),
                 "--ros-args", "-p", f"executor:={executor}", "-p",
                 "contacts:=[" + ",".join(f'"{n}"' for n in names) + "]", *node_args]
     return [str(NODE), "--ros-args", "-p", f"executor:={executor}", "-p",

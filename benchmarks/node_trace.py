@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import array
 import gc
+import importlib
+import importlib.util
 import sys
 import time
 from pathlib import Path
@@ -137,7 +139,10 @@ def main() -> int:
         sys.path.insert(0, str(Path(sys.argv.pop(1)).resolve()))
     else:
         sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-    from fastsim_ros.ros import node
+    # the node module where the checkout has it (fastsim_ros/ros/, or the package's top
+    # level in a checkout from before the front ends had their package)
+    node = importlib.import_module("fastsim_ros.ros.node" if importlib.util.find_spec(
+        "fastsim_ros.ros") else "fastsim_ros.node")
     timeline = Timeline()
     install(timeline, node)
     try:
