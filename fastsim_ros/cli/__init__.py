@@ -1,25 +1,18 @@
 """``fastsim_contact``: one-off contact computations from the command line.
 
-Three commands: ``coefficients`` prints an area's generalised
+Four commands: ``coefficients`` prints an area's generalised
 creepage coefficients, ``forces`` the creep forces at given creepages,
 ``wheelset`` a wheelset's patches and creep forces from wheel and rail profiles
 (:mod:`fastsim_ros.cli.wheelset`), and ``estimate`` fits the friction law to
 measured creep forces (:mod:`fastsim_ros.cli.estimate`); ``coefficients`` and
 ``forces`` are :mod:`fastsim_ros.cli.patch`, the flags, limits and checks they
 share :mod:`fastsim_ros.cli.options`, the reading of their text files
-:mod:`fastsim_ros.cli.patch_files`.  SI
-units throughout.  ``--json`` prints exactly one JSON object on stdout.  Bad
-input gives one line on stderr and exit status 2, never a traceback, and no
-non-finite number is ever printed as a result.
+:mod:`fastsim_ros.cli.patch_files`.  SI units throughout.  ``--json`` prints
+exactly one JSON object on stdout.  Bad input gives one line on stderr and
+exit status 2, never a traceback, and no non-finite number is ever printed as
+a result.
 
-``forces --method mae_calibrated`` (the default: the calibrated MAE, better than
-the paper's MAE on every area of docs/validation_wider.md), ``mae`` (the paper's)
-and ``fastsim_ellipse`` run the compiled solvers of
-:mod:`fastsim_ros.contact.compiled`, the code the node runs; ``exact`` runs
-the exact theory (:mod:`fastsim_ros.contact.exact`); ``fastrip`` the numpy
-FaStrip baseline (:mod:`fastsim_ros.contact.fastrip`, no compiled path);
-``dlm`` and ``asm`` the seed paper's older ways to FastSim's flexibilities
-(:mod:`~fastsim_ros.contact.dlm`, :mod:`~fastsim_ros.contact.asm`, numpy).
+Which solver each ``--method`` runs: :mod:`fastsim_ros.cli.patch`.
 
 Defaults are one set, the node's (:func:`~fastsim_ros.cli.options.node_default` reads
 :data:`fastsim_ros.ros.params.PARAMETERS`): method (``coefficients``: ``exact``,
