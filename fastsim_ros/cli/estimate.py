@@ -108,7 +108,7 @@ def read_measured(path: Path, *,
     """Read the measured samples: ``(n, 3)`` creepages and ``(n, 1 or 2)`` forces (N).
 
     Refused (:class:`InvalidInputError`, one line naming the file and the
-    line): what :func:`fastsim_ros.cli.read_patch` refuses of a text file,
+    line): what :func:`fastsim_ros.cli.patch_files.read_patch` refuses of a text file,
     a header other than :data:`HEADERS`, a row of the wrong length, a value
     that is not a finite number, a creepage beyond the command line's limits,
     more than :data:`MAX_SAMPLES` rows, no row; and, unless

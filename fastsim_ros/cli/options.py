@@ -31,7 +31,7 @@ def node_default(parameter: str) -> Any:
     """Return the node's default of ``parameter``: every tool's default (one set, the node's).
 
     The command line's material, friction, method, bound and grid defaults
-    are the node's parameters' (:data:`fastsim_ros.params.PARAMETERS`), read
+    are the node's parameters' (:data:`fastsim_ros.ros.params.PARAMETERS`), read
     from there, so that the same question gets the same numbers from every tool.
     """
     return SPECS[parameter].default
