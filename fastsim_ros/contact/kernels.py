@@ -1872,22 +1872,49 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, law, prm,
     flexibilities on every strip, spin flexibility ``L3``, sweep point the
     ellipse's centre.  Return as :func:`sweep`.
     """
-    n = shape.shape[0]
-    x_c = ell[ELL_XC]
-    y_c = ell[ELL_YC]
+    gx0, gy0, gdx, gdy, flex, xi_s, eta_s = ellipse_march(ell, shape.shape[0], xi, eta, phi,
+                                                          xp, yp)
+    return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi, flex,
+                 ell[ELL_XC], ell[ELL_YC], xp, yp, law, prm, speed, out_x, out_y, slip, store,
+                 False)
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_bound(ell, n, parabolic):
+    """Return ``(shape, env, scale)`` of the equivalent ellipse's ``n`` x ``n`` grid.
+
+    ``shape``: Hertz's (or with ``parabolic`` Kalker's parabolic) pressure
+    profile on the grid (:func:`ellipse_shape`), ``env`` its column
+    envelopes, ``scale`` (Pa) the factor that makes ``shape`` the pressure
+    of the ellipse's load.
+    """
+    shape = np.empty((n, n))
+    env = np.empty((2, n), dtype=np.int64)
     a = ell[ELL_A]
     b = ell[ELL_B]
-    gx0, gy0, gdx, gdy = ellipse_grid(a, b, n, x_c, y_c)
+    total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
+    return shape, env, ell[ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_march(ell, n, xi, eta, phi, xp, yp):
+    """Return the equivalent ellipse's march: its grid, flexibilities, creepages at its centre.
+
+    ``(x0, y0, dx, dy, flex, xi_s, eta_s)``: the grid of ``ellipse(a, b,
+    nx=n, ny=n).shifted(x_c, y_c)`` (m), Kalker's flexibilities on every
+    strip with spin flexibility ``L3`` (``(4, n)``, m/Pa), and the
+    creepages about ``(xp, yp)`` (m) moved to the ellipse's centre.
+    """
+    x_c = ell[ELL_XC]
+    y_c = ell[ELL_YC]
+    gx0, gy0, gdx, gdy = ellipse_grid(ell[ELL_A], ell[ELL_B], n, x_c, y_c)
     flex = np.empty((4, n))
     for j in range(n):
         flex[0, j] = ell[ELL_L1]
         flex[1, j] = ell[ELL_L2]
         flex[2, j] = ell[ELL_L3]
         flex[3, j] = ell[ELL_L3]
-    xi_s = xi + phi * (yp - y_c)
-    eta_s = eta - phi * (xp - x_c)
-    return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi,
-                 flex, x_c, y_c, xp, yp, law, prm, speed, out_x, out_y, slip, store, False)
+    return gx0, gy0, gdx, gdy, flex, xi + phi * (yp - y_c), eta - phi * (xp - x_c)
 
 
 # ---------------------------------------------------------------- whole solves
@@ -2047,12 +2074,7 @@ def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
         n = ellipse_cells(ell[ELL_NCELLS])
     if n < 2:
         return E_CELLS, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
-    shape = np.empty((n, n))
-    env = np.empty((2, n), dtype=np.int64)
-    a = ell[ELL_A]
-    b = ell[ELL_B]
-    total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
-    scale = ell[ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
+    shape, env, scale = ellipse_bound(ell, n, parabolic)
     fx, fy, mz, nslip, ncontact = equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi,
                                                    xp, yp, law, prm, speed, out_x, out_y,
                                                    slip, store)
