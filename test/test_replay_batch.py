@@ -392,7 +392,8 @@ def _scan_cases():
 
 def test_the_scan_gives_the_node_adapter_loop_bit_for_bit():
     # the batched scan's loop for finite words (all_finite, adapt_finite) against the node's
-    # own patch_kernels.adapt, patch by patch: pressures and every number of its out array
+    # own patch_kernels.adapt, patch by patch: pressures and every number of its out array,
+    # and the largest pressure of each patch the loop passes
     from numba.typed import List
     from fastsim_ros.replay import kernels
     from msg_adapters import patch_kernels
@@ -404,9 +405,10 @@ def test_the_scan_gives_the_node_adapter_loop_bit_for_bit():
         one = np.zeros(1, dtype=np.int64)
         pressure = np.full((1, layout.height, layout.cells), -7.0)
         out = np.full((1, patch_kernels.OUT_SIZE), -7.0)
+        peak = np.full(1, -7.0)
         kernels.scan_patches(List([buf]), one, one, layout.data_at, layout.width,
                              layout.height, layout.cells, layout.row, layout.step, layout.cols,
-                             pressure, out)
+                             pressure, out, peak)
         count = (layout.height - 1) * layout.row + layout.cells * layout.step
         words = buf[layout.data_at:layout.data_at + count * layout.width].view(
             np.float32 if layout.width == 4 else np.float64)
@@ -416,6 +418,8 @@ def test_the_scan_gives_the_node_adapter_loop_bit_for_bit():
                             layout.cols, want_p, want)
         assert out[0].tobytes() == want.tobytes(), name
         assert pressure[0].tobytes() == want_p.tobytes(), name
+        if want[patch_kernels.STATUS] == patch_kernels.OK:   # the plausibility bound's peak
+            assert peak[0] == want_p.max(), name
         seen.add((int(want[patch_kernels.STATUS]), bool(kernels.all_finite(words, count))))
     # every status of the loop, on both of its branches where they can be
     ok, nonfinite = patch_kernels.OK, patch_kernels.NONFINITE

@@ -336,10 +336,11 @@ class _ContactState:
 
 @dataclass
 class _Group:
-    """Patches of one layout scanned together: rows of the run, their pressures."""
+    """Patches of one layout scanned together: rows of the run, pressures, peak pressures."""
 
     rows: Ints
     pressure: Floats
+    peak: Floats
 
 
 # ------------------------------------------------------------------------ the batch
@@ -639,10 +640,11 @@ class Batch:
         n = rows.size
         pressure = np.empty((n, layout.height, layout.cells))
         out = np.zeros((n, adapter.OUT_SIZE))
+        peak = np.empty(n)
         m = at[rows]
         kernels.scan_patches(w.arrays, w.buffer[m], w.start[m], layout.data_at, layout.width,
                              layout.height, layout.cells, layout.row, layout.step, layout.cols,
-                             pressure, out)
+                             pressure, out, peak)
         p.stamp[rows] = self._stamps(w, m)
         status, cells = out[:, adapter.STATUS], out[:, adapter.CELLS]
         clean = status == adapter.OK
@@ -675,10 +677,10 @@ class Batch:
             pressure[i] = np.ascontiguousarray(pressure[i][::y_order[~bad][j],
                                                            ::x_order[~bad][j]])
         if good.size == n:   # every patch to solve: the array as it is (no copy)
-            return _Group(r, pressure), rest
+            return _Group(r, pressure, peak), rest
         keep = np.zeros(n, dtype=np.bool_)
         keep[good] = True
-        return _Group(r, pressure[keep]), rest
+        return _Group(r, pressure[keep], peak[keep]), rest
 
     def _one(self, w: Window, message: int, i: int, p: Patches) -> ContactPatch | None:
         """Decode patch row ``i`` as the pipeline does, one message at a time."""
@@ -814,24 +816,24 @@ class Batch:
         where = np.zeros(p.status.size, dtype=np.bool_)
         where[todo] = True
         # one compiled call per grid shape (the patches of every layout and topic of that shape)
-        shapes: dict[tuple[int, ...], list[tuple[Ints, Floats]]] = {}
+        shapes: dict[tuple[int, ...], list[tuple[Ints, Floats, Floats]]] = {}
         for g in groups:
             take = where[g.rows]
             if take.all():
-                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows, g.pressure))
+                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows, g.pressure, g.peak))
             elif take.any():
-                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows[take],
-                                                                    g.pressure[take]))
+                shapes.setdefault(g.pressure.shape[1:], []).append(
+                    (g.rows[take], g.pressure[take], g.peak[take]))
         for i, patch in singles.items():
             if where[i]:
-                shapes.setdefault(patch.pressure.shape, []).append((np.array([i]),
-                                                                    patch.pressure[None]))
+                shapes.setdefault(patch.pressure.shape, []).append(
+                    (np.array([i]), patch.pressure[None], np.array([patch.pressure.max()])))
         items = [pieces[0] if len(pieces) == 1 else
-                 (np.concatenate([r for r, _ in pieces]), np.concatenate([q for _, q in pieces]))
+                 tuple(np.concatenate([piece[k] for piece in pieces]) for k in range(3))
                  for pieces in shapes.values()]
         t0 = time.perf_counter()
         solved: list[Ints] = []
-        for rows, ps in items:
+        for rows, ps, peak in items:
             creep = p.creep[rows]
             grid = self._grid[rows].copy()
             xep = creep[:, :3].copy()
@@ -864,28 +866,29 @@ class Batch:
                 p.status[rows[j]] = CODE["nonfinite"]
                 p.detail[rows[j]] = "nonfinite: the solve gave a non-finite force"
             if not self.allow_implausible:
-                self._implausible(p, rows, ps, grid, np.flatnonzero(ok & finite))
+                self._implausible(p, rows, ps, grid, peak, np.flatnonzero(ok & finite))
         elapsed = time.perf_counter() - t0
         done = np.concatenate(solved)
         self.timing.solves += done.size
         if done.size:
             p.solve_time[done] = elapsed / done.size
 
-    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats,
+    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats, peak: Floats,
                      solved: Ints) -> None:
         """``implausible``: the pipeline's rule (:func:`fastsim_ros.pipeline.implausible`).
 
-        On items ``solved`` of a solve (``rows``, ``ps``, ``grid``: its
-        patches' rows, pressures and grids).  Its bounds tested on every row
-        at once (the grid's span, the largest pressure, the creepages); the
-        rows that fail one get the pipeline's own words from
+        On items ``solved`` of a solve (``rows``, ``ps``, ``grid``, ``peak``:
+        its patches' rows, pressures, grids and largest pressures (Pa), the
+        scan's).  Its bounds tested on every row at once (the grid's span,
+        the largest pressure, the creepages); the rows that fail one get the
+        pipeline's own words from
         :func:`~fastsim_ros.plausibility.stream_problem`.
         """
         if solved.size == 0:
             return
         table = plausibility.PLAUSIBLE
         ny, nx = ps.shape[1], ps.shape[2]
-        peak = ps.reshape(ps.shape[0], -1).max(axis=1)[solved]
+        peak = peak[solved]
         rows, grid = rows[solved], grid[solved]
         creep = p.creep[rows]
         suspect = ((nx * grid[:, 2] > table["patch_extent"].high)

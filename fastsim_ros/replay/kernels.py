@@ -119,7 +119,8 @@ def doubles(bufs, which, start, at, out):
 
 
 @njit(cache=True)
-def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pressure, out):
+def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pressure, out,
+                 peak):
     """Run the node's patch adapter loop on every patch of one layout.
 
     Patch ``i``'s points start ``data_at`` bytes into its message
@@ -131,7 +132,9 @@ def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pr
     patch whose words are all finite goes through :func:`adapt_finite`
     (the node's loop without its per-point finiteness test, the same
     operations in the same order), any other through the node's own loop,
-    so a patch gives the node's numbers.
+    so a patch gives the node's numbers.  ``peak[i]``: the largest of
+    ``pressure[i]`` (Pa) where the points are finite (the plausibility
+    bound's peak pressure; NaN in, anything out).
     """
     words = (ny - 1) * row + nx * step
     nbytes = words * width
@@ -142,15 +145,19 @@ def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pr
         if width == 4:
             w4 = buf[s:s + nbytes].view(np.float32)
             if all_finite(w4, words):
-                adapt_finite(w4, ny, nx, row, step, cols, pressure[i], out[i], offsets)
+                peak[i] = adapt_finite(w4, ny, nx, row, step, cols, pressure[i], out[i],
+                                       offsets)
             else:
                 patch_kernels.adapt(w4, ny, nx, row, step, cols, pressure[i], out[i])
+                peak[i] = pressure[i].max()
         else:
             w8 = buf[s:s + nbytes].view(np.float64)
             if all_finite(w8, words):
-                adapt_finite(w8, ny, nx, row, step, cols, pressure[i], out[i], offsets)
+                peak[i] = adapt_finite(w8, ny, nx, row, step, cols, pressure[i], out[i],
+                                       offsets)
             else:
                 patch_kernels.adapt(w8, ny, nx, row, step, cols, pressure[i], out[i])
+                peak[i] = pressure[i].max()
 
 
 @njit(cache=True)
@@ -177,9 +184,9 @@ def adapt_finite(words, ny, nx, row, step, cols, pressure, out, offsets):
     finiteness test, which :func:`all_finite` has passed for the whole
     block; ``i dx`` of the fit's residuals taken once per column into
     ``offsets`` (at least ``nx`` long), ``j dy`` once per row.  Writes what
-    ``adapt`` writes, bit for bit (the tests compare them on every patch of
-    the bundled bags and on float32, float64, padded, reversed and refused
-    grids).
+    ``adapt`` writes, bit for bit (the tests compare them on float32,
+    float64, padded, reordered, reversed and refused grids); returns the
+    largest pressure (Pa).
     """
     cells = 0
     p_sum = 0.0
@@ -221,7 +228,7 @@ def adapt_finite(words, ny, nx, row, step, cols, pressure, out, offsets):
     out[patch_kernels.P_SUM] = p_sum
     out[patch_kernels.P_MIN] = p_min
     if status != patch_kernels.OK or cells == 0:
-        return
+        return p_max
     o0, o1, o2 = s0 / p_sum, s1 / p_sum, s2 / p_sum
     out[patch_kernels.ORIGIN] = o0
     out[patch_kernels.ORIGIN + 1] = o1
@@ -230,13 +237,13 @@ def adapt_finite(words, ny, nx, row, step, cols, pressure, out, offsets):
     norm = math.sqrt(s3 * s3 + s4 * s4 + s5 * s5)
     if not norm > 0.0:
         out[patch_kernels.STATUS] = patch_kernels.ZERO_NORMAL
-        return
+        return p_max
     z0, z1, z2 = s3 / norm, s4 / norm, s5 / norm
     exx, exy, exz = 1.0 - z0 * z0, -z0 * z1, -z0 * z2
     ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
     if not ex_norm > 1e-6:
         out[patch_kernels.STATUS] = patch_kernels.NORMAL_ALONG_X
-        return
+        return p_max
     x0_, x1_, x2_ = exx / ex_norm, exy / ex_norm, exz / ex_norm
     y0_, y1_, y2_ = z1 * x2_ - z2 * x1_, z2 * x0_ - z0 * x2_, z0 * x1_ - z1 * x0_
     out[patch_kernels.E_X] = x0_
@@ -249,7 +256,7 @@ def adapt_finite(words, ny, nx, row, step, cols, pressure, out, offsets):
     out[patch_kernels.E_Z + 1] = z1
     out[patch_kernels.E_Z + 2] = z2
     if ny < 2 or nx < 2:
-        return
+        return p_max
     span_x = 0.0
     for j in range(ny):
         first = j * row
@@ -296,6 +303,7 @@ def adapt_finite(words, ny, nx, row, step, cols, pressure, out, offsets):
     out[patch_kernels.Y0] = gy0
     out[patch_kernels.DY] = dy
     out[patch_kernels.WORST_Y] = max(ry_high - gy0, gy0 - ry_low)
+    return p_max
 
 
 @njit(cache=True, inline="always")
@@ -486,5 +494,5 @@ def warm_up() -> None:
     cols = np.arange(7, dtype=np.int64)
     for width in (4, 8):
         scan_patches(bufs, one, one, 0, width, 2, 2, 14, 7, cols, np.empty((1, 2, 2)),
-                     np.zeros((1, patch_kernels.OUT_SIZE)))
+                     np.zeros((1, patch_kernels.OUT_SIZE)), np.zeros(1))
     scatter_rows(np.zeros(64, dtype=np.uint8), np.zeros((1, 8), dtype=np.uint8), one)
