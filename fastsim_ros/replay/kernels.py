@@ -470,13 +470,33 @@ def advance(contact_of, stamp, status, frame, force, tolerance, markers_on, peri
 
 
 @njit(cache=True)
-def scatter_rows(out, rows, offsets):
-    """Copy row ``i`` of ``rows`` to ``out[offsets[i]:]`` (records of one size into a chunk)."""
-    width = rows.shape[1]
-    for i in range(rows.shape[0]):
+def message_records(out, offsets, channel, log_time, payloads):
+    """Write one MCAP message record per payload row into ``out`` at ``offsets[i]``.
+
+    The bytes :class:`mcap.records.Message` writes (and
+    :func:`fastsim_ros.replay.mcap.message_records` builds): opcode 0x05,
+    the record's length ``22 + L`` (u64), ``channel`` (u16), sequence 0
+    (u32), ``log_time[i]`` (ns, u64) as log and publish time, then the
+    ``L`` bytes of ``payloads[i]``.
+    """
+    size = payloads.shape[1]
+    length = np.uint64(22 + size)
+    for i in range(payloads.shape[0]):
         o = offsets[i]
-        for j in range(width):
-            out[o + j] = rows[i, j]
+        out[o] = _OP_MESSAGE
+        for k in range(8):
+            out[o + 1 + k] = np.uint8((length >> np.uint64(8 * k)) & np.uint64(0xFF))
+        out[o + 9] = np.uint8(channel & 0xFF)
+        out[o + 10] = np.uint8((channel >> 8) & 0xFF)
+        for k in range(4):
+            out[o + 11 + k] = 0
+        t = np.uint64(log_time[i])
+        for k in range(8):
+            byte = np.uint8((t >> np.uint64(8 * k)) & np.uint64(0xFF))
+            out[o + 15 + k] = byte
+            out[o + 23 + k] = byte
+        for j in range(size):
+            out[o + 31 + j] = payloads[i, j]
 
 
 def warm_up() -> None:
@@ -495,4 +515,4 @@ def warm_up() -> None:
     for width in (4, 8):
         scan_patches(bufs, one, one, 0, width, 2, 2, 14, 7, cols, np.empty((1, 2, 2)),
                      np.zeros((1, patch_kernels.OUT_SIZE)), np.zeros(1))
-    scatter_rows(np.zeros(64, dtype=np.uint8), np.zeros((1, 8), dtype=np.uint8), one)
+    message_records(np.zeros(64, dtype=np.uint8), one, 3, one, np.zeros((1, 8), dtype=np.uint8))

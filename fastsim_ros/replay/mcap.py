@@ -453,7 +453,7 @@ class _MessageIndex(rec.MessageIndex):
 class _Pending:
     """New message records not yet in a chunk."""
 
-    parts: list[bytes] = field(default_factory=list)
+    parts: list[bytes | NDArray[np.uint8]] = field(default_factory=list)
     size: int = 0
     start: int = (1 << 63) - 1
     end: int = 0
@@ -555,12 +555,13 @@ class McapWriter:
         self.end = max(self.end, p.end)
         self._flush_if(CHUNK_BYTES)
 
-    def write_records(self, records: bytes, channel: NDArray[np.int64],
+    def write_records(self, records: bytes | NDArray[np.uint8], channel: NDArray[np.int64],
                       log_time: NDArray[np.int64], offset: NDArray[np.int64]) -> None:
         """Add message records built in bulk.
 
-        ``records``: their bytes; per record its ``channel``, ``log_time``
-        (ns) and ``offset`` in ``records``.
+        ``records``: their bytes (or a uint8 array of them, kept as it is
+        until the chunk is written); per record its ``channel``,
+        ``log_time`` (ns) and ``offset`` in ``records``.
         """
         if not channel.size:
             return
