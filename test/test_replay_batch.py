@@ -357,13 +357,12 @@ def _scan_cases():
     egg = samples.semi_ellipses_patch(0.5, 2.0, cells=24, scale=8e-3, load=5e4)
     left = dict(origin=(0.0, 0.75, -WHEEL_RADIUS), normal=contact_normal(0.1, "left"))
     rng = np.random.default_rng(7)
+    order = ("pressure", "normal_z", "x", "normal_x", "y", "normal_y", "z")
     cases = [("float32", cdr(cloud_msg(hertz, **left))),
              ("float64", cdr(cloud_msg(hertz, dtype="<f8", **left))),
              ("padded reversed", cdr(cloud_msg(egg, pad=4, reverse_rows=True,
                                                reverse_columns=True, **left))),
-             ("field order", cdr(cloud_msg(egg, field_order=("pressure", "normal_z", "x",
-                                                            "normal_x", "y", "normal_y", "z"),
-                                           **left)))]
+             ("field order", cdr(cloud_msg(egg, field_order=order, **left)))]
     noisy = hertz.pressure * (1.0 + 1e-3 * rng.standard_normal(hertz.pressure.shape))
     cases.append(("noisy", cdr(cloud_msg(hertz, pressure=np.maximum(noisy, 0.0), **left))))
     for name, cell, value in (("nan", (12, 12), math.nan), ("inf outside", (0, 0), math.inf),

@@ -544,17 +544,18 @@ class Batch:
         kernels.doubles(w.arrays, w.buffer[hit], w.start[hit], self.twist_doubles, got)
         value[fast] = got
         ok = fast & np.isfinite(value).all(axis=1)
-        reason = np.where(fast & ~ok, "nonfinite", "").astype(object)
+        # each twist's verdict: an index of _TWIST_ORDER (-1: not yet decided)
+        code = np.where(fast & ~ok, _TWIST_CODE["nonfinite"], -1)
         for i in np.flatnonzero(~fast).tolist():     # another layout: the pipeline's decoder
             try:
                 t = read_twist(w.data(int(at[i])))
             except MalformedMessageError:
-                reason[i] = "malformed"
+                code[i] = _TWIST_CODE["malformed"]
                 continue
             if t.frame_id != self.frame_id:
-                reason[i] = "wrong_frame"
+                code[i] = _TWIST_CODE["wrong_frame"]
             elif not twist_is_finite(t):
-                reason[i] = "nonfinite"
+                code[i] = _TWIST_CODE["nonfinite"]
             else:
                 ok[i] = True
                 stamp[i] = t.stamp_ns
@@ -566,14 +567,14 @@ class Batch:
             last = hist.stamp[-1] if hist.stamp.size else _FIRST
             before = np.maximum(np.concatenate(([last], np.maximum.accumulate(s)[:-1])), last)
             old = s < before
-            reason[candidates[old]] = "old_stamp"
+            code[candidates[old]] = _TWIST_CODE["old_stamp"]
             taken = candidates[~old]
             hist.stamp = np.concatenate((hist.stamp, stamp[taken]))
             hist.value = np.concatenate((hist.value, value[taken]))
             hist.arrival = np.concatenate((hist.arrival, base + at[taken]))
-            reason[taken] = _TWIST_COUNTS[which]
-        counted = reason != ""
-        code = np.array([_TWIST_CODE[r] for r in reason[counted].tolist()], dtype=np.int64)
+            code[taken] = _TWIST_CODE[_TWIST_COUNTS[which]]
+        counted = code >= 0
+        code = code[counted]
         place = np.concatenate((self._twist_place, base + at[counted]))
         count = np.concatenate((self._twist_count, code))
         order = np.argsort(place, kind="stable")   # the wheel's and the rail's, by place

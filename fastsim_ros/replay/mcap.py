@@ -453,7 +453,7 @@ class _MessageIndex(rec.MessageIndex):
 class _Pending:
     """New message records not yet in a chunk."""
 
-    parts: list[bytes | NDArray[np.uint8]] = field(default_factory=list)
+    parts: list[bytes | memoryview] = field(default_factory=list)
     size: int = 0
     start: int = (1 << 63) - 1
     end: int = 0
@@ -567,7 +567,7 @@ class McapWriter:
             return
         p = self._pending
         base = p.size
-        p.parts.append(records)
+        p.parts.append(records if isinstance(records, bytes) else records.data)
         p.size += len(records)
         p.start = min(p.start, int(log_time.min()))
         p.end = max(p.end, int(log_time.max()))
