@@ -1,8 +1,9 @@
 """The batched replay: the pipeline's rules applied to a run of messages at once.
 
-For a run of a bag's messages (between two diagnostics) the pipeline's
-per-message rules (:meth:`fastsim_ros.pipeline.Pipeline.on_patch`,
-``on_wheel_twist``, ``on_rail_twist``) are applied in bulk:
+For a run of a bag's messages (a window of them, which the replay takes
+at once) the pipeline's per-message rules
+(:meth:`fastsim_ros.pipeline.Pipeline.on_patch`, ``on_wheel_twist``,
+``on_rail_twist``) are applied in bulk:
 
 1. twists decoded together (those of the usual layout read straight from the
    chunks; any other through :func:`msg_adapters.cdr.read_twist`) and taken

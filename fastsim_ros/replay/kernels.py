@@ -1,9 +1,11 @@
 """Compiled loops of the batched replay (numba): passes over chunks and patches.
 
 The decisions stay in Python (:mod:`~fastsim_ros.replay.batch`); these
-loops only walk bytes and sum.  The patch scan calls the node's own
-compiled loops (:mod:`msg_adapters.patch_kernels`) on each patch of a
-chunk, so a patch gives the same numbers here as in the node.
+loops only walk bytes and sum.  The patch scan runs the node's adapter
+loop (:func:`msg_adapters.patch_kernels.adapt`) on each patch of a chunk,
+or, where every word of the patch is finite, the same operations without
+its per-point finiteness test (:func:`adapt_finite`), so a patch gives the
+same numbers here as in the node.
 """
 
 from __future__ import annotations
