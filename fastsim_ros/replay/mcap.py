@@ -381,21 +381,22 @@ def windows(mcap: IndexedMcap, on_chunk: Any, max_messages: int = 8192,
                    key=lambda k: (mcap.chunks[k].start_time, mcap.chunks[k].offset))
     loaded: list[_Loaded] = []
     nxt = 0
+    pending = held = 0     # messages not given out, bytes of records, of the loaded chunks
     while True:
-        loaded = [c for c in loaded if c.taken < c.log_time.size]
         horizon = mcap.chunks[order[nxt]].start_time if nxt < len(order) else None
-        pending = sum(c.log_time.size - c.taken for c in loaded)
-        held = sum(len(c.records) for c in loaded)
-        if horizon is not None and (not loaded or _pending_min(loaded) >= horizon
-                                    or (pending < max_messages and held < max_bytes)):
+        if horizon is not None and (not loaded or (pending < max_messages and held < max_bytes)
+                                    or _pending_min(loaded) >= horizon):
             k = order[nxt]
             nxt += 1
             raw, records = mcap.read_chunk(mcap.chunks[k])
             arrays = scan_records(records)
             _check_chunk(mcap, mcap.chunks[k], arrays)
             on_chunk(k, raw, records, arrays)
-            loaded.append(_Loaded(mcap.chunks[k].offset, records, *arrays))
-            loaded.sort(key=lambda c: c.order)
+            if arrays[0].size:   # (a chunk of no messages gives nothing out)
+                loaded.append(_Loaded(mcap.chunks[k].offset, records, *arrays))
+                loaded.sort(key=lambda c: c.order)
+                pending += arrays[0].size
+                held += len(records)
             continue
         if not loaded:
             return
@@ -419,6 +420,9 @@ def windows(mcap: IndexedMcap, on_chunk: Any, max_messages: int = 8192,
                      np.concatenate([c.channel for c in loaded])[flat], times[merged], which,
                      np.concatenate([c.start for c in loaded])[flat],
                      np.concatenate([c.size for c in loaded])[flat])
+        loaded = [c for c in loaded if c.taken < c.log_time.size]
+        pending = sum(c.log_time.size - c.taken for c in loaded)
+        held = sum(len(c.records) for c in loaded)
 
 
 def _pending_min(loaded: list[_Loaded]) -> int:
