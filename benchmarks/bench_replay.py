@@ -43,7 +43,9 @@ partial slip, the default method) replayed ``--rounds`` times in this process af
 untimed replay (the kernels loaded: the wall beyond start-up), and the
 command line's start-up measured apart; patches per second, the multiple
 of real time, the batch solver's rate on the same patches in the same run
-and the share; each run printed, then the medians.
+and the share; each run printed (with its phases in us per patch, and of
+``read`` the decompression, of ``decode`` the compiled adapter loop, of
+``solve`` the compiled solves), then the medians.
 
 With ``--scheduler``, instead: ``N`` small bags (generated: the first
 0.5 s of ``hertz_ramp``, 200 by default) replayed by two local worker
@@ -98,6 +100,9 @@ PER_MESSAGE = ("transient_step", "adhesion_rig", "mbench_a22")
 SAME_CONTACTS = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
 PHASES = ("read", "copy", "decode", "kinematics", "solve", "state", "encode", "write",
           "diagnostics")
+#: parts of phases, printed beside them in --long: (part, of phase, label)
+PARTS = (("decompress", "read", "decompression"), ("scan", "decode", "adapter loop"),
+         ("solver", "solve", "compiled solves"))
 #: the last commit whose fastsim_ros/replay/mcap.py wrote and parsed MCAP by hand
 MCAP_BEFORE = "ddc07d7"
 SOLVERS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
@@ -320,10 +325,13 @@ def long_main(seconds: float, rounds: int) -> int:
             rate = batch_rate(r.profile.solves, values)
             rows.append((n_patch / r.wall_s, r.duration_s / r.wall_s, rate))
             phases = r.profile.phases
+            parts = {of: f" ({label} {phases.get(part, 0.0) / n_patch * 1e6:.1f})"
+                     for part, of, label in PARTS}
             print(f"  run {k}: wall {r.wall_s:.3f} s, {n_patch / r.wall_s:8.0f} patches/s, "
                   f"{r.duration_s / r.wall_s:6.1f}x real time; batch solver {rate:8.0f}/s; "
                   f"share {100 * n_patch / r.wall_s / rate:5.1f}%; us/patch: " + ", ".join(
-                      f"{key} {phases.get(key, 0.0) / n_patch * 1e6:.1f}" for key in PHASES))
+                      f"{key} {phases.get(key, 0.0) / n_patch * 1e6:.1f}{parts.get(key, '')}"
+                      for key in PHASES))
             for f in out.glob(f"run{k}*"):
                 if f.is_dir():
                     import shutil

@@ -288,6 +288,10 @@ class Timing:
     kinematics: float = 0.0
     solve: float = 0.0
     state: float = 0.0
+    #: of ``decode``, the compiled scan of the patches (the adapter loop); of ``solve``, the
+    #: compiled solves
+    scan: float = 0.0
+    solver: float = 0.0
     solves: int = 0
     #: the solves as they were solved, when kept: :attr:`results.Profile.solves`
     inputs: list[tuple[Any, ...]] | None = None
@@ -644,9 +648,11 @@ class Batch:
         out = np.zeros((n, adapter.OUT_SIZE))
         peak = np.empty(n)
         m = at[rows]
+        t0 = time.perf_counter()
         kernels.scan_patches(w.arrays, w.buffer[m], w.start[m], layout.data_at, layout.width,
                              layout.height, layout.cells, layout.row, layout.step, layout.cols,
                              pressure, out, peak)
+        self.timing.scan += time.perf_counter() - t0
         p.stamp[rows] = self._stamps(w, m)
         status, cells = out[:, adapter.STATUS], out[:, adapter.CELLS]
         clean = status == adapter.OK
@@ -848,7 +854,9 @@ class Batch:
                 grid[back, 1] = -(grid[back, 1] + (ny - 1) * grid[back, 3])
                 xep[back, 2] = -xep[back, 2]
             speed = np.abs(creep[:, 3]) if self.law is not None else np.zeros(rows.size)
+            t1 = time.perf_counter()
             status, out = self._solve(np.ascontiguousarray(ps), grid, xep, speed)
+            self.timing.solver += time.perf_counter() - t1
             ok = status == contact_kernels.OK
             solved.append(rows[ok])
             if self.timing.inputs is not None:

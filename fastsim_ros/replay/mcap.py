@@ -31,6 +31,7 @@ import io
 import os
 import struct
 import threading
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -188,6 +189,8 @@ class IndexedMcap:
     file: BinaryIO
     #: by channel id, whether the file defines it (:meth:`channel_table`)
     known: NDArray[np.bool_] | None = None
+    #: wall time (s) spent decompressing chunks (:meth:`read_chunk`)
+    decompress_s: float = 0.0
 
     def close(self) -> None:
         """Close the file."""
@@ -223,7 +226,10 @@ class IndexedMcap:
             record = None
         if record is None or stream.count > chunk.length:
             raise McapError(f"the chunk at byte {chunk.offset} ends inside a field")
-        return raw, _chunk_records(record, chunk.offset)
+        t0 = time.perf_counter()
+        records = _chunk_records(record, chunk.offset)
+        self.decompress_s += time.perf_counter() - t0
+        return raw, records
 
 
 def open_indexed(path: Path) -> IndexedMcap | None:
