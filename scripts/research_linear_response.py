@@ -60,7 +60,8 @@ from fastsim_ros.contact.compiled import CalibratedMaeSolver  # noqa: E402
 import validate_accuracy as va  # noqa: E402  (the wheelset's patches and spin cases)
 
 MU, NU, G = va.MU, va.NU, va.G
-VARIANTS = ("default", "linear", "translation", "no_coupling")
+VARIANTS = ("default", "linear", "translation", "no_coupling", "faded_linear",
+            "faded_translation")
 _NO_FLOAT = np.empty((0, 0))
 _NO_BOOL = np.empty((0, 0), dtype=np.bool_)
 _NO_PARAMS = np.zeros(2)
@@ -68,13 +69,13 @@ _NO_PARAMS = np.zeros(2)
 TINY = 1e-6
 
 
-def exact_linear(area: GridArea, *, rtol: float = 1e-10,
+def exact_linear(area: GridArea, *, rtol: float = 1e-10, g: float = G,
                  reference: tuple[float, float] = (0.0, 0.0)) -> np.ndarray:
     """Return the exact ``3 x 3`` response: rows ``Fx, Fy, Mz``, columns ``xi, eta, phi``."""
-    op = exact.SteadyRollingOperator.of(area, nu=NU, shear_modulus=G)
+    op = exact.SteadyRollingOperator.of(area, nu=NU, shear_modulus=g)
     out = np.zeros((3, 3))
     for j, c in enumerate(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))):
-        s = exact.full_adhesion(area, *c, nu=NU, shear_modulus=G, reference=reference,
+        s = exact.full_adhesion(area, *c, nu=NU, shear_modulus=g, reference=reference,
                                 rtol=rtol, operator=op)
         out[:, j] = (s.fx, s.fy, s.mz)
     return out
@@ -108,8 +109,9 @@ def coarse_linear(area: GridArea) -> np.ndarray:
 class Prototype:
     """The calibrated MAE's march with each strip's ``1/L_k`` times a factor ``s_k``."""
 
-    def __init__(self) -> None:
-        self.solver = CalibratedMaeSolver(NU, G)
+    def __init__(self, g: float = G) -> None:
+        self.g = g
+        self.solver = CalibratedMaeSolver(NU, g)
 
     def setup(self, area: GridArea) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         s = self.solver
@@ -117,7 +119,7 @@ class Prototype:
         p.setflags(write=False)
         status, info, geo, env, flex, bound = k.mae_setup(
             p, area.x0, area.y0, area.dx, area.dy, 0.0, 0.0, 0.0, MU, 0.0, 0.0, s._rule, False,
-            G, s._knots, s._polys, True, s._pair_knots, s._pair_values)
+            self.g, s._knots, s._polys, True, s._pair_knots, s._pair_values)
         if status != k.OK:
             raise RuntimeError(f"mae_setup status {status} ({info})")
         return p, geo, env, flex
@@ -125,12 +127,38 @@ class Prototype:
     def sweep(self, area: GridArea, prep: tuple[Any, ...], flex: np.ndarray, xi: float,
               eta: float, phi: float, mu: float, *, knee: bool = True,
               reference: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float]:
+        fx, fy, mz, _ = self.sweep_slip(area, prep, flex, xi, eta, phi, mu, knee=knee,
+                                        reference=reference)
+        return fx, fy, mz
+
+    def sweep_slip(self, area: GridArea, prep: tuple[Any, ...], flex: np.ndarray, xi: float,
+                   eta: float, phi: float, mu: float, *, knee: bool = True,
+                   reference: tuple[float, float] = (0.0, 0.0)
+                   ) -> tuple[float, float, float, float]:
+        """Return ``Fx, Fy, Mz`` and the share of the cells in contact that slip."""
         p, geo, env, _ = prep
-        fx, fy, mz, _, _ = k.mae_sweep(
+        fx, fy, mz, nslip, ncontact = k.mae_sweep(
             p, mu, False, _NO_FLOAT, env, area.x0, area.y0, area.dx, area.dy, geo, flex, xi,
             eta, phi, reference[0], reference[1], k.LAW_CONSTANT, _NO_PARAMS, 0.0, _NO_FLOAT,
             _NO_FLOAT, _NO_BOOL, False, True, self.solver._knee if knee else k.NO_KNEE)
-        return fx, fy, mz
+        return fx, fy, mz, nslip / ncontact
+
+    def force(self, area: GridArea, prep: tuple[Any, ...], target: np.ndarray, variant: str,
+              creep: tuple[float, float, float], mu: float,
+              knee: bool = True) -> tuple[float, float, float]:
+        """Return the variant's ``Fx, Fy, Mz``.
+
+        ``faded_*``: the factors ``1 + (s - 1) a``, ``a`` the share of the
+        cells in adhesion in the method's own (unscaled) march at these
+        creepages: the exact stiffness in adhesion, the method's as the slip
+        area spreads.
+        """
+        base = variant.removeprefix("faded_")
+        s = self.factors(area, prep, target, base)
+        if variant.startswith("faded_"):
+            slipping = self.sweep_slip(area, prep, prep[3], *creep, mu, knee=knee)[3]
+            s = 1.0 + (s - 1.0) * (1.0 - slipping)
+        return self.sweep(area, prep, self.scaled(prep[3], s), *creep, mu, knee=knee)
 
     def partials(self, area: GridArea, prep: tuple[Any, ...]) -> tuple[float, ...]:
         """Return ``P1 .. P4`` (N per unit creepage, N m per unit spin) at ``S``."""
@@ -206,14 +234,14 @@ def part_wheelset(proto: Prototype) -> None:
         if key not in cache:
             prep = proto.setup(area)
             target = exact_linear(area)
-            cache[key] = (prep, target, {v: proto.factors(area, prep, target[:2], v)
-                                         for v in VARIANTS})
+            cache[key] = (prep, target, {"linear": proto.factors(area, prep, target[:2],
+                                                                 "linear")})
         prep, target, facs = cache[key]
         ex = exact.coulomb(area, *creep, mu=MU, nu=NU, shear_modulus=G)
         ref = proto.solver.solve(area, *creep, mu=MU)
         errs = []
         for v in VARIANTS:
-            fx, fy, _ = proto.sweep(area, prep, proto.scaled(prep[3], facs[v]), *creep, MU)
+            fx, fy, _ = proto.force(area, prep, target[:2], v, creep, MU)
             if v == "default":
                 assert abs(fx - ref.fx) + abs(fy - ref.fy) < 1e-6 * MU * n, "not the default"
             errs.append(error((fx, fy), (ex.fx, ex.fy), n))
@@ -229,12 +257,10 @@ def part_wheelset(proto: Prototype) -> None:
     print("| --- | " + " | ".join("---" for _ in VARIANTS) + " |")
     for group, g in worst.items():
         print(f"| {group} | " + " | ".join(f"{g[v]:.2f}" for v in VARIANTS) + " |")
-    print("\n### Couplings the march cannot carry (exact, relative)\n")
-    for key, (prep, target, _) in cache.items():
-        c12 = target[0, 1] / target[0, 0]
-        c21 = target[1, 0] / target[1, 1]
-        print(f"- patch {len(prep[1]) and int(prep[1][k.G_NCONTACT])} cells: dFx/deta / "
-              f"dFx/dxi {c12:+.4f}, dFy/dxi / dFy/deta {c21:+.4f}")
+    c12 = max(abs(t[0, 1] / t[0, 0]) for _, t, _ in cache.values())
+    c21 = max(abs(t[1, 0] / t[1, 1]) for _, t, _ in cache.values())
+    print(f"\nCouplings the march cannot carry (exact, largest over the {len(cache)} patches): "
+          f"|dFx/deta| / |dFx/dxi| {c12:.4f}, |dFy/dxi| / |dFy/deta| {c21:.4f}")
 
 
 WIDER_CELLS = 40
@@ -284,8 +310,7 @@ def part_wider(proto: Prototype) -> None:
         op = exact.SteadyRollingOperator.of(ar, nu=NU, shear_modulus=G)
         prep = proto.setup(ar)
         target = exact_linear(ar)
-        facs = {v: proto.factors(ar, prep, target[:2], v) for v in VARIANTS}
-        flex = {v: proto.scaled(prep[3], facs[v]) for v in VARIANTS}
+        facs = {"linear": proto.factors(ar, prep, target[:2], "linear")}
         sat = saturation(ar)
         mun = MU * ar.load
         worst = {v: (0.0, "") for v in VARIANTS}
@@ -294,7 +319,7 @@ def part_wider(proto: Prototype) -> None:
                 cr = tuple(lev * d * s for d, s in zip(direction, sat))
                 ex = exact.coulomb(ar, *cr, mu=MU, nu=NU, shear_modulus=G, operator=op)
                 for v in VARIANTS:
-                    fx, fy, _ = proto.sweep(ar, prep, flex[v], *cr, MU)
+                    fx, fy, _ = proto.force(ar, prep, target[:2], v, cr, MU)
                     e = 0.0
                     for fm, fe in ((fx, ex.fx), (fy, ex.fy)):
                         if abs(fe) > 0.05 * mun:
@@ -310,7 +335,7 @@ def part_wider(proto: Prototype) -> None:
 def part_ellipses(proto: Prototype) -> None:
     print("\n## Hertzian ellipses: the factors (1 = unchanged) on the grid, and against "
           "Kalker's extrapolated coefficients\n")
-    print("| a/b | cells | s1 | s2 | s3 | s4 | exact grid C11 / extrapolated |")
+    print("| a/b | cells | s1 | s2 | s3 | s4 | exact on the grid / extrapolated: C11, C22, C23 |")
     print("| --- | --- | --- | --- | --- | --- | --- |")
     for g in (0.3, 1.0, 2.0 / 3.0, 3.0):
         a, b = areas.semi_ellipse_axes(g)
@@ -319,10 +344,90 @@ def part_ellipses(proto: Prototype) -> None:
             prep = proto.setup(ar)
             target = exact_linear(ar)
             s = proto.factors(ar, prep, target[:2], "linear")
-            c11 = target[0, 0] / (G * ar.area)
-            ext = exact.extrapolated_coefficients("ellipse", (g,), nu=NU, finest=60).C11
+            grid = exact.creep_coefficients(ar, nu=NU)
+            ext = exact.extrapolated_coefficients("ellipse", (g,), nu=NU, finest=60)
             print(f"| {g:.3g} | {n} | {s[0]:.3f} | {s[1]:.3f} | {s[2]:.3f} | {s[3]:.3f} | "
-                  f"{abs(c11) / abs(ext):.3f} |", flush=True)
+                  f"{grid.C11 / ext.C11:.3f}, {grid.C22 / ext.C22:.3f}, "
+                  f"{grid.C23 / ext.C23:.3f} |", flush=True)
+
+
+def part_curve(proto: Prototype) -> None:
+    """Print the signed Fx, Fy errors along the creepage on the patches the fit fails on.
+
+    The tread: ``xi`` alone varied (the pose's ``eta``, ``phi`` kept, as the
+    axle spin of ``scripts/validate_accuracy.py`` does); the take-over: the
+    pose's creepages times a factor.
+    """
+    curve_variants = VARIANTS
+    print("\n## Along the curve: (F - F_exact) / (mu N), % (signed; x then y)\n")
+    print("| patch | creepages | F_exact / (mu N) | " + " | ".join(curve_variants)
+          + " | default, FastSim's knee | linear, FastSim's knee |")
+    print("| --- | --- | --- | " + " | ".join("---" for _ in curve_variants) + " | --- | --- |")
+    for label, dy, spin, wheel in (("tread", -0.414e-3, va.axle_spin(None), "right"),
+                                   ("take-over", -4.95e-3, va.SPEED / va.RADIUS, "right")):
+        area, creep, n = va.patches(dy, spin)[wheel]
+        prep = proto.setup(area)
+        target = exact_linear(area)
+        mun = MU * n
+        if label == "tread":
+            points = [(x, creep[1], creep[2]) for x in
+                      (1e-4, 2e-4, 3e-4, 4e-4, 6e-4, 8e-4, 1e-3, 1.5e-3, 2e-3, 3e-3, 5e-3, 1e-2)]
+        else:
+            points = [tuple(f * c for c in creep) for f in (0.1, 0.25, 0.5, 1.0, 2.0, 4.0, 10.0)]
+        for cr in points:
+            ex = exact.coulomb(area, *cr, mu=MU, nu=NU, shear_modulus=G)
+            cells = []
+            for v, knee in [(v, True) for v in curve_variants] + [("default", False),
+                                                                  ("linear", False)]:
+                fx, fy, _ = proto.force(area, prep, target[:2], v, cr, MU, knee=knee)
+                cells.append(f"{100 * (fx - ex.fx) / mun:+.2f}, {100 * (fy - ex.fy) / mun:+.2f}")
+            print(f"| {label} ({wheel}, {1e3 * dy:+.3f} mm) | {cr[0]:.2e}, {cr[1]:.1e}, "
+                  f"{cr[2]:.3f} | {ex.fx / mun:+.3f}, {ex.fy / mun:+.3f} | "
+                  + " | ".join(cells) + " |", flush=True)
+
+
+def part_a22() -> None:
+    """CONTACT's Manchester A-2.2 poses (the package's patches, exact.coulomb on them)."""
+    from fastsim_ros import cli
+    from fastsim_ros.cli_wheelset import solve_pose
+    from fastsim_ros.geometry import benchmark as bm
+    proto = Prototype(bm.SHEAR_MODULUS)
+    print("\n## Manchester A-2.2 poses (package's patches, 0.2 mm cells): error, % of mu N\n")
+    print("| wheel, pose (dy mm, yaw mrad) | patch | s1 | s2 | s3 | s4 | "
+          + " | ".join(VARIANTS) + " |")
+    print("| --- | --- | --- | --- | --- | --- | " + " | ".join("---" for _ in VARIANTS) + " |")
+    worst = {v: 0.0 for v in VARIANTS}
+    for side in ("right", "left"):
+        for case in bm.a22(side):
+            args = cli.build_parser().parse_args([
+                "wheelset", "--dy", repr(case.dy), "--yaw", repr(case.yaw), "--roll",
+                repr(case.roll), "--load", repr(bm.LOAD), "--speed", repr(case.forward_speed),
+                "--axle-spin", repr(case.axle_spin), "--mu", repr(bm.MU), "--shear-modulus",
+                repr(bm.SHEAR_MODULUS), "--nu", repr(bm.POISSON), "--cell", repr(bm.CELL)])
+            cycle, _ = solve_pose(args, case.dy, case.yaw)
+            for o in cycle.outcomes:
+                if o.patch is None or o.creepage is None or o.forces is None:
+                    continue
+                if not o.contact.startswith(side):
+                    continue
+                pp = o.patch
+                area = GridArea(pp.x0, pp.y0, pp.dx, pp.dy, np.array(pp.pressure))
+                creep = (o.creepage.xi, o.creepage.eta, o.creepage.phi)
+                n = o.forces.n
+                prep = proto.setup(area)
+                target = exact_linear(area, g=bm.SHEAR_MODULUS)
+                ex = exact.coulomb(area, *creep, mu=bm.MU, nu=bm.POISSON,
+                                   shear_modulus=bm.SHEAR_MODULUS)
+                errs = []
+                for v in VARIANTS:
+                    fx, fy, _ = proto.force(area, prep, target[:2], v, creep, bm.MU)
+                    errs.append(error((fx, fy), (ex.fx, ex.fy), n))
+                    worst[v] = max(worst[v], errs[-1])
+                s = proto.factors(area, prep, target[:2], "linear")
+                print(f"| {side} {case.number} ({1e3 * case.dy:.1f}, {1e3 * case.yaw:.0f}) | "
+                      f"{o.contact} | {s[0]:.3f} | {s[1]:.3f} | {s[2]:.3f} | {s[3]:.3f} | "
+                      + " | ".join(f"{e:.2f}" for e in errs) + " |", flush=True)
+    print("| worst | | | | | | " + " | ".join(f"{worst[v]:.2f}" for v in VARIANTS) + " |")
 
 
 def part_cost(proto: Prototype) -> None:
@@ -377,7 +482,7 @@ def part_cost(proto: Prototype) -> None:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--part", default="all",
-                        choices=("all", "wheelset", "wider", "ellipses", "cost"))
+                        choices=("all", "wheelset", "wider", "ellipses", "curve", "a22", "cost"))
     args = parser.parse_args()
     proto = Prototype()
     start = time.perf_counter()
@@ -387,6 +492,10 @@ def main() -> int:
         part_wider(proto)
     if args.part in ("all", "ellipses"):
         part_ellipses(proto)
+    if args.part in ("all", "curve"):
+        part_curve(proto)
+    if args.part in ("all", "a22"):
+        part_a22()
     if args.part in ("all", "cost"):
         part_cost(proto)
     print(f"\nThe run took {time.perf_counter() - start:.0f} s.")
