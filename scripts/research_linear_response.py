@@ -33,7 +33,20 @@ Hertzian ellipses (the factors' distance from 1).  Errors: the larger of
 :func:`fastsim_ros.contact.exact.coulomb` on the same grid.  Then the cost
 of the exact linear response per patch and of cheaper estimates of it.
 
-Usage: ``python scripts/research_linear_response.py [--part all|wheelset|wider|cost]``.
+Findings (the run's tables, 2 cores shared): the exact stiffness fixes the
+linear range of the long narrow tread patch (right wheel, -0.414 mm: 4.2% of
+mu N at xi 1e-4 with the pose's spin, 0.8% scaled) but the strip knee
+factors then overshoot at the knee (-0.52% to -2.7% at xi 1e-3; the wheelset's
+knee level 1.9% to 3.9%): the exact theory's excess stiffness of that patch
+is lost as the slip area spreads, the ellipses' knee table has none.  The
+``L4`` factor is ill-conditioned (``P4`` a difference of the zones' terms:
+4.5 on the take-over, whose error goes from 4.2% to 35%).  On a Hertzian
+ellipse the factors are the exact solver's own grid error (``C_grid /
+C_extrapolated`` to 0.003): the scaling moves an ellipse off Kalker's.
+The exact linear response costs 40-290 ms a patch (three GMRES solves).
+
+Usage: ``python scripts/research_linear_response.py
+[--part all|wheelset|wider|ellipses|curve|a22|cost]``.  About 2 minutes.
 """
 
 from __future__ import annotations
@@ -430,12 +443,35 @@ def part_a22() -> None:
     print("| worst | | | | | | " + " | ".join(f"{worst[v]:.2f}" for v in VARIANTS) + " |")
 
 
+def dense_linear(area: GridArea) -> np.ndarray:
+    """Return :func:`exact_linear`'s ``Fx, Fy`` rows by one dense LU and three right sides."""
+    import scipy.linalg
+    from fastsim_ros.contact.traction import resultants, rigid_slip
+    op = exact.SteadyRollingOperator.of(area, nu=NU, shear_modulus=G)
+    mask = area.mask
+    n = int(np.count_nonzero(mask))
+    rhs = []
+    for c in ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)):
+        wx, wy = rigid_slip(area, *c, (0.0, 0.0))
+        rhs.append(np.concatenate([wx[mask], wy[mask]]))
+    tau = scipy.linalg.lu_solve(scipy.linalg.lu_factor(op.dense()), np.array(rhs).T)
+    out = np.zeros((2, 3))
+    for j in range(3):
+        tx = np.zeros(mask.shape)
+        ty = np.zeros(mask.shape)
+        tx[mask] = tau[:n, j]
+        ty[mask] = tau[n:, j]
+        out[:, j] = resultants(area, tx, ty, (0.0, 0.0))[:2]
+    return out
+
+
 def part_cost(proto: Prototype) -> None:
     print("\n## Cost of the exact linear response per patch (median of 3, one core)\n")
     print("| patch | cells in contact | operator build, ms | 3 solves rtol 1e-10, ms | "
           "3 solves rtol 1e-4, ms | worst factor change at 1e-4 | coarse grid (2x cells), "
-          "ms | worst factor change coarse | calibrated MAE solve, us |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+          "ms | worst factor change coarse | dense LU, 3 right sides, ms | "
+          "calibrated MAE solve, us |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     cases = []
     for dy, wheel in ((-0.414e-3, "right"), (-0.414e-3, "left"), (-4.95e-3, "right"),
                       (-4.0e-3, "right")):
@@ -445,7 +481,7 @@ def part_cost(proto: Prototype) -> None:
         ar = wider_makers()[name](40)
         cases.append((f"{name} (40 cells)", ar, (1e-4, 0.0, 0.0)))
     for label, area, creep in cases:
-        t_op, t_fine, t_loose, t_coarse = [], [], [], []
+        t_op, t_fine, t_loose, t_coarse, t_dense = [], [], [], [], []
         for _ in range(3):
             t0 = time.perf_counter()
             op = exact.SteadyRollingOperator.of(area, nu=NU, shear_modulus=G)
@@ -460,6 +496,9 @@ def part_cost(proto: Prototype) -> None:
             t0 = time.perf_counter()
             rough = coarse_linear(area)
             t_coarse.append(time.perf_counter() - t0)
+            t0 = time.perf_counter()
+            dense_linear(area)
+            t_dense.append(time.perf_counter() - t0)
         fine = exact_linear(area)
         prep = proto.setup(area)
         s_fine = proto.factors(area, prep, fine[:2], "linear")
@@ -476,7 +515,8 @@ def part_cost(proto: Prototype) -> None:
               f"{np.max(np.abs(s_loose / s_fine - 1)):.2e} | "
               f"{1e3 * np.median(t_coarse):.1f} | {np.max(np.abs(s_rough / s_fine - 1)):.3f} "
               f"(s {', '.join(f'{v:.3f}' for v in s_rough)} vs "
-              f"{', '.join(f'{v:.3f}' for v in s_fine)}) | {1e6 * t_fast:.0f} |", flush=True)
+              f"{', '.join(f'{v:.3f}' for v in s_fine)}) | {1e3 * np.median(t_dense):.1f} | "
+              f"{1e6 * t_fast:.0f} |", flush=True)
 
 
 def main() -> int:
