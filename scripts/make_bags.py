@@ -825,6 +825,7 @@ def adhesion_rig() -> tuple[Bag, dict[str, Any]]:
 
     law_shape = {"limit_ratio": ADHESION_LAW["friction_limit_ratio"],
                  "decay": ADHESION_LAW["friction_decay"]}
+
     def measure(t: float, outcomes: list[Any]) -> tuple[float, float, float]:
         # the two treads are mirror images under the same creepages: one exact solve a cycle
         total = np.zeros(3)

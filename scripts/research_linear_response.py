@@ -400,7 +400,7 @@ def part_curve(proto: Prototype) -> None:
 
 
 def part_a22() -> None:
-    """CONTACT's Manchester A-2.2 poses (the package's patches, exact.coulomb on them)."""
+    """Solve the Manchester A-2.2 poses of CONTACT (the package's patches, exact on them)."""
     from fastsim_ros import cli
     from fastsim_ros.cli_wheelset import solve_pose
     from fastsim_ros.geometry import benchmark as bm
