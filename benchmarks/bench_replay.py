@@ -41,9 +41,13 @@ With ``--long``, instead: a recording made here (``--seconds`` of one
 contact at 200 Hz, 30 x 30-cell Hertzian patches in steady running's
 partial slip, the default method) replayed ``--rounds`` times in this process after one
 untimed replay (the kernels loaded: the wall beyond start-up), and the
-command line's start-up measured apart; patches per second, the multiple
-of real time, the batch solver's rate on the same patches in the same run
-and the share; each run printed, then the medians.
+command line's start-up measured apart; patches per second and the
+multiple of real time of the replay as ``fastsim_replay`` runs it, the
+batch solver's rate on the same patches in the same run (after a profiled
+replay of each round, which keeps the solves' inputs) and the share; each
+run printed (with the profiled replay's phases in us per patch, and of
+``read`` the decompression, of ``decode`` the compiled adapter loop, of
+``solve`` the compiled solves), then the medians.
 
 With ``--scheduler``, instead: ``N`` small bags (generated: the first
 0.5 s of ``hertz_ramp``, 200 by default) replayed by two local worker
@@ -98,6 +102,9 @@ PER_MESSAGE = ("transient_step", "adhesion_rig", "mbench_a22")
 SAME_CONTACTS = ("hertz_ramp", "semi_ellipses_spin", "bad_inputs")
 PHASES = ("read", "copy", "decode", "kinematics", "solve", "state", "encode", "write",
           "diagnostics")
+#: parts of phases, printed beside them in --long: (part, of phase, label)
+PARTS = (("decompress", "read", "decompression"), ("scan", "decode", "adapter loop"),
+         ("solver", "solve", "compiled solves"))
 #: the last commit whose fastsim_ros/replay/mcap.py wrote and parsed MCAP by hand
 MCAP_BEFORE = "ddc07d7"
 SOLVERS = {"mae": MaeSolver, "mae_calibrated": CalibratedMaeSolver,
@@ -314,17 +321,26 @@ def long_main(seconds: float, rounds: int) -> int:
         n_patch = int(round(seconds * 200))
         rows = []
         for k in range(rounds):
-            r = replay.replay_bag(bag, f"run{k}", out, values, progress=False, profile=True)
-            if not r.ok:
-                raise SystemExit(f"replay failed: {r.error}")
-            rate = batch_rate(r.profile.solves, values)
+            # the replay as fastsim_replay runs it, then a profiled one (its phases, and its
+            # solves for the batch solver: it keeps every solve's inputs, 86 MB of pressures for
+            # the 60 s recording, which costs it some 5% of its wall)
+            r = replay.replay_bag(bag, f"run{k}", out, values, progress=False)
+            prof = replay.replay_bag(bag, f"prof{k}", out, values, progress=False, profile=True)
+            if not (r.ok and prof.ok):
+                raise SystemExit(f"replay failed: {r.error or prof.error}")
+            rate = batch_rate(prof.profile.solves, values)
             rows.append((n_patch / r.wall_s, r.duration_s / r.wall_s, rate))
-            phases = r.profile.phases
-            print(f"  run {k}: wall {r.wall_s:.3f} s, {n_patch / r.wall_s:8.0f} patches/s, "
-                  f"{r.duration_s / r.wall_s:6.1f}x real time; batch solver {rate:8.0f}/s; "
-                  f"share {100 * n_patch / r.wall_s / rate:5.1f}%; us/patch: " + ", ".join(
-                      f"{key} {phases.get(key, 0.0) / n_patch * 1e6:.1f}" for key in PHASES))
-            for f in out.glob(f"run{k}*"):
+            phases = prof.profile.phases
+            parts = {of: f" ({label} {phases.get(part, 0.0) / n_patch * 1e6:.1f})"
+                     for part, of, label in PARTS}
+            share = 100 * n_patch / r.wall_s / rate
+            print(f"  run {k}: wall {r.wall_s:.3f} s (profiled {prof.wall_s:.3f} s), "
+                  f"{n_patch / r.wall_s:8.0f} patches/s, {r.duration_s / r.wall_s:6.1f}x real "
+                  f"time; batch solver {rate:8.0f}/s; share {share:5.1f}%"
+                  f"; us/patch (profiled): " + ", ".join(
+                      f"{key} {phases.get(key, 0.0) / n_patch * 1e6:.1f}{parts.get(key, '')}"
+                      for key in PHASES))
+            for f in [*out.glob(f"run{k}*"), *out.glob(f"prof{k}*")]:
                 if f.is_dir():
                     import shutil
                     shutil.rmtree(f)

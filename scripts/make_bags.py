@@ -754,6 +754,55 @@ def adhesion_xi(t: float) -> float:
     return 3.0e-3 + 9.0e-3 * (t % 1.0)  # ramps 3e-3 -> 1.2e-2 in a second
 
 
+def _rig(name: str, xi_of: Callable[[float], float], seed: int, noise: float,
+         measure: Callable[[float, list[Any]], tuple[float, float, float]]) -> Bag:
+    """Return a rig's bag: twists, patch pairs and with each pair a measured wheelset wrench.
+
+    Two mirrored Hertzian treads (gap radii 0.46 m and 0.3 m, 50 kN each,
+    20 x 20 cells) at 20 m/s for 4 s, the creepage ``xi_of(t)``; the
+    measured wrench is ``measure(t, outcomes)`` (N, wheelset frame) on the
+    pair's outcomes as the node converts these very messages (the
+    pipeline's own conversion), plus a load cell's Gaussian noise of
+    ``noise`` (N) on ``force.x``, seeded by ``seed`` (the same bag every run).
+    """
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+
+    dur, v0 = 4.0, 20.0
+    bag = Bag(name)
+    bag.topic("/wheelset/twist", TWIST)
+    bag.topic("/wheelset/measured_wrench", WRENCH)
+    for c in ("left", "right"):
+        bag.topic(f"/contact/{c}/patch", CLOUD)
+    area = hertz_area(R, 0.3, 5.0e4, 20)
+    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
+           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
+    converter = Pipeline(PipelineConfig.from_values(dict(BASE_PARAMS, method="mae_calibrated")))
+    twists = {}
+    for t in twist_times(dur):
+        msg = twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, xi_of(t), R), 0))
+        twists[stamp_ns(t)] = msg
+        bag.add("/wheelset/twist", stamp_ns(t), msg)
+    rng = np.random.default_rng(seed)
+    for t in patch_times(dur):
+        ns = stamp_ns(t)
+        newest = max(k for k in twists if k <= ns)
+        converter.on_wheel_twist(TYPESTORE.serialize_cdr(twists[newest], TWIST))
+        outcomes = []
+        for c in ("left", "right"):
+            cloud = cloud_msg(ns, pts[c])
+            out = converter.on_patch(c, TYPESTORE.serialize_cdr(cloud, CLOUD))
+            assert out.status == "solved", out.status
+            outcomes.append(out)
+            bag.add(f"/contact/{c}/patch", ns, cloud)
+        force = measure(t, outcomes)
+        w = T[WRENCH](
+            header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
+                force=vec((force[0] + rng.normal(0.0, noise), force[1], force[2])),
+                torque=vec((0.0, 0.0, 0.0))))
+        bag.add("/wheelset/measured_wrench", ns, w)
+    return bag
+
+
 def adhesion_rig() -> tuple[Bag, dict[str, Any]]:
     """Build (h): a wheelset on a traction rig, the measured wrench from the exact theory.
 
@@ -773,52 +822,27 @@ def adhesion_rig() -> tuple[Bag, dict[str, Any]]:
     """
     from fastsim_ros.contact import exact
     from fastsim_ros.contact.friction import friction_law
-    from fastsim_ros.pipeline import Pipeline, PipelineConfig
 
-    dur, v0 = 4.0, 20.0
-    bag = Bag("adhesion_rig")
-    bag.topic("/wheelset/twist", TWIST)
-    bag.topic("/wheelset/measured_wrench", WRENCH)
-    for c in ("left", "right"):
-        bag.topic(f"/contact/{c}/patch", CLOUD)
-    area = hertz_area(R, 0.3, 5.0e4, 20)
-    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
-           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
-    converter = Pipeline(PipelineConfig.from_values(dict(BASE_PARAMS, method="mae_calibrated")))
-    twists = {}
-    for t in twist_times(dur):
-        msg = twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, adhesion_xi(t), R), 0))
-        twists[stamp_ns(t)] = msg
-        bag.add("/wheelset/twist", stamp_ns(t), msg)
-    rng = np.random.default_rng(ADHESION_SEED)
     law_shape = {"limit_ratio": ADHESION_LAW["friction_limit_ratio"],
                  "decay": ADHESION_LAW["friction_decay"]}
-    for t in patch_times(dur):
-        ns = stamp_ns(t)
-        newest = max(k for k in twists if k <= ns)
-        converter.on_wheel_twist(TYPESTORE.serialize_cdr(twists[newest], TWIST))
+
+    def measure(t: float, outcomes: list[Any]) -> tuple[float, float, float]:
+        # the two treads are mirror images under the same creepages: one exact solve a cycle
         total = np.zeros(3)
-        solved = None
-        for c in ("left", "right"):
-            cloud = cloud_msg(ns, pts[c])
-            out = converter.on_patch(c, TYPESTORE.serialize_cdr(cloud, CLOUD))
-            assert out.status == "solved", out.status
+        solved: list[Any] = [None]
+        for out in outcomes:
             p, cr = out.patch, out.creepage
             key = (p.pressure.tobytes(), p.x0, p.y0, p.dx, p.dy, cr.xi, cr.eta, abs(cr.phi),
                    cr.speed)
-            if solved is None or solved[0] != key:
+            if solved[0] is None or solved[0][0] != key:
                 law = friction_law(ADHESION_LAW["friction_law"], adhesion_mu(t), **law_shape)
                 f = exact.coulomb(GridArea(p.x0, p.y0, p.dx, p.dy, p.pressure), cr.xi,
                                   cr.eta, cr.phi, nu=NU, shear_modulus=G, friction=law,
                                   speed=abs(cr.speed))
-                solved = (key, f.fx, f.fy)
-            total += p.frame.to_wheelset((solved[1], solved[2], p.load))
-            bag.add(f"/contact/{c}/patch", ns, cloud)
-        w = T[WRENCH](
-            header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
-                force=vec((total[0] + rng.normal(0.0, ADHESION_NOISE), total[1], total[2])),
-                torque=vec((0.0, 0.0, 0.0))))
-        bag.add("/wheelset/measured_wrench", ns, w)
+                solved[0] = (key, f.fx, f.fy)
+            total += p.frame.to_wheelset((solved[0][1], solved[0][2], p.load))
+        return float(total[0]), float(total[1]), float(total[2])
+    bag = _rig("adhesion_rig", adhesion_xi, ADHESION_SEED, ADHESION_NOISE, measure)
     return bag, {"method": "mae_calibrated", **ADHESION_LAW, "friction_coefficient": 0.3,
                  "friction_estimation": "on", "friction_measurement_noise": ADHESION_NOISE,
                  "friction_estimate_sigma": 0.1}
@@ -890,50 +914,25 @@ def contaminated_rig() -> tuple[Bag, dict[str, Any]]:
     from fastsim_ros.contact.slope_reduction import SlopeReduction
     from fastsim_ros.estimation import ContactSample, CreepModel
     from fastsim_ros.estimation.model import solver_for
-    from fastsim_ros.pipeline import Pipeline, PipelineConfig
 
-    dur, v0 = 4.0, 20.0
-    bag = Bag("contaminated_rig")
-    bag.topic("/wheelset/twist", TWIST)
-    bag.topic("/wheelset/measured_wrench", WRENCH)
-    for c in ("left", "right"):
-        bag.topic(f"/contact/{c}/patch", CLOUD)
-    area = hertz_area(R, 0.3, 5.0e4, 20)
-    pts = {"left": cloud_points(area, (0.0, Y_WHEEL, -R), left_normal(0.0)),
-           "right": cloud_points(area, (0.0, -Y_WHEEL, -R), right_normal(0.0))}
-    converter = Pipeline(PipelineConfig.from_values(dict(BASE_PARAMS, method="mae_calibrated")))
     solver = solver_for("mae_calibrated", NU, G)
-    twists = {}
-    for t in twist_times(dur):
-        msg = twist_msg(stamp_ns(t), (v0, 0, 0), (0, omega_for(v0, contaminated_xi(t), R), 0))
-        twists[stamp_ns(t)] = msg
-        bag.add("/wheelset/twist", stamp_ns(t), msg)
-    rng = np.random.default_rng(CONTAMINATED_SEED)
-    for t in patch_times(dur):
-        ns = stamp_ns(t)
-        newest = max(k for k in twists if k <= ns)
-        converter.on_wheel_twist(TYPESTORE.serialize_cdr(twists[newest], TWIST))
+
+    def measure(t: float, outcomes: list[Any]) -> tuple[float, float, float]:
         samples, normal = [], np.zeros(3)
-        for c in ("left", "right"):
-            cloud = cloud_msg(ns, pts[c])
-            out = converter.on_patch(c, TYPESTORE.serialize_cdr(cloud, CLOUD))
-            assert out.status == "solved", out.status
+        for out in outcomes:
             p, cr = out.patch, out.creepage
             samples.append(ContactSample(p.pressure, p.x0, p.y0, p.dx, p.dy, cr.xi, cr.eta,
                                          cr.phi, cr.speed,
                                          ((p.frame.axes[0][0], p.frame.axes[1][0]),)))
             normal += p.frame.to_wheelset((0.0, 0.0, p.load))
-            bag.add(f"/contact/{c}/patch", ns, cloud)
         model = CreepModel(solver, knee=False, reduction=SlopeReduction(
             stepped(CONTAMINATED_K0_STEPS, t),
             CONTAMINATED_REDUCTION["slope_reduction_alpha_inf"],
             CONTAMINATED_REDUCTION["slope_reduction_beta"]))
         fx = float(model.predict(samples, stepped(CONTAMINATED_MU_STEPS, t))[0]) + normal[0]
-        w = T[WRENCH](
-            header=header(ns), wrench=T["geometry_msgs/msg/Wrench"](
-                force=vec((fx + rng.normal(0.0, CONTAMINATED_NOISE), 0.0, normal[2])),
-                torque=vec((0.0, 0.0, 0.0))))
-        bag.add("/wheelset/measured_wrench", ns, w)
+        return fx, 0.0, float(normal[2])
+    bag = _rig("contaminated_rig", contaminated_xi, CONTAMINATED_SEED, CONTAMINATED_NOISE,
+               measure)
     return bag, {"method": "mae_calibrated", "friction_coefficient": 0.3,
                  "slope_reduction_k0": 0.8, **CONTAMINATED_REDUCTION,
                  "friction_estimation": "on", "friction_estimate_slope_reduction": True,

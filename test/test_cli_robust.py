@@ -502,7 +502,7 @@ def test_an_extrapolation_solves_no_grid_finer_than_asked(capsys, cells, grids):
                                   ["0,0,1e9", "0,0.001,1e9", "0,0.002,1e9", "0.001,0,0"]],
                          ids=["one-cell", "one-column"])
 def test_dlm_on_a_patch_too_thin_to_level_is_bad_input(capsys, tmp_path, command, rows):
-    """Refuse DLM on a patch too thin to level: one line, exit 2 (was exit 1, a nan)."""
+    """Refuse DLM on a patch too thin to level: one line, exit 2 (not a nan)."""
     patch = tmp_path / "thin.csv"
     patch.write_text("x,y,pressure\n" + "\n".join(rows) + "\n")
     argv = [command, "--patch", patch, "--method", "dlm"]
@@ -538,7 +538,7 @@ def test_an_overflowing_load_is_told_without_inf(capsys):
 
 
 def test_an_answer_that_cannot_be_written_is_one_line(tmp_path):
-    """Tell a full device on stdout in one line on stderr, no traceback (was an OSError's)."""
+    """Tell a full device on stdout in one line on stderr, no traceback (not an OSError's)."""
     with open("/dev/full", "w") as full:
         proc = subprocess.run([sys.executable, "-m", "fastsim_ros.cli", "coefficients",
                                "--shape", "ellipse", "--a-over-b", "1", "--method", "mae",

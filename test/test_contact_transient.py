@@ -295,11 +295,11 @@ def test_steps_of_whole_cells_reach_the_steady_state_under_spin(solver_cls, cell
     march's own projection (the calibrated MAE's rigid-slip return, the
     falling law's kinetic level from where the particle starts), and every
     cell of the path is tested, not only the last: so with ``h`` a whole
-    number of cells the steady state is a fixed point of the steps.  Before,
-    a path was marched only when its end was over the bound, with the radial
-    return: the calibrated MAE's fixed point under spin lay 1-4 points of
-    mu N off its steady answer (-0.3515 against -0.3910 on a/b = 2 at ten
-    cells a step).
+    number of cells the steady state is a fixed point of the steps.  A path
+    marched only where its end is over the bound, with the radial return,
+    puts the calibrated MAE's fixed point under spin 1-4 points of mu N off
+    its steady answer (-0.3515 against -0.3910 on a/b = 2 at ten cells a
+    step).
     """
     solver = solver_cls(NU, G)
     creep = CREEPAGES[2]

@@ -578,7 +578,7 @@ def test_a_run_time_prior_restarts_the_estimate(hertz):
     just cleaned or sanded) means it: the estimate starts again from that
     value with friction_estimate_sigma, and the wrenches use it at once;
     a new friction_estimate_sigma alone sets the estimate's uncertainty.
-    (Before, both were taken and did nothing.)
+    Both act: a value taken and ignored would tell the engineer nothing.
     """
     from fastsim_ros.pipeline import Pipeline, PipelineConfig
     from ros_messages import cdr, cloud_msg, rolling_twist

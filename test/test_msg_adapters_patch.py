@@ -124,8 +124,8 @@ def test_empty_patch_is_no_contact():
 def test_a_grid_of_no_points_over_a_patchs_data_is_irregular_not_empty(emptied):
     """A zero width (or height) with the points still there is malformed, not a lifted wheel.
 
-    Before, the grid's size alone made it an empty patch: a zero wrench
-    published for a message that carried a whole loaded patch.
+    The grid's size alone must not make it an empty patch: that would
+    publish a zero wrench for a message that carries a whole loaded patch.
     """
     msg = cloud_msg(egg(), dtype="<f8")
     setattr(msg, emptied, 0)

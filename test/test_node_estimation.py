@@ -107,16 +107,21 @@ def offline_estimates(out, name="adhesion_rig", topic="/friction/estimate"):
     return estimates, fx
 
 
-def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
-    """The bag over DDS: twists and measured wrenches first (counted), then the patches."""
-    want, want_fx = offline_estimates(tmp_path / "offline")
-    with Reader(BAGS / "adhesion_rig") as reader:
+def feed_node(tmp_path, name, topics, finish=None):
+    """Play the bag ``name`` to a node over DDS; return its estimates, its Fx and its output.
+
+    Twists and measured wrenches first (counted), then the patches a cycle
+    at a time, each cycle waited for on every topic of ``topics``.  Return
+    ``({topic: {stamp: (x, y, z)}}, {(contact, stamp): Fx}, the node's
+    output)``; ``finish(client, publishers)`` runs before the node stops.
+    """
+    with Reader(BAGS / name) as reader:
         messages = [(conn.topic, bytes(raw)) for conn, _, raw in reader.messages()]
     first = [m for m in messages if m[0].endswith(("/twist", "/measured_wrench"))]
     patches = [m for m in messages if m[0].endswith("/patch")]
     assert len(first) + len(patches) == len(messages) and len(first) <= 2 * TWIST_HISTORY
     wrenches = sum(m[0].endswith("/measured_wrench") for m in first)
-    proc = NodeProcess("--params-file", str(BAGS / "adhesion_rig.params.yaml"),
+    proc = NodeProcess("--params-file", str(BAGS / f"{name}.params.yaml"),
                        "-p", "patch_reliability:=reliable", "-p", "qos_depth:=1000",
                        log_dir=tmp_path)
     client = Client(("left", "right"), name="player")
@@ -125,7 +130,7 @@ def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
                 "/wheelset/measured_wrench": client.publisher(WrenchStamped,
                                                               "wheelset/measured_wrench")}
         pubs.update({f"/contact/{c}/patch": p for c, p in client.patch.items()})
-        estimates = client.subscribe(Vector3Stamped, "friction/estimate")
+        received = {topic: client.subscribe(Vector3Stamped, topic) for topic in topics}
         client.wait_connected(proc)
         for topic, raw in first:
             pubs[topic].publish(raw)
@@ -135,10 +140,25 @@ def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
         for k in range(0, len(patches), 2):  # a cycle at a time: both patches, then its estimate
             for topic, raw in patches[k:k + 2]:
                 pubs[topic].publish(raw)
-            assert client.wait_for(lambda k=k: len(estimates) >= k // 2 + 1, 10.0)
-        got = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in estimates}
+            assert client.wait_for(
+                lambda k=k: all(len(got) >= k // 2 + 1 for got in received.values()), 10.0)
+        got = {topic: {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in ms}
+               for topic, ms in received.items()}
         got_fx = {(c, stamp_ns(w)): w.wrench.force.x for c, ws in client.wrenches.items()
                   for w in ws}
+        if finish is not None:
+            finish(client, pubs, got)
+    finally:
+        client.close()
+        assert proc.stop() == 0
+    return got, got_fx, proc.output()
+
+
+def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
+    """The bag over DDS: its estimates and forces as the replay's; a stray wrench dropped."""
+    want, want_fx = offline_estimates(tmp_path / "offline")
+
+    def wrong_frame(client, pubs, got):
         # a measured wrench in another frame: dropped, counted by its reason, logged
         bad = WrenchStamped()
         bad.header.frame_id = "base_link"
@@ -146,10 +166,10 @@ def test_node_fed_adhesion_rig_estimates_as_the_replay_does(tmp_path):
         pubs["/wheelset/measured_wrench"].publish(bad)
         assert client.wait_for(lambda: client.diagnostic_values("left").get(
             "measured_wrench/wrong_frame") == "1", 20.0)
-    finally:
-        client.close()
-        assert proc.stop() == 0
-    assert "wheelset/measured_wrench dropped: wrong_frame" in proc.output()
+    got, got_fx, output = feed_node(tmp_path, "adhesion_rig", ["friction/estimate"],
+                                    wrong_frame)
+    got = got["friction/estimate"]
+    assert "wheelset/measured_wrench dropped: wrong_frame" in output
     assert len(want) == 400 and got.keys() == want.keys()
     for stamp, value in want.items():
         assert got[stamp] == pytest.approx(value, rel=1e-12), stamp
@@ -169,44 +189,15 @@ def test_node_fed_contaminated_rig_estimates_mu_and_k0_as_the_replay_does(tmp_pa
     want_mu, want_fx = offline_estimates(tmp_path / "offline", "contaminated_rig")
     want_k0, _ = offline_estimates(tmp_path / "offline_k0", "contaminated_rig",
                                    "/friction/slope_estimate")
-    with Reader(BAGS / "contaminated_rig") as reader:
-        messages = [(conn.topic, bytes(raw)) for conn, _, raw in reader.messages()]
-    first = [m for m in messages if m[0].endswith(("/twist", "/measured_wrench"))]
-    patches = [m for m in messages if m[0].endswith("/patch")]
-    assert len(first) + len(patches) == len(messages) and len(first) <= 2 * TWIST_HISTORY
-    wrenches = sum(m[0].endswith("/measured_wrench") for m in first)
-    proc = NodeProcess("--params-file", str(BAGS / "contaminated_rig.params.yaml"),
-                       "-p", "patch_reliability:=reliable", "-p", "qos_depth:=1000",
-                       log_dir=tmp_path)
-    client = Client(("left", "right"), name="player")
-    try:
-        pubs = {"/wheelset/twist": client.twist,
-                "/wheelset/measured_wrench": client.publisher(WrenchStamped,
-                                                              "wheelset/measured_wrench")}
-        pubs.update({f"/contact/{c}/patch": p for c, p in client.patch.items()})
-        estimates = client.subscribe(Vector3Stamped, "friction/estimate")
-        slopes = client.subscribe(Vector3Stamped, "friction/slope_estimate")
-        client.wait_connected(proc)
-        for topic, raw in first:
-            pubs[topic].publish(raw)
-        client.wait_twists_handled(len(first) - wrenches)
-        assert client.wait_for(lambda: int(client.diagnostic_values("left").get(
-            "friction_estimation/measured", "0")) >= wrenches, 20.0)
-        for k in range(0, len(patches), 2):  # a cycle at a time: both patches, then its estimate
-            for topic, raw in patches[k:k + 2]:
-                pubs[topic].publish(raw)
-            assert client.wait_for(lambda k=k: len(estimates) >= k // 2 + 1
-                                   and len(slopes) >= k // 2 + 1, 10.0)
-        got_mu = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in estimates}
-        got_k0 = {stamp_ns(m): (m.vector.x, m.vector.y, m.vector.z) for m in slopes}
-        last_k0 = got_k0[max(got_k0)][0]
+
+    def k0_diagnosed(client, pubs, got):
+        last = got["friction/slope_estimate"]
+        last_k0 = last[max(last)][0]
         assert client.wait_for(lambda: client.diagnostic_values("left").get(
             "friction_estimation/k0") == f"{last_k0:.6g}", 20.0)
-        got_fx = {(c, stamp_ns(w)): w.wrench.force.x for c, ws in client.wrenches.items()
-                  for w in ws}
-    finally:
-        client.close()
-        assert proc.stop() == 0
+    got, got_fx, _ = feed_node(tmp_path, "contaminated_rig",
+                               ["friction/estimate", "friction/slope_estimate"], k0_diagnosed)
+    got_mu, got_k0 = got["friction/estimate"], got["friction/slope_estimate"]
     assert len(want_mu) == len(want_k0) == 400
     assert got_mu.keys() == want_mu.keys() and got_k0.keys() == want_k0.keys()
     for stamp in want_mu:

@@ -60,7 +60,7 @@ def _cases() -> list[tuple[str, str, list[str]]]:
     cases.append(("wheelset_frame-empty", "wheelset_frame", ["-p", "wheelset_frame:=''"]))
     cases.append(("contacts-duplicate", "contacts", ["-p", 'contacts:=["left", "left"]']))
     cases.append(("contacts-bad-name", "contacts", ["-p", 'contacts:=["left", "9x"]']))
-    # an empty list: rclpy cannot type it and leaves the parameter unset (was a traceback)
+    # an empty list: rclpy cannot type it and leaves the parameter unset (no traceback)
     cases.append(("contacts-empty", "contacts", ["-p", "contacts:=[]"]))
     for name in ("wheel_profile", "rail_profile", "right_wheel_profile", "right_rail_profile"):
         suffix = ".prw" if "wheel" in name else ".prr"

@@ -143,8 +143,8 @@ def test_bad_loads_are_not_taken(load, why):
 def test_a_stale_load_is_rejected_not_replaced():
     """Once a load has arrived, a pose without a fresh one is stale_kinematics.
 
-    Before, wheel_load (or, at 0, the pose's height: zero wrenches as if the
-    wheelset were lifted) silently took the measured load's place.
+    Replacing it with wheel_load (or, at 0, the pose's height: zero wrenches
+    as if the wheelset were lifted) would hide the lost load cell.
     """
     p = ProfilePipeline(_config(wheel_load=1e4))
     p.on_wheel_twist(_twist(0))
@@ -228,8 +228,8 @@ def tabled(table_cache):
 def test_the_table_refuses_a_wheel_load_of_zero_at_run_time(tabled):
     """The table needs a load: wheel_load 0 is refused at run time as at start.
 
-    Before, it was taken and poses went to the per-pose solve at their own
-    height (328 kN on a pose outside the table).
+    Taken, it would send poses to the per-pose solve at their own height
+    (328 kN on a pose outside the table).
     """
     with pytest.raises(ParameterError, match="wheel_load"):
         tabled.update({"wheel_load": 0.0})

@@ -802,10 +802,11 @@ def test_truncated_bag_from_the_console_script(tmp_path):
 
 @pytest.mark.parametrize("where", ["batch", "message"])
 def test_interrupt_leaves_nothing(tmp_path, monkeypatch, capsys, where):
-    # Ctrl-C in the middle of the first bag: in a batched run of messages, or in one
+    # Ctrl-C in the middle of the first bag: in the batched replay (at its second
+    # diagnostics, its window's rules run, its outputs not yet written), or in one
     # message's pipeline call (the per-message path: traction clouds on)
     calls = {"n": 0}
-    owner, name, at = ((batch.Batch, "run", 3) if where == "batch"
+    owner, name, at = ((batch.Batch, "store", 2) if where == "batch"
                        else (replay.Pipeline, "on_patch", 300))
     original = getattr(owner, name)
 

@@ -349,3 +349,78 @@ def test_windows_that_end_mid_second_count_the_diagnostics_as_the_per_message_pa
     assert_same(batched, reference)
     diagnostics = reference[1]["/diagnostics"][1]
     assert len(diagnostics) >= 2       # one inside the recording, the last at its end
+
+
+def _scan_cases():
+    """Return ``(name, cdr bytes)`` of patch clouds that take every branch of the adapter loop."""
+    hertz = ellipse(6e-3, 4e-3, nx=24, load=6e4)
+    egg = samples.semi_ellipses_patch(0.5, 2.0, cells=24, scale=8e-3, load=5e4)
+    left = dict(origin=(0.0, 0.75, -WHEEL_RADIUS), normal=contact_normal(0.1, "left"))
+    rng = np.random.default_rng(7)
+    order = ("pressure", "normal_z", "x", "normal_x", "y", "normal_y", "z")
+    cases = [("float32", cdr(cloud_msg(hertz, **left))),
+             ("float64", cdr(cloud_msg(hertz, dtype="<f8", **left))),
+             ("padded reversed", cdr(cloud_msg(egg, pad=4, reverse_rows=True,
+                                               reverse_columns=True, **left))),
+             ("field order", cdr(cloud_msg(egg, field_order=order, **left)))]
+    noisy = hertz.pressure * (1.0 + 1e-3 * rng.standard_normal(hertz.pressure.shape))
+    cases.append(("noisy", cdr(cloud_msg(hertz, pressure=np.maximum(noisy, 0.0), **left))))
+    for name, cell, value in (("nan", (12, 12), math.nan), ("inf outside", (0, 0), math.inf),
+                              ("negative", (5, 5), -1.0), ("too high", (12, 12), 1e30),
+                              ("negative zero", (0, 1), -0.0)):
+        p = hertz.pressure.copy()
+        p[cell] = value
+        cases.append((name, cdr(cloud_msg(hertz, pressure=p, **left))))
+    cases.append(("no contact", cdr(cloud_msg(hertz, pressure=0 * hertz.pressure, **left))))
+    along_x = cloud_msg(hertz)                   # the normal's z named its x
+    for f in along_x.fields:
+        f.name = {"normal_x": "normal_z", "normal_z": "normal_x"}.get(f.name, f.name)
+    cases.append(("along x", cdr(along_x)))
+    one_row = cloud_msg(hertz, **left)          # the middle strip alone
+    one_row.height = 1
+    one_row.data = one_row.data[12 * one_row.row_step:13 * one_row.row_step]
+    cases.append(("one row", cdr(one_row)))
+    # NaN in a point's padding: no field is touched, the node's loop decides
+    padded = cloud_msg(egg, pad=4, **left)
+    raw = bytearray(cdr(padded))
+    end = batch.cloud_layout(bytes(raw), "wheelset", 10_000).data_at + len(padded.data)
+    raw[end - 4:end] = struct.pack("<f", math.nan)   # the last point's padding
+    cases.append(("nan padding", bytes(raw)))
+    return cases
+
+
+def test_the_scan_gives_the_node_adapter_loop_bit_for_bit():
+    # the batched scan's loop for finite words (all_finite, adapt_finite) against the node's
+    # own patch_kernels.adapt, patch by patch: pressures and every number of its out array,
+    # and the largest pressure of each patch the loop passes
+    from numba.typed import List
+    from fastsim_ros.replay import kernels
+    from msg_adapters import patch_kernels
+    seen = set()
+    for name, raw in _scan_cases():
+        layout = batch.cloud_layout(raw, "wheelset", 10_000)
+        assert layout is not None and layout.fast, name
+        buf = np.frombuffer(raw, dtype=np.uint8)
+        one = np.zeros(1, dtype=np.int64)
+        pressure = np.full((1, layout.height, layout.cells), -7.0)
+        out = np.full((1, patch_kernels.OUT_SIZE), -7.0)
+        peak = np.full(1, -7.0)
+        kernels.scan_patches(List([buf]), one, one, layout.data_at, layout.width,
+                             layout.height, layout.cells, layout.row, layout.step, layout.cols,
+                             pressure, out, peak)
+        count = (layout.height - 1) * layout.row + layout.cells * layout.step
+        words = buf[layout.data_at:layout.data_at + count * layout.width].view(
+            np.float32 if layout.width == 4 else np.float64)
+        want_p = np.full((layout.height, layout.cells), -7.0)
+        want = np.full(patch_kernels.OUT_SIZE, -7.0)
+        patch_kernels.adapt(words, layout.height, layout.cells, layout.row, layout.step,
+                            layout.cols, want_p, want)
+        assert out[0].tobytes() == want.tobytes(), name
+        assert pressure[0].tobytes() == want_p.tobytes(), name
+        if want[patch_kernels.STATUS] == patch_kernels.OK:   # the plausibility bound's peak
+            assert peak[0] == want_p.max(), name
+        seen.add((int(want[patch_kernels.STATUS]), bool(kernels.all_finite(words, count))))
+    # every status of the loop, on both of its branches where they can be
+    ok, nonfinite = patch_kernels.OK, patch_kernels.NONFINITE
+    assert {(ok, True), (ok, False), (nonfinite, False), (patch_kernels.NEGATIVE, True),
+            (patch_kernels.TOO_HIGH, True), (patch_kernels.NORMAL_ALONG_X, True)} <= seen

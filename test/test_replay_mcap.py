@@ -203,3 +203,28 @@ def test_message_indexes_of_single_and_bulk_writes_point_at_their_records(tmp_pa
     assert sorted(indexed, key=lambda m: m[1]) == written
     got, _ = window_order(path)
     assert [(int(topic[-1]), t, d) for topic, t, d in got] == written
+
+
+def test_the_compiled_message_records_are_the_librarys_bytes():
+    # the batched writer's records, written in place at their offsets, against the array
+    # builder and the mcap library's own Message record
+    from mcap.records import Message
+    from fastsim_ros.replay import kernels
+    payloads = np.arange(5 * 13, dtype=np.uint8).reshape(5, 13)
+    times = np.array([0, 1, 2**40 + 3, 2**62 + 5, 1_700_000_000_123_456_789], dtype=np.int64)
+    offsets = np.array([3, 3 + 44 + 7, 3 + 2 * 44 + 7, 3 + 3 * 44 + 9, 3 + 4 * 44 + 9])
+    out = np.full(offsets[-1] + 44 + 2, 0xAB, dtype=np.uint8)
+    kernels.message_records(out, offsets, 0x1234, times, payloads)
+    built = mcap.message_records(np.full(5, 0x1234, dtype=np.int64), times, payloads)
+    for k, o in enumerate(offsets.tolist()):
+        record = out[o:o + 44].tobytes()
+        assert record == built[k].tobytes()
+        msg = Message(channel_id=0x1234, sequence=0, log_time=int(times[k]),
+                      publish_time=int(times[k]), data=payloads[k].tobytes())
+        stream = mcap.RecordBuilder()
+        msg.write(stream)
+        assert record == stream.end()
+    gaps = np.ones(out.size, dtype=np.bool_)
+    for o in offsets.tolist():
+        gaps[o:o + 44] = False
+    assert (out[gaps] == 0xAB).all()      # nothing written between the records

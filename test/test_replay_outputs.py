@@ -428,15 +428,15 @@ def test_a_commit_that_fails_midway_puts_the_earlier_outputs_back(earlier, monke
 def test_an_interrupted_overwrite_leaves_the_earlier_outputs(earlier, monkeypatch):
     before = _snapshot(earlier)
     calls = {"n": 0}
-    original = batch.Batch.run
+    original = batch.Batch.store
 
-    def interrupted(*args):
+    def interrupted(*args):   # Ctrl-C at the batched replay's second diagnostics
         calls["n"] += 1
-        if calls["n"] == 3:
+        if calls["n"] == 2:
             raise KeyboardInterrupt
         return original(*args)
 
-    monkeypatch.setattr(batch.Batch, "run", interrupted)
+    monkeypatch.setattr(batch.Batch, "store", interrupted)
     status, _, err = quiet_run([BAGS / "hertz_ramp", "-o", earlier, "--csv", "--plot",
                                 "--overwrite"])
     assert status == 130 and "interrupted" in err

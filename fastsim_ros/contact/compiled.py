@@ -304,6 +304,47 @@ class _Solver:
                            b=float(ell[k.ELL_B]), c11=c11, shear_modulus=self.shear_modulus,
                            load=float(ell[k.ELL_LOAD]))
 
+    def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
+                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
+                    reference: tuple[float, float] = (0.0, 0.0),
+                    bound: Bound = "given", friction: FrictionLaw | None = None,
+                    speed: ArrayLike | None = None) -> FloatArray:
+        """Solve a batch (one compiled loop); return ``(B, 3)``: ``Fx, Fy`` (N), ``Mz`` (N m).
+
+        ``pressures``: ``(B, ny, nx)`` (Pa), or one ``(ny, nx)`` patch for
+        every creepage; ``x0 .. dy`` (m) and ``mu``: scalars or ``(B,)``;
+        ``creepages``: ``(B, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about
+        ``reference`` (m).  ``friction``: one law for the batch (``mu``, if
+        given too, must be its ``mu_s``); ``speed``: ``|V|`` (m/s), a scalar
+        or ``(B,)``.  Item ``b`` equals ``solve_arrays`` on it.
+        """
+        ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
+        return self._batch(ps, grid, cr, mu, reference, bound, friction, speed)
+
+    def _batch(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
+               mu: ArrayLike | None, reference: tuple[float, float], bound: Bound,
+               friction: FrictionLaw | None, speed: ArrayLike | None) -> FloatArray:
+        """Solve the checked batch in the solver's compiled loop (:meth:`_batch_kernel`)."""
+        reduced = self._reduce_batch(ps, grid, cr, mu, friction, speed)
+        if reduced is None:
+            code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
+        else:
+            cr, mus = reduced
+            code, prm, speeds = k.LAW_CONSTANT, _NO_PARAMS, np.zeros(cr.shape[0])
+        out = np.empty((cr.shape[0], 3))
+        status, index, info = self._batch_kernel(ps, grid, cr, mus, reference, bound, code,
+                                                 prm, speeds, out)
+        if status:
+            _raise(status, info, self._knots, f"batch item {index}: ")
+        return out
+
+    def _batch_kernel(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
+                      mus: FloatArray, reference: tuple[float, float], bound: str, code: int,
+                      prm: FloatArray, speeds: FloatArray,
+                      out: FloatArray) -> tuple[int, int, int]:
+        """Run the solver's batch kernel into ``out``; return ``(status, item, info)``."""
+        raise NotImplementedError
+
     def _reduce_batch(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
                       mu: ArrayLike | None, friction: FrictionLaw | None,
                       speed: ArrayLike | None) -> tuple[FloatArray, FloatArray] | None:
@@ -398,37 +439,15 @@ class MaeSolver(_Solver):
         """Return the packed knee table the solve applies (none with the parabolic bound)."""
         return self._knee if bound == "given" else k.NO_KNEE
 
-    def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
-                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
-                    reference: tuple[float, float] = (0.0, 0.0),
-                    bound: Bound = "given", friction: FrictionLaw | None = None,
-                    speed: ArrayLike | None = None) -> FloatArray:
-        """Solve a batch in one compiled loop; return ``(B, 3)``: ``Fx, Fy`` (N), ``Mz`` (N m).
-
-        ``pressures``: ``(B, ny, nx)`` (Pa), or one ``(ny, nx)`` patch for
-        every creepage; ``x0 .. dy`` (m) and ``mu``: scalars or ``(B,)``;
-        ``creepages``: ``(B, 3)`` rows ``xi, eta, phi`` (1, 1, 1/m) about
-        ``reference`` (m).  ``friction``: one law for the batch (``mu``, if
-        given too, must be its ``mu_s``); ``speed``: ``|V|`` (m/s), a scalar
-        or ``(B,)``.  Item ``b`` equals ``solve_arrays`` on it.
-        """
-        ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
-        reduced = self._reduce_batch(ps, grid, cr, mu, friction, speed)
-        if reduced is None:
-            code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
-        else:
-            cr, mus = reduced
-            code, prm, speeds = k.LAW_CONSTANT, _NO_PARAMS, np.zeros(cr.shape[0])
-        out = np.empty((cr.shape[0], 3))
-        status, index, info = k.mae_batch(ps, grid[0], grid[1], grid[2], grid[3], cr, mus,
-                                          float(reference[0]), float(reference[1]),
-                                          self._rule, _bound(bound), self.shear_modulus,
-                                          self._knots, self._polys, code, prm, speeds, out,
-                                          self._calibrated, self._pair_knots,
-                                          self._pair_values, self._knee_for(bound))
-        if status:
-            _raise(status, info, self._knots, f"batch item {index}: ")
-        return out
+    def _batch_kernel(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
+                      mus: FloatArray, reference: tuple[float, float], bound: str, code: int,
+                      prm: FloatArray, speeds: FloatArray,
+                      out: FloatArray) -> tuple[int, int, int]:
+        return k.mae_batch(ps, grid[0], grid[1], grid[2], grid[3], cr, mus,
+                           float(reference[0]), float(reference[1]), self._rule,
+                           _bound(bound), self.shear_modulus, self._knots, self._polys, code,
+                           prm, speeds, out, self._calibrated, self._pair_knots,
+                           self._pair_values, self._knee_for(bound))
 
     def _prepare(self, area: GridArea) -> tuple[int, float, FloatArray]:
         geo = np.empty(k.GEO_SIZE)
@@ -538,27 +557,14 @@ class EquivalentEllipseSolver(_Solver):
         return self._forces(result, grid, out, tractions,  # type: ignore[arg-type]
                             dissipation)
 
-    def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
-                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
-                    reference: tuple[float, float] = (0.0, 0.0),
-                    bound: Bound = "given", friction: FrictionLaw | None = None,
-                    speed: ArrayLike | None = None) -> FloatArray:
-        """Solve a batch in one compiled loop: as :meth:`MaeSolver.solve_batch`."""
-        ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
-        reduced = self._reduce_batch(ps, grid, cr, mu, friction, speed)
-        if reduced is None:
-            code, prm, mus, speeds = _batch_law(mu, friction, speed, cr.shape[0])
-        else:
-            cr, mus = reduced
-            code, prm, speeds = k.LAW_CONSTANT, _NO_PARAMS, np.zeros(cr.shape[0])
-        out = np.empty((cr.shape[0], 3))
-        status, index, info = k.equivalent_batch(
+    def _batch_kernel(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
+                      mus: FloatArray, reference: tuple[float, float], bound: str, code: int,
+                      prm: FloatArray, speeds: FloatArray,
+                      out: FloatArray) -> tuple[int, int, int]:
+        return k.equivalent_batch(
             ps, grid[0], grid[1], grid[2], grid[3], cr, mus, float(reference[0]),
             float(reference[1]), _bound(bound), self.cells or 0, self.shear_modulus,
             self._knots, self._polys, code, prm, speeds, out)
-        if status:
-            _raise(status, info, self._knots, f"batch item {index}: ")
-        return out
 
     def _ellipse(self, p: FloatArray, x0: float, y0: float, dx: float,
                  dy: float) -> EquivalentEllipse:

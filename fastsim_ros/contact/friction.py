@@ -151,7 +151,7 @@ class FrictionLaw:
 
 @dataclass(frozen=True)
 class ConstantFriction(FrictionLaw):
-    """Coulomb friction with one coefficient ``mu`` (today's law); ``mu > 0``."""
+    """Coulomb friction with one coefficient ``mu`` (the default law); ``mu > 0``."""
 
     def __post_init__(self) -> None:
         check_friction(self.mu_s)

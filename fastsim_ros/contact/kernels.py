@@ -453,6 +453,28 @@ def march_path(t_x, t_y, lev, shape, outer, inner, j, i, nx, rolled, nsub, s, v_
     return t_x, t_y, lev
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def adhesion_step(lin, j, continues, dx, half, rate_x, rate_y0, rate_yx, x_rel, g):
+    """Advance strip ``j``'s march without a bound by one cell and add it to its sums.
+
+    ``lin`` ``(5, ny)``: the strip's traction in full adhesion at its last
+    cell (``x``, ``y``, Pa), its sums over the strip's cells so far (Pa) and
+    the sum of the bound ``g`` (Pa); a cell that does not continue the
+    strip's segment starts from zero traction half a cell behind its front
+    face.  ``rate_*`` the strip's rates (:func:`strip_rates`), ``x_rel``
+    (m) the cell's ``x`` from the sweep point.  Inlined in the marches.
+    """
+    s_l = dx if continues else half
+    if not continues:
+        lin[0, j] = 0.0
+        lin[1, j] = 0.0
+    lin[0, j] = lin[0, j] - rate_x * s_l
+    lin[1, j] = lin[1, j] - (rate_y0 + rate_yx * (x_rel + 0.5 * s_l)) * s_l
+    lin[2, j] += lin[0, j]
+    lin[3, j] += lin[1, j]
+    lin[4, j] += g
+
+
 @njit(cache=True, error_model="numpy")
 def sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, x_c, y_s, xp, yp,
           law, prm, speed, out_x, out_y, slip, store, rigid, strip_sums=_NO_STATE):
@@ -540,7 +562,7 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
     # the strips in full adhesion (record): the steady march's traction without a bound, and
     # the sums of it and of the bound
     lin = np.zeros((5, ny if record else 1))
-    ulx, uly, slx, sly, sgb = lin[0], lin[1], lin[2], lin[3], lin[4]
+    slx, sly, sgb = lin[2], lin[3], lin[4]
     da = dx * dy
     half = 0.5 * dx
     # per-strip state, constants and partial sums in one block (one allocation)
@@ -631,15 +653,8 @@ def rolling_sweep(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex, 
                 continue
             if record:
                 # the steady march without a bound, from the segment's front face
-                s_l = dx if cont[j] == i else half
-                if cont[j] != i:
-                    ulx[j] = 0.0
-                    uly[j] = 0.0
-                ulx[j] = ulx[j] - rate_x[j] * s_l
-                uly[j] = uly[j] - (rate_y0[j] + rate_yx[j] * (x_rel + 0.5 * s_l)) * s_l
-                slx[j] += ulx[j]
-                sly[j] += uly[j]
-                sgb[j] += g
+                adhesion_step(lin, j, cont[j] == i, dx, half, rate_x[j], rate_y0[j],
+                              rate_yx[j], x_rel, g)
             if cont[j] == i:
                 s = dx
                 t_x = tx[j]
@@ -844,6 +859,37 @@ def knee_capped(k, sx, sy, bound):
     return k
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def strip_factor(log_aspect_nodes, s_nodes, kappa, lx, ly, bound, log_aspect):
+    """Return ``(kappa_j, d kappa/d s, s_j)`` of a strip, not capped; ``(1, 0, 0)`` if idle.
+
+    The strip's force in full adhesion ``(lx, ly)`` and its bound summed
+    ``bound`` (any common unit) put it at ``s_j = |F_lin,j| / (mu N_j)``;
+    the table (:func:`knee_arrays`) gives the factor there, at ``log(a/b)``
+    = ``log_aspect`` and the share of ``x`` in the linear force.  A strip
+    with no linear force or no bound has no factor.
+    """
+    l2 = lx * lx + ly * ly
+    if l2 > 0.0 and bound > 0.0:
+        s_j = math.sqrt(l2) / bound
+        k, dk = knee_interpolate(log_aspect_nodes, s_nodes, kappa, s_j, log_aspect,
+                                 lx * lx / l2)
+        return k, dk, s_j
+    return 1.0, 0.0, 0.0
+
+
+@njit(cache=True, error_model="numpy", inline="always")
+def factored_sums(sums, j, k, fx, fy, mz, kappa_out):
+    """Return the force sums ``fx, fy, mz`` with strip ``j``'s sums times its factor ``k`` added.
+
+    ``sums``: the strips' sums (rows ``tau_x``, ``tau_y``, the moment's);
+    ``kappa_out`` ``(ny,)``, if given, receives ``k``.
+    """
+    if kappa_out.shape[0] == sums.shape[1]:
+        kappa_out[j] = k
+    return fx + k * sums[0, j], fy + k * sums[1, j], mz + k * sums[2, j]
+
+
 @njit(cache=True, error_model="numpy")
 def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store, kappa_out=NO_KNEE):
     """Return ``(Fx, Fy, Mz)`` (N, N, N m): each strip's force times its knee factor.
@@ -869,19 +915,11 @@ def strip_knee(strip_sums, da, knee, log_aspect, out_x, out_y, store, kappa_out=
     fy = 0.0
     mz = 0.0
     for j in range(ny):
-        lx = strip_sums[3, j]
-        ly = strip_sums[4, j]
-        l2 = lx * lx + ly * ly
-        k = 1.0
-        if l2 > 0.0 and strip_sums[5, j] > 0.0:
-            k, _ = knee_interpolate(la, sn, kap, math.sqrt(l2) / strip_sums[5, j], log_aspect,
-                                    lx * lx / l2)
+        k, _, s_j = strip_factor(la, sn, kap, strip_sums[3, j], strip_sums[4, j],
+                                 strip_sums[5, j], log_aspect)
+        if s_j > 0.0:
             k = knee_capped(k, strip_sums[0, j], strip_sums[1, j], strip_sums[5, j])
-        fx += k * strip_sums[0, j]
-        fy += k * strip_sums[1, j]
-        mz += k * strip_sums[2, j]
-        if kappa_out.shape[0] == ny:
-            kappa_out[j] = k
+        fx, fy, mz = factored_sums(strip_sums, j, k, fx, fy, mz, kappa_out)
         if store and k != 1.0:
             for i in range(out_x.shape[1]):
                 out_x[j, i] *= k
@@ -926,13 +964,9 @@ def tractions_knee(out_x, out_y, shape, outer, inner, env, x0, y0, dx, dy, xp, y
     fy = 0.0
     mz = 0.0
     for j in range(ny):
-        k = 1.0
-        lx = steady[3, j]
-        ly = steady[4, j]
-        l2 = lx * lx + ly * ly
-        if l2 > 0.0 and steady[5, j] > 0.0:
-            k, _ = knee_interpolate(la, sn, kap, math.sqrt(l2) / steady[5, j], log_aspect,
-                                    lx * lx / l2)
+        k, _, s_j = strip_factor(la, sn, kap, steady[3, j], steady[4, j], steady[5, j],
+                                 log_aspect)
+        if s_j > 0.0:
             k = knee_capped(k, steady[0, j], steady[1, j], steady[5, j])
             st2 = steady[0, j] * steady[0, j] + steady[1, j] * steady[1, j]
             if st2 > 0.0:
@@ -940,11 +974,7 @@ def tractions_knee(out_x, out_y, shape, outer, inner, env, x0, y0, dx, dy, xp, y
                 if w < 1.0:  # (the steady state keeps kappa itself, to the bit)
                     k = 1.0 + (k - 1.0) * max(w, 0.0)
             k = knee_capped(k, sums[0, j], sums[1, j], steady[5, j])
-        fx += k * sums[0, j]
-        fy += k * sums[1, j]
-        mz += k * sums[2, j]
-        if kappa_out.shape[0] == ny:
-            kappa_out[j] = k
+        fx, fy, mz = factored_sums(sums, j, k, fx, fy, mz, kappa_out)
     da = dx * dy
     return fx * da, fy * da, mz * da
 
@@ -1030,7 +1060,7 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
     inv_mu = 1.0 / mu
     record = knee.shape[0] > 0
     lin = np.zeros((5, ny if record else 1))
-    ulx, uly, slx, sly, sgb = lin[0], lin[1], lin[2], lin[3], lin[4]
+    slx, sly, sgb = lin[2], lin[3], lin[4]
     w = np.empty((15, ny))
     tx, ty, dtx, dty, sx, sy, sm, dsx, dsy = w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8]
     rate_x, rate_y0, rate_yx, yr, w_x, dlevel = w[9], w[10], w[11], w[12], w[13], w[14]
@@ -1053,16 +1083,9 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
                 continue
             dg = g * inv_mu
             if record:
-                # the steady march without a bound (rolling_sweep's strip_sums)
-                s_l = dx if cont[j] == i else half
-                if cont[j] != i:
-                    ulx[j] = 0.0
-                    uly[j] = 0.0
-                ulx[j] = ulx[j] - rate_x[j] * s_l
-                uly[j] = uly[j] - (rate_y0[j] + rate_yx[j] * (x_rel + 0.5 * s_l)) * s_l
-                slx[j] += ulx[j]
-                sly[j] += uly[j]
-                sgb[j] += g
+                # the steady march without a bound, from the segment's front face
+                adhesion_step(lin, j, cont[j] == i, dx, half, rate_x[j], rate_y0[j],
+                              rate_yx[j], x_rel, g)
             if cont[j] == i:
                 s = dx
                 t_x = tx[j]
@@ -1202,13 +1225,9 @@ def sweep_mu_slope(shape, outer, inner, env, x0, y0, dx, dy, xi, eta, phi, flex,
     knee_la, knee_s, knee_kappa = knee_arrays(knee if record else _ONE_NODE_KNEE)
     for j in range(ny):
         if record:
-            lx = slx[j]
-            ly = sly[j]
-            l2 = lx * lx + ly * ly
-            if l2 > 0.0 and sgb[j] > 0.0:
-                s_j = math.sqrt(l2) / sgb[j]
-                k, dk = knee_interpolate(knee_la, knee_s, knee_kappa, s_j, log_aspect,
-                                         lx * lx / l2)
+            k, dk, s_j = strip_factor(knee_la, knee_s, knee_kappa, slx[j], sly[j], sgb[j],
+                                      log_aspect)
+            if s_j > 0.0:
                 ds = -s_j * inv_mu
                 dk_dmu = dk * ds
                 capped = knee_capped(k, sx[j], sy[j], sgb[j])
@@ -1872,22 +1891,49 @@ def equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi, xp, yp, law, prm,
     flexibilities on every strip, spin flexibility ``L3``, sweep point the
     ellipse's centre.  Return as :func:`sweep`.
     """
-    n = shape.shape[0]
-    x_c = ell[ELL_XC]
-    y_c = ell[ELL_YC]
+    gx0, gy0, gdx, gdy, flex, xi_s, eta_s = ellipse_march(ell, shape.shape[0], xi, eta, phi,
+                                                          xp, yp)
+    return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi, flex,
+                 ell[ELL_XC], ell[ELL_YC], xp, yp, law, prm, speed, out_x, out_y, slip, store,
+                 False)
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_bound(ell, n, parabolic):
+    """Return ``(shape, env, scale)`` of the equivalent ellipse's ``n`` x ``n`` grid.
+
+    ``shape``: Hertz's (or with ``parabolic`` Kalker's parabolic) pressure
+    profile on the grid (:func:`ellipse_shape`), ``env`` its column
+    envelopes, ``scale`` (Pa) the factor that makes ``shape`` the pressure
+    of the ellipse's load.
+    """
+    shape = np.empty((n, n))
+    env = np.empty((2, n), dtype=np.int64)
     a = ell[ELL_A]
     b = ell[ELL_B]
-    gx0, gy0, gdx, gdy = ellipse_grid(a, b, n, x_c, y_c)
+    total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
+    return shape, env, ell[ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
+
+
+@njit(cache=True, error_model="numpy")
+def ellipse_march(ell, n, xi, eta, phi, xp, yp):
+    """Return the equivalent ellipse's march: its grid, flexibilities, creepages at its centre.
+
+    ``(x0, y0, dx, dy, flex, xi_s, eta_s)``: the grid of ``ellipse(a, b,
+    nx=n, ny=n).shifted(x_c, y_c)`` (m), Kalker's flexibilities on every
+    strip with spin flexibility ``L3`` (``(4, n)``, m/Pa), and the
+    creepages about ``(xp, yp)`` (m) moved to the ellipse's centre.
+    """
+    x_c = ell[ELL_XC]
+    y_c = ell[ELL_YC]
+    gx0, gy0, gdx, gdy = ellipse_grid(ell[ELL_A], ell[ELL_B], n, x_c, y_c)
     flex = np.empty((4, n))
     for j in range(n):
         flex[0, j] = ell[ELL_L1]
         flex[1, j] = ell[ELL_L2]
         flex[2, j] = ell[ELL_L3]
         flex[3, j] = ell[ELL_L3]
-    xi_s = xi + phi * (yp - y_c)
-    eta_s = eta - phi * (xp - x_c)
-    return sweep(shape, mu, scale, env, gx0, gy0, gdx, gdy, xi_s, eta_s, phi,
-                 flex, x_c, y_c, xp, yp, law, prm, speed, out_x, out_y, slip, store, False)
+    return gx0, gy0, gdx, gdy, flex, xi + phi * (yp - y_c), eta - phi * (xp - x_c)
 
 
 # ---------------------------------------------------------------- whole solves
@@ -2047,12 +2093,7 @@ def equivalent_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic, n,
         n = ellipse_cells(ell[ELL_NCELLS])
     if n < 2:
         return E_CELLS, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0
-    shape = np.empty((n, n))
-    env = np.empty((2, n), dtype=np.int64)
-    a = ell[ELL_A]
-    b = ell[ELL_B]
-    total, _ = ellipse_shape(n, a, b, not parabolic, shape, env)
-    scale = ell[ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
+    shape, env, scale = ellipse_bound(ell, n, parabolic)
     fx, fy, mz, nslip, ncontact = equivalent_sweep(ell, shape, scale, mu, env, xi, eta, phi,
                                                    xp, yp, law, prm, speed, out_x, out_y,
                                                    slip, store)

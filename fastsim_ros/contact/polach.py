@@ -60,10 +60,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from fastsim_ros.contact import kernels as k
-from fastsim_ros.contact.area import GridArea
-from fastsim_ros.contact.checks import Bound, check_bound, check_shear_modulus
-from fastsim_ros.contact.compiled import (ContactForces, _batch_inputs, _per_item, _pressure,
-                                          _raise, _readonly)
+from fastsim_ros.contact.checks import Bound, check_bound
+from fastsim_ros.contact.compiled import ContactForces, _per_item, _raise, _readonly, _Solver
 from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.friction import FrictionLaw, check_speed, resolve
 from fastsim_ros.contact.slope_reduction import rigid_slip_velocity
@@ -125,7 +123,7 @@ def polach_forces(a: float, b: float, load: float, c11: float, c22: float, c23: 
     return PolachForces(fx, fy, min(1.0, 0.5 * eps))
 
 
-class PolachSolver:
+class PolachSolver(_Solver):
     """Polach's method on the patch's equivalent ellipse, with the fast solvers' calls.
 
     ``nu``: combined Poisson ratio (the tables' range); ``shear_modulus``:
@@ -134,42 +132,26 @@ class PolachSolver:
     equivalent-ellipse method's (the patch's area, centroid and second-moment
     ratio), its load the patch's.  ``bound`` is accepted for the common call
     and does not act: Polach's closed form is that of a Hertzian ellipse.
-    No traction field (``tractions=True`` is refused).
+    No traction field (``tractions=True`` is refused).  ``friction``: the
+    law, taken at the rigid slip velocity (``speed = |V|`` in m/s for a
+    slip-dependent one); a law's slope reduction is refused (Polach's own
+    is ``k_a``, ``k_s``).  The calls are those of
+    :class:`~fastsim_ros.contact.compiled.MaeSolver`; a batch is solved item
+    by item.
     """
 
     def __init__(self, nu: float, shear_modulus: float, *, k_a: float = 1.0,
                  k_s: float = 1.0) -> None:
-        check_shear_modulus(shear_modulus)
+        super().__init__(nu, shear_modulus)
         check_reduction_factors(k_a, k_s)
-        self.table = coefficient_table(float(nu))  # refuses nu outside the tables
-        self.nu = float(nu)
-        self.shear_modulus = float(shear_modulus)
+        self.table = coefficient_table(float(nu))
         self.k_a, self.k_s = float(k_a), float(k_s)
-        self._knots = np.array(self.table.knots, dtype=np.float64)
-        self._polys = np.ascontiguousarray(np.stack([self.table.poly[name]
-                                                     for name in k.TABLE_NAMES]))
 
-    def solve(self, area: GridArea, xi: float, eta: float, phi: float, *,
-              mu: float | None = None, reference: tuple[float, float] = (0.0, 0.0),
-              bound: Bound = "given", tractions: bool = False,
-              friction: FrictionLaw | None = None, speed: float | None = None) -> ContactForces:
-        """Solve at creepages ``xi``, ``eta`` (1), spin ``phi`` (1/m) about ``reference`` (m).
-
-        As :meth:`fastsim_ros.contact.compiled.MaeSolver.solve`; ``friction``:
-        the law, taken at the rigid slip velocity (``speed = |V|`` in m/s for a
-        slip-dependent one); a law's slope reduction is refused (Polach's own
-        is ``k_a``, ``k_s``).
-        """
-        return self.solve_arrays(area.pressure, area.x0, area.y0, area.dx, area.dy, xi, eta,
-                                 phi, mu, reference=reference, bound=bound,
-                                 tractions=tractions, friction=friction, speed=speed)
-
-    def solve_arrays(self, pressure: ArrayLike, x0: float, y0: float, dx: float, dy: float,
-                     xi: float, eta: float, phi: float, mu: float | None = None, *,
-                     reference: tuple[float, float] = (0.0, 0.0), bound: Bound = "given",
-                     tractions: bool = False, friction: FrictionLaw | None = None,
-                     speed: float | None = None) -> ContactForces:
-        """Solve on the pressure ``p[j, i]`` (Pa) of the grid ``x0, y0, dx, dy`` (m)."""
+    def _reducing(self, p: FloatArray, x0: float, y0: float, dx: float, dy: float, xi: float,
+                  eta: float, phi: float, mu: float | None, friction: FrictionLaw | None,
+                  speed: float | None, reference: tuple[float, float], bound: str,
+                  tractions: bool) -> ContactForces:
+        """Solve one patch (Polach's closed form, no slope reduction but his own)."""
         if tractions:
             raise InvalidInputError("Polach's method gives forces only, no traction field")
         check_bound(bound)
@@ -181,7 +163,6 @@ class PolachSolver:
         for name, v in (("xi", xi), ("eta", eta), ("phi", phi)):
             if not math.isfinite(float(v)):
                 raise InvalidInputError("creepages xi, eta, phi must be finite")
-        p = _pressure(pressure, 2)
         ell = np.empty(k.ELL_SIZE)
         status, info = k.equivalent_prepare(p, float(x0), float(y0), float(dx), float(dy),
                                             self.shear_modulus, self._knots, self._polys, ell)
@@ -203,23 +184,20 @@ class PolachSolver:
         mz = (x_c - xr) * f.fy - (y_c - yr) * f.fx
         return ContactForces(f.fx, f.fy, mz, load, f.slip_fraction)
 
-    def solve_batch(self, pressures: ArrayLike, x0: ArrayLike, y0: ArrayLike, dx: ArrayLike,
-                    dy: ArrayLike, creepages: ArrayLike, *, mu: ArrayLike | None = None,
-                    reference: tuple[float, float] = (0.0, 0.0),
-                    bound: Bound = "given", friction: FrictionLaw | None = None,
-                    speed: ArrayLike | None = None) -> FloatArray:
-        """Solve a batch: as :meth:`fastsim_ros.contact.compiled.MaeSolver.solve_batch`."""
-        ps, grid, cr = _batch_inputs(pressures, x0, y0, dx, dy, creepages)
+    def _batch(self, ps: FloatArray, grid: list[FloatArray], cr: FloatArray,
+               mu: ArrayLike | None, reference: tuple[float, float], bound: Bound,
+               friction: FrictionLaw | None, speed: ArrayLike | None) -> FloatArray:
+        """Solve the checked batch item by item (a closed form each: no compiled loop)."""
         size = cr.shape[0]
         mus = None if mu is None else _per_item(mu, size, "mu")
         speeds = None if speed is None else _per_item(speed, size, "speed")
         out = np.empty((size, 3))
         for i in range(size):
-            f = self.solve_arrays(_readonly(ps[0] if ps.shape[0] == 1 else ps[i]),
-                                  grid[0][i], grid[1][i], grid[2][i], grid[3][i],
-                                  cr[i, 0], cr[i, 1], cr[i, 2],
-                                  None if mus is None else float(mus[i]), reference=reference,
-                                  bound=bound, friction=friction,
-                                  speed=None if speeds is None else float(speeds[i]))
+            f = self._reducing(_readonly(ps[0] if ps.shape[0] == 1 else ps[i]),
+                               grid[0][i], grid[1][i], grid[2][i], grid[3][i],
+                               cr[i, 0], cr[i, 1], cr[i, 2],
+                               None if mus is None else float(mus[i]), friction,
+                               None if speeds is None else float(speeds[i]), reference,
+                               bound, False)
             out[i] = f.fx, f.fy, f.mz
         return out

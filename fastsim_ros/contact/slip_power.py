@@ -137,21 +137,8 @@ def equivalent_dissipation(p, x0, y0, dx, dy, xi, eta, phi, xp, yp, parabolic, n
     status, _ = k.equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell)
     if status != k.OK:
         return status, 0.0
-    shape = np.empty((n, n))
-    env = np.empty((2, n), dtype=np.int64)
-    a = ell[k.ELL_A]
-    b = ell[k.ELL_B]
-    k.ellipse_shape(n, a, b, not parabolic, shape, env)
-    x_c = ell[k.ELL_XC]
-    y_c = ell[k.ELL_YC]
-    gx0, gy0, gdx, gdy = k.ellipse_grid(a, b, n, x_c, y_c)
-    flex = np.empty((4, n))
-    for j in range(n):
-        flex[0, j] = ell[k.ELL_L1]
-        flex[1, j] = ell[k.ELL_L2]
-        flex[2, j] = ell[k.ELL_L3]
-        flex[3, j] = ell[k.ELL_L3]
-    xi_s = xi + phi * (yp - y_c)
-    eta_s = eta - phi * (xp - x_c)
+    shape, _, _ = k.ellipse_bound(ell, n, parabolic)
+    gx0, gy0, gdx, gdy, flex, xi_s, eta_s = k.ellipse_march(ell, n, xi, eta, phi, xp, yp)
     return k.OK, march_dissipation(shape > 0.0, tau_x, tau_y, slip, gx0, gy0, gdx, gdy, xi_s,
-                                   eta_s, phi, flex, x_c, y_c, False, density)
+                                   eta_s, phi, flex, ell[k.ELL_XC], ell[k.ELL_YC], False,
+                                   density)

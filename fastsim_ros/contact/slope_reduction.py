@@ -32,7 +32,7 @@ the rigid slip velocity ``|V| sqrt(xi^2 + eta^2)`` (m/s), and the solve
 runs with that constant coefficient.
 
 ``k0 = 1`` with ``alpha_inf = 1`` (or ``beta = 0``) is no reduction: the
-solvers then run exactly today's path, bit for bit.
+solvers then run their path without a reduction, bit for bit.
 
 Imports :mod:`~fastsim_ros.contact.errors` only.
 """

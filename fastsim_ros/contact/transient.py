@@ -572,23 +572,12 @@ def ellipse_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, parabolic
     status, info = k.equivalent_prepare(p, x0, y0, dx, dy, shear_modulus, knots, polys, ell)
     if status != k.OK:
         return status, info, 0.0, 0.0, 0.0, 0.0, 0, 0
-    shape = np.empty((n, n))
-    env = np.empty((2, n), dtype=np.int64)
+    shape, env, scale = k.ellipse_bound(ell, n, parabolic)
     a = ell[k.ELL_A]
     b = ell[k.ELL_B]
     x_c = ell[k.ELL_XC]
     y_c = ell[k.ELL_YC]
-    total, _ = k.ellipse_shape(n, a, b, not parabolic, shape, env)
-    scale = ell[k.ELL_LOAD] / (total * ((2 * a / n) * (2 * b / n)))
-    gx0, gy0, gdx, gdy = k.ellipse_grid(a, b, n, x_c, y_c)
-    flex = np.empty((4, n))
-    for j in range(n):
-        flex[0, j] = ell[k.ELL_L1]
-        flex[1, j] = ell[k.ELL_L2]
-        flex[2, j] = ell[k.ELL_L3]
-        flex[3, j] = ell[k.ELL_L3]
-    xi_s = xi + phi * (yp - y_c)
-    eta_s = eta - phi * (xp - x_c)
+    gx0, gy0, gdx, gdy, flex, xi_s, eta_s = k.ellipse_march(ell, n, xi, eta, phi, xp, yp)
     if rolled >= longest_segment(p, dx):
         # a step over the whole patch is the steady state (the rule of every method): the
         # ellipse's own grid is longer than the patch (its area is the staircase's), and a

@@ -142,7 +142,22 @@ def _positive(name: str, value: float, *, zero_ok: bool = False) -> float:
     return v
 
 
-class FrictionEkf:
+class _Tuning:
+    """The tuning both filters share, checked, and their counts of updates, skips and steps."""
+
+    def __init__(self, measurement_noise: float, min_sensitivity: float, relative_step: float,
+                 step_gate: float) -> None:
+        self.measurement_noise = _positive("measurement_noise", measurement_noise)
+        self.min_sensitivity = _positive("min_sensitivity", min_sensitivity, zero_ok=True)
+        self.relative_step = _positive("relative_step", relative_step)
+        self.step_gate = (_positive("step_gate", step_gate) if step_gate != math.inf
+                          else math.inf)
+        self.updates = 0
+        self.skipped = 0
+        self.steps = 0
+
+
+class FrictionEkf(_Tuning):
     """Extended Kalman filter on ``mu_s``; see the module's docstring for the model.
 
     ``mu``: initial estimate; ``sigma``: its standard deviation;
@@ -170,14 +185,7 @@ class FrictionEkf:
         self.variance = min(_positive("sigma", sigma), self.sigma_max) ** 2
         self.model_bound = 0.0
         self.process_noise = _positive("process_noise", process_noise, zero_ok=True)
-        self.measurement_noise = _positive("measurement_noise", measurement_noise)
-        self.min_sensitivity = _positive("min_sensitivity", min_sensitivity, zero_ok=True)
-        self.relative_step = _positive("relative_step", relative_step)
-        self.step_gate = _positive("step_gate", step_gate) if step_gate != math.inf \
-            else math.inf
-        self.updates = 0
-        self.skipped = 0
-        self.steps = 0
+        super().__init__(measurement_noise, min_sensitivity, relative_step, step_gate)
 
     def restart(self, sigma: float, mu: float | None = None) -> None:
         """Start again from ``mu`` (None: the estimate as it is) with standard deviation ``sigma``.
@@ -341,7 +349,7 @@ class SlopeEkfStep(NamedTuple):
     innovation: float
 
 
-class FrictionSlopeEkf:
+class FrictionSlopeEkf(_Tuning):
     """Extended Kalman filter on ``(mu_s, k0)``: friction and the creep-slope reduction.
 
     State ``x = (mu_s, k0)``: the static coefficient and the modified
@@ -393,14 +401,7 @@ class FrictionSlopeEkf:
                           min(_positive("sigma_k0", sigma_k0), self.sigma_max) ** 2])
         self.process_noise = _positive("process_noise", process_noise, zero_ok=True)
         self.process_noise_k0 = _positive("process_noise_k0", process_noise_k0, zero_ok=True)
-        self.measurement_noise = _positive("measurement_noise", measurement_noise)
-        self.min_sensitivity = _positive("min_sensitivity", min_sensitivity, zero_ok=True)
-        self.relative_step = _positive("relative_step", relative_step)
-        self.step_gate = _positive("step_gate", step_gate) if step_gate != math.inf \
-            else math.inf
-        self.updates = 0
-        self.skipped = 0
-        self.steps = 0
+        super().__init__(measurement_noise, min_sensitivity, relative_step, step_gate)
 
     @property
     def mu(self) -> float:

@@ -1232,14 +1232,14 @@ class Pipeline:
                     torque: tuple[float, float, float]) -> WheelsetWrench | None:
         """Keep the contact's wrench; return the wheelset wrench if it completes a rig cycle.
 
-        the node's rule by the stamps: every contact has a wrench newer
+        The node's rule, by the stamps: every contact has a wrench newer
         than those of the last sum, i.e. stamped after the last sum's stamp
-        (the newest of its wrenches).  A flag per contact instead paired,
-        after one rejected patch of the contact that arrives first, every
-        later sum with the other contact's wrench of the cycle before, for
-        good; by the stamps that pairing happens once and the next cycle is
-        whole again (:func:`fastsim_ros.replay.kernels.advance` is the
-        replay's copy of this rule).
+        (the newest of its wrenches).  After a rejected patch of the contact
+        that arrives first, one sum pairs the other contact's wrench of the
+        cycle before, and the next cycle is whole again (a flag per contact
+        would pair them so for good).
+        :func:`fastsim_ros.replay.kernels.advance` is the replay's copy of
+        this rule.
         """
         state.wrench = (stamp, force, torque)
         newest = stamp

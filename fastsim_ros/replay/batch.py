@@ -1,8 +1,9 @@
 """The batched replay: the pipeline's rules applied to a run of messages at once.
 
-For a run of a bag's messages (between two diagnostics) the pipeline's
-per-message rules (:meth:`fastsim_ros.pipeline.Pipeline.on_patch`,
-``on_wheel_twist``, ``on_rail_twist``) are applied in bulk:
+For a run of a bag's messages (a window of them, which the replay takes
+at once) the pipeline's per-message rules
+(:meth:`fastsim_ros.pipeline.Pipeline.on_patch`, ``on_wheel_twist``,
+``on_rail_twist``) are applied in bulk:
 
 1. twists decoded together (those of the usual layout read straight from the
    chunks; any other through :func:`msg_adapters.cdr.read_twist`) and taken
@@ -287,6 +288,10 @@ class Timing:
     kinematics: float = 0.0
     solve: float = 0.0
     state: float = 0.0
+    #: of ``decode``, the compiled scan of the patches (the adapter loop); of ``solve``, the
+    #: compiled solves
+    scan: float = 0.0
+    solver: float = 0.0
     solves: int = 0
     #: the solves as they were solved, when kept: :attr:`results.Profile.solves`
     inputs: list[tuple[Any, ...]] | None = None
@@ -336,10 +341,11 @@ class _ContactState:
 
 @dataclass
 class _Group:
-    """Patches of one layout scanned together: rows of the run, their pressures."""
+    """Patches of one layout scanned together: rows of the run, pressures, peak pressures."""
 
     rows: Ints
     pressure: Floats
+    peak: Floats
 
 
 # ------------------------------------------------------------------------ the batch
@@ -543,17 +549,18 @@ class Batch:
         kernels.doubles(w.arrays, w.buffer[hit], w.start[hit], self.twist_doubles, got)
         value[fast] = got
         ok = fast & np.isfinite(value).all(axis=1)
-        reason = np.where(fast & ~ok, "nonfinite", "").astype(object)
+        # each twist's verdict: an index of _TWIST_ORDER (-1: not yet decided)
+        code = np.where(fast & ~ok, _TWIST_CODE["nonfinite"], -1)
         for i in np.flatnonzero(~fast).tolist():     # another layout: the pipeline's decoder
             try:
                 t = read_twist(w.data(int(at[i])))
             except MalformedMessageError:
-                reason[i] = "malformed"
+                code[i] = _TWIST_CODE["malformed"]
                 continue
             if t.frame_id != self.frame_id:
-                reason[i] = "wrong_frame"
+                code[i] = _TWIST_CODE["wrong_frame"]
             elif not twist_is_finite(t):
-                reason[i] = "nonfinite"
+                code[i] = _TWIST_CODE["nonfinite"]
             else:
                 ok[i] = True
                 stamp[i] = t.stamp_ns
@@ -565,14 +572,14 @@ class Batch:
             last = hist.stamp[-1] if hist.stamp.size else _FIRST
             before = np.maximum(np.concatenate(([last], np.maximum.accumulate(s)[:-1])), last)
             old = s < before
-            reason[candidates[old]] = "old_stamp"
+            code[candidates[old]] = _TWIST_CODE["old_stamp"]
             taken = candidates[~old]
             hist.stamp = np.concatenate((hist.stamp, stamp[taken]))
             hist.value = np.concatenate((hist.value, value[taken]))
             hist.arrival = np.concatenate((hist.arrival, base + at[taken]))
-            reason[taken] = _TWIST_COUNTS[which]
-        counted = reason != ""
-        code = np.array([_TWIST_CODE[r] for r in reason[counted].tolist()], dtype=np.int64)
+            code[taken] = _TWIST_CODE[_TWIST_COUNTS[which]]
+        counted = code >= 0
+        code = code[counted]
         place = np.concatenate((self._twist_place, base + at[counted]))
         count = np.concatenate((self._twist_count, code))
         order = np.argsort(place, kind="stable")   # the wheel's and the rail's, by place
@@ -639,10 +646,13 @@ class Batch:
         n = rows.size
         pressure = np.empty((n, layout.height, layout.cells))
         out = np.zeros((n, adapter.OUT_SIZE))
+        peak = np.empty(n)
         m = at[rows]
+        t0 = time.perf_counter()
         kernels.scan_patches(w.arrays, w.buffer[m], w.start[m], layout.data_at, layout.width,
                              layout.height, layout.cells, layout.row, layout.step, layout.cols,
-                             pressure, out)
+                             pressure, out, peak)
+        self.timing.scan += time.perf_counter() - t0
         p.stamp[rows] = self._stamps(w, m)
         status, cells = out[:, adapter.STATUS], out[:, adapter.CELLS]
         clean = status == adapter.OK
@@ -675,10 +685,10 @@ class Batch:
             pressure[i] = np.ascontiguousarray(pressure[i][::y_order[~bad][j],
                                                            ::x_order[~bad][j]])
         if good.size == n:   # every patch to solve: the array as it is (no copy)
-            return _Group(r, pressure), rest
+            return _Group(r, pressure, peak), rest
         keep = np.zeros(n, dtype=np.bool_)
         keep[good] = True
-        return _Group(r, pressure[keep]), rest
+        return _Group(r, pressure[keep], peak[keep]), rest
 
     def _one(self, w: Window, message: int, i: int, p: Patches) -> ContactPatch | None:
         """Decode patch row ``i`` as the pipeline does, one message at a time."""
@@ -814,24 +824,24 @@ class Batch:
         where = np.zeros(p.status.size, dtype=np.bool_)
         where[todo] = True
         # one compiled call per grid shape (the patches of every layout and topic of that shape)
-        shapes: dict[tuple[int, ...], list[tuple[Ints, Floats]]] = {}
+        shapes: dict[tuple[int, ...], list[tuple[Ints, Floats, Floats]]] = {}
         for g in groups:
             take = where[g.rows]
             if take.all():
-                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows, g.pressure))
+                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows, g.pressure, g.peak))
             elif take.any():
-                shapes.setdefault(g.pressure.shape[1:], []).append((g.rows[take],
-                                                                    g.pressure[take]))
+                shapes.setdefault(g.pressure.shape[1:], []).append(
+                    (g.rows[take], g.pressure[take], g.peak[take]))
         for i, patch in singles.items():
             if where[i]:
-                shapes.setdefault(patch.pressure.shape, []).append((np.array([i]),
-                                                                    patch.pressure[None]))
+                shapes.setdefault(patch.pressure.shape, []).append(
+                    (np.array([i]), patch.pressure[None], np.array([patch.pressure.max()])))
         items = [pieces[0] if len(pieces) == 1 else
-                 (np.concatenate([r for r, _ in pieces]), np.concatenate([q for _, q in pieces]))
+                 tuple(np.concatenate([piece[k] for piece in pieces]) for k in range(3))
                  for pieces in shapes.values()]
         t0 = time.perf_counter()
         solved: list[Ints] = []
-        for rows, ps in items:
+        for rows, ps, peak in items:
             creep = p.creep[rows]
             grid = self._grid[rows].copy()
             xep = creep[:, :3].copy()
@@ -844,7 +854,9 @@ class Batch:
                 grid[back, 1] = -(grid[back, 1] + (ny - 1) * grid[back, 3])
                 xep[back, 2] = -xep[back, 2]
             speed = np.abs(creep[:, 3]) if self.law is not None else np.zeros(rows.size)
+            t1 = time.perf_counter()
             status, out = self._solve(np.ascontiguousarray(ps), grid, xep, speed)
+            self.timing.solver += time.perf_counter() - t1
             ok = status == contact_kernels.OK
             solved.append(rows[ok])
             if self.timing.inputs is not None:
@@ -864,28 +876,29 @@ class Batch:
                 p.status[rows[j]] = CODE["nonfinite"]
                 p.detail[rows[j]] = "nonfinite: the solve gave a non-finite force"
             if not self.allow_implausible:
-                self._implausible(p, rows, ps, grid, np.flatnonzero(ok & finite))
+                self._implausible(p, rows, ps, grid, peak, np.flatnonzero(ok & finite))
         elapsed = time.perf_counter() - t0
         done = np.concatenate(solved)
         self.timing.solves += done.size
         if done.size:
             p.solve_time[done] = elapsed / done.size
 
-    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats,
+    def _implausible(self, p: Patches, rows: Ints, ps: Floats, grid: Floats, peak: Floats,
                      solved: Ints) -> None:
         """``implausible``: the pipeline's rule (:func:`fastsim_ros.pipeline.implausible`).
 
-        On items ``solved`` of a solve (``rows``, ``ps``, ``grid``: its
-        patches' rows, pressures and grids).  Its bounds tested on every row
-        at once (the grid's span, the largest pressure, the creepages); the
-        rows that fail one get the pipeline's own words from
+        On items ``solved`` of a solve (``rows``, ``ps``, ``grid``, ``peak``:
+        its patches' rows, pressures, grids and largest pressures (Pa), the
+        scan's).  Its bounds tested on every row at once (the grid's span,
+        the largest pressure, the creepages); the rows that fail one get the
+        pipeline's own words from
         :func:`~fastsim_ros.ros.plausibility.stream_problem`.
         """
         if solved.size == 0:
             return
         table = plausibility.PLAUSIBLE
         ny, nx = ps.shape[1], ps.shape[2]
-        peak = ps.reshape(ps.shape[0], -1).max(axis=1)[solved]
+        peak = peak[solved]
         rows, grid = rows[solved], grid[solved]
         creep = p.creep[rows]
         suspect = ((nx * grid[:, 2] > table["patch_extent"].high)

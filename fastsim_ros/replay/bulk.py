@@ -5,12 +5,14 @@ log-time order, memory bounded by the chunks that overlap in time); its
 chunks are copied to the output as they are (the input's messages, with
 their channels, schemas and message indexes: no second compression), except
 a chunk holding messages on one of the node's output topics, whose other
-messages are copied one by one.  Between two diagnostics the messages go,
-as a run, through :class:`~fastsim_ros.replay.batch.Batch` (the pipeline's
-rules in bulk) and their outputs are encoded and written in bulk; where the
-batch does not apply (inputs it does not know, traction clouds) each
-message goes through the pipeline's own handler
-(:meth:`~fastsim_ros.pipeline.Pipeline.inputs`).  Either way the messages,
+messages are copied one by one.  The messages of a window go at once
+through :class:`~fastsim_ros.replay.batch.Batch` (the pipeline's rules in
+bulk), each diagnostics array of the window counts the verdicts before its
+place (:meth:`~fastsim_ros.replay.batch.Batch.store`), and the window's
+outputs and diagnostics are encoded and written in bulk, in the order the
+per-message replay writes them; where the batch does not apply (inputs it
+does not know, traction clouds) each message goes through the pipeline's
+own handler (:meth:`~fastsim_ros.pipeline.Pipeline.inputs`).  Either way the messages,
 their order and their values are those of the per-message replay.
 """
 
@@ -212,16 +214,24 @@ class IndexedReplay:
                 if first is None:
                     first = out.first = int(log[0])
                     next_diag = first + 1_000_000_000
+                # the batch: the window's rules at once, its outputs (and diagnostics) at once
+                p = self.batch.run(w, 0, n, base) if self.batch is not None else None
+                diags: list[tuple[int, int, bytes]] = []
                 lo = 0
                 while lo < n:
                     j = lo + int(np.searchsorted(log[lo:], next_diag, "left"))
-                    if j > lo:
+                    if j > lo and p is None:
                         self._messages(w, lo, j, base)
                     if j < n:
                         stamp = int(log[j])
-                        self._diagnostics(diagnostics, stamp, base + j)
+                        if p is None:
+                            self._diagnostics(diagnostics, stamp, base + j)
+                        else:
+                            diags.append((j, stamp, self._diagnostics_cdr(stamp, base + j)))
                         next_diag += ((stamp - next_diag) // 1_000_000_000 + 1) * 1_000_000_000
                     lo = j
+                if p is not None:
+                    self._outputs(w, p, diags, diagnostics)
                 base += n
                 last = int(log[-1])
                 self.result.messages_in += n
@@ -267,19 +277,26 @@ class IndexedReplay:
     def _diagnostics(self, topic: str, stamp: int, place: int) -> None:
         """Write the diagnostics array at ``stamp``: counts of the messages before ``place``."""
         t0 = time.perf_counter()
-        if self.batch is not None:
-            self.batch.store(place)
         data = self.pipeline.diagnostics_cdr(stamp)
-        if self.batch is not None:
-            self.batch.reported()
         self.writer.write(self.channel(topic), stamp, data)
         self.result.messages_out += 1
         self.phases["diagnostics"] += time.perf_counter() - t0
 
+    def _diagnostics_cdr(self, stamp: int, place: int) -> bytes:
+        """Return the diagnostics array at ``stamp``: counts of the messages before ``place``.
+
+        The window's rules have run (:meth:`batch.Batch.run`); the counts
+        are those of its messages before ``place`` (:meth:`batch.Batch.store`).
+        """
+        assert self.batch is not None
+        t0 = time.perf_counter()
+        self.batch.store(place)
+        data = self.pipeline.diagnostics_cdr(stamp)
+        self.batch.reported()
+        self.phases["diagnostics"] += time.perf_counter() - t0
+        return data
+
     def _messages(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
-        if self.batch is not None:
-            self._batch(w, lo, hi, base)
-            return
         for i in range(lo, hi):  # the pipeline's own handlers, one message at a time
             handler = self.handlers.get(int(w.channel[i]))
             if handler is None:
@@ -296,66 +313,84 @@ class IndexedReplay:
             self.result.messages_out += 1
         self.out.outcome(outcome, log_ns)
 
-    def _batch(self, w: mcap.Window, lo: int, hi: int, base: int) -> None:
-        assert self.batch is not None
-        p = self.batch.run(w, lo, hi, base)
+    def _outputs(self, w: mcap.Window, p: batch.Patches, diags: list[tuple[int, int, bytes]],
+                 diagnostics: str) -> None:
+        """Encode and write a window's outputs and its diagnostics arrays, in the replay's order.
+
+        ``p``: the window's patches; ``diags``: ``(message, stamp, CDR)`` of
+        each diagnostics array, which comes before the outputs of that
+        message's patch (the per-message replay writes each when the first
+        message of its second arrives).  The output channels are declared in
+        the order the per-message replay first uses them.
+        """
         t0 = time.perf_counter()
         solved = p.status == 0
         wrench = solved | (p.status == 1)
-        parts: list[tuple[Ints, Ints, NDArray[np.uint8], int]] = []  # keys, rows, bytes, channel
         log = w.log_time[p.index]
+        # each diagnostics array before the patch rows from its message on
+        at = np.searchsorted(p.index, np.array([j for j, _, _ in diags], dtype=np.int64), "left")
+        markers = resolve(MARKERS_TOPIC, self.namespace)
+        kinds: list[tuple[int, Ints, Any, str]] = []   # (kind, rows, encode(rows), topic)
         for k, c in enumerate(self.config.contacts):
             mine = p.contact == k
             force_enc, creep_enc, pose_enc, marker_enc = self.encoders[c]
             base_topic = resolve(f"contact/{c}/", self.namespace)
-            rows = np.flatnonzero(mine & wrench)
+            kinds.append((_WRENCH, np.flatnonzero(mine & wrench),
+                          lambda rows, e=force_enc: e.encode(p.stamp[rows], _wrenches(p, rows)),
+                          base_topic + "wrench"))
+            kinds.append((_CREEPAGE, np.flatnonzero(mine & solved),
+                          lambda rows, e=creep_enc: e.encode(p.stamp[rows], p.creep[rows, :3]),
+                          base_topic + "creepage"))
+            kinds.append((_FRAME, np.flatnonzero(mine & solved & p.changed),
+                          lambda rows, e=pose_enc: e.encode(p.stamp[rows], np.concatenate(
+                              (p.frame[rows, :3], encode.quaternions(p.frame[rows])), axis=1)),
+                          base_topic + "frame"))
+            kinds.append((_MARKER, np.flatnonzero(mine & solved & p.marker),
+                          lambda rows, e=marker_enc: e.arrows(p.stamp[rows], p.frame[rows],
+                                                              p.force[rows, 0],
+                                                              p.force[rows, 1]), markers))
+            kinds.append((_MARKER, np.flatnonzero(mine & ~solved & wrench & p.marker),
+                          lambda rows, e=marker_enc: e.deletions(p.stamp[rows]), markers))
+        kinds.append((_WHEELSET, np.flatnonzero(p.cycle),
+                      lambda rows: self.wheelset_encoder.encode(p.cycle_stamp[rows],
+                                                                p.cycle_wrench[rows]),
+                      resolve(WHEELSET_WRENCH_TOPIC, self.namespace)))
+        self._declare([(rows, topic) for _, rows, _, topic in kinds], at, diagnostics)
+        parts: list[tuple[Ints, Ints, NDArray[np.uint8], int]] = []  # keys, log times, rows, ch
+        for kind, rows, make, topic in kinds:
             if rows.size:
-                values = np.zeros((rows.size, 6))
-                values[:, 0] = p.force[rows, 0]
-                values[:, 1] = p.force[rows, 1]
-                values[:, 2] = p.force[rows, 2]
-                values[:, 5] = p.force[rows, 3]
-                values[~solved[rows]] = 0.0
-                parts.append((rows * 8 + _WRENCH, rows,
-                              force_enc.encode(p.stamp[rows], values),
-                              self.channel(base_topic + "wrench")))
-            rows = np.flatnonzero(mine & solved)
-            if rows.size:
-                parts.append((rows * 8 + _CREEPAGE, rows,
-                              creep_enc.encode(p.stamp[rows], p.creep[rows, :3]),
-                              self.channel(base_topic + "creepage")))
-            rows = np.flatnonzero(mine & solved & p.changed)
-            if rows.size:
-                pose = np.concatenate((p.frame[rows, :3], encode.quaternions(p.frame[rows])),
-                                      axis=1)
-                parts.append((rows * 8 + _FRAME, rows,
-                              pose_enc.encode(p.stamp[rows], pose),
-                              self.channel(base_topic + "frame")))
-            rows = np.flatnonzero(mine & solved & p.marker)
-            markers = resolve(MARKERS_TOPIC, self.namespace)
-            if rows.size:
-                parts.append((rows * 8 + _MARKER, rows,
-                              marker_enc.arrows(p.stamp[rows], p.frame[rows], p.force[rows, 0],
-                                                p.force[rows, 1]), self.channel(markers)))
-            rows = np.flatnonzero(mine & ~solved & wrench & p.marker)
-            if rows.size:
-                parts.append((rows * 8 + _MARKER, rows, marker_enc.deletions(p.stamp[rows]),
-                              self.channel(markers)))
-        rows = np.flatnonzero(p.cycle)
-        if rows.size:
-            parts.append((rows * 8 + _WHEELSET, rows,
-                          self.wheelset_encoder.encode(p.cycle_stamp[rows],
-                                                       p.cycle_wrench[rows]),
-                          self.channel(resolve(WHEELSET_WRENCH_TOPIC, self.namespace))))
+                parts.append((rows * 8 + kind, log[rows], make(rows), self.channel(topic)))
+        for r, (_, stamp, data) in zip(at.tolist(), diags):
+            parts.append((np.array([r * 8 + _DIAG]), np.array([stamp]),
+                          np.frombuffer(data, dtype=np.uint8)[None], self.channel(diagnostics)))
         t1 = time.perf_counter()
         self.phases["encode"] += t1 - t0
         if parts:
-            self._write(parts, log)
+            self._write(parts)
         self.phases["write"] += time.perf_counter() - t1
         if self.out.rows is not None or self.out.series is not None:
             t2 = time.perf_counter()
             self._records(p, wrench, log)
             self.phases["csv"] += time.perf_counter() - t2
+
+    def _declare(self, topics: list[tuple[Ints, str]], at: Ints, diagnostics: str) -> None:
+        """Declare the output channels a window uses first, in the per-message replay's order.
+
+        ``topics``: the rows of each kind of output in the order the replay
+        takes them for one patch run; ``at``: the row each diagnostics array
+        comes before.  A run between two diagnostics declares its topics in
+        that order, then the diagnostics' (the replay runs its patches from
+        one diagnostics to the next).
+        """
+        first: list[tuple[int, int, str]] = []   # (run, order, topic)
+        for order, (rows, topic) in enumerate(topics):
+            if rows.size and topic not in self.out_channels:
+                run = int(np.searchsorted(at, rows[0], "right"))
+                first.append((2 * run, order, topic))
+        if at.size and diagnostics not in self.out_channels:
+            first.append((1, 0, diagnostics))
+        for _, _, topic in sorted(first):
+            self.channel(topic)
 
     def _records(self, p: batch.Patches, wrench: NDArray[np.bool_], log: Ints) -> None:
         """Add the CSV row and plot sample of each wrench, in order (records.record's).
@@ -390,10 +425,8 @@ class IndexedReplay:
                 else:
                     out.series[c].add(tt, nan, nan, nan, 0.0, 0.0, 0.0, mu)
 
-    def _write(self, parts: list[Any], log: Ints) -> None:
-        parts = [part for part in parts if part[1].size]
-        if not parts:
-            return
+    def _write(self, parts: list[Any]) -> None:
+        """Write message records of ``(keys, log times, payloads (k, L), channel)`` by key."""
         keys = np.concatenate([k for k, _, _, _ in parts])
         order = np.argsort(keys, kind="stable")
         sizes = np.concatenate([np.full(r.shape[0], r.shape[1] + 31, dtype=np.int64)
@@ -404,13 +437,22 @@ class IndexedReplay:
         channels = np.empty(keys.size, dtype=np.int64)
         times = np.empty(keys.size, dtype=np.int64)
         at = 0
-        for _, rows, payloads, cid in parts:
-            k = rows.size
-            ch = np.full(k, cid, dtype=np.int64)
-            records = mcap.message_records(ch, log[rows], payloads)
-            kernels.scatter_rows(out, records, offsets[at:at + k])
-            channels[at:at + k] = ch
-            times[at:at + k] = log[rows]
+        for _, log, payloads, cid in parts:
+            k = log.size
+            kernels.message_records(out, offsets[at:at + k], cid, log, payloads)
+            channels[at:at + k] = cid
+            times[at:at + k] = log
             at += k
-        self.writer.write_records(out.tobytes(), channels[order], times[order], offsets[order])
+        self.writer.write_records(out, channels[order], times[order], offsets[order])
         self.result.messages_out += int(keys.size)
+
+
+def _wrenches(p: batch.Patches, rows: Ints) -> NDArray[np.float64]:
+    """Return the wrench ``Fx, Fy, N, 0, 0, Mz`` of each row (zero where not solved)."""
+    values = np.zeros((rows.size, 6))
+    values[:, 0] = p.force[rows, 0]
+    values[:, 1] = p.force[rows, 1]
+    values[:, 2] = p.force[rows, 2]
+    values[:, 5] = p.force[rows, 3]
+    values[p.status[rows] != 0] = 0.0
+    return values

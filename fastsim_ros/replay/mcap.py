@@ -31,6 +31,7 @@ import io
 import os
 import struct
 import threading
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -188,6 +189,8 @@ class IndexedMcap:
     file: BinaryIO
     #: by channel id, whether the file defines it (:meth:`channel_table`)
     known: NDArray[np.bool_] | None = None
+    #: wall time (s) spent decompressing chunks (:meth:`read_chunk`)
+    decompress_s: float = 0.0
 
     def close(self) -> None:
         """Close the file."""
@@ -223,7 +226,10 @@ class IndexedMcap:
             record = None
         if record is None or stream.count > chunk.length:
             raise McapError(f"the chunk at byte {chunk.offset} ends inside a field")
-        return raw, _chunk_records(record, chunk.offset)
+        t0 = time.perf_counter()
+        records = _chunk_records(record, chunk.offset)
+        self.decompress_s += time.perf_counter() - t0
+        return raw, records
 
 
 def open_indexed(path: Path) -> IndexedMcap | None:
@@ -381,21 +387,22 @@ def windows(mcap: IndexedMcap, on_chunk: Any, max_messages: int = 8192,
                    key=lambda k: (mcap.chunks[k].start_time, mcap.chunks[k].offset))
     loaded: list[_Loaded] = []
     nxt = 0
+    pending = held = 0     # messages not given out, bytes of records, of the loaded chunks
     while True:
-        loaded = [c for c in loaded if c.taken < c.log_time.size]
         horizon = mcap.chunks[order[nxt]].start_time if nxt < len(order) else None
-        pending = sum(c.log_time.size - c.taken for c in loaded)
-        held = sum(len(c.records) for c in loaded)
-        if horizon is not None and (not loaded or _pending_min(loaded) >= horizon
-                                    or (pending < max_messages and held < max_bytes)):
+        if horizon is not None and (not loaded or (pending < max_messages and held < max_bytes)
+                                    or _pending_min(loaded) >= horizon):
             k = order[nxt]
             nxt += 1
             raw, records = mcap.read_chunk(mcap.chunks[k])
             arrays = scan_records(records)
             _check_chunk(mcap, mcap.chunks[k], arrays)
             on_chunk(k, raw, records, arrays)
-            loaded.append(_Loaded(mcap.chunks[k].offset, records, *arrays))
-            loaded.sort(key=lambda c: c.order)
+            if arrays[0].size:   # (a chunk of no messages gives nothing out)
+                loaded.append(_Loaded(mcap.chunks[k].offset, records, *arrays))
+                loaded.sort(key=lambda c: c.order)
+                pending += arrays[0].size
+                held += len(records)
             continue
         if not loaded:
             return
@@ -419,6 +426,9 @@ def windows(mcap: IndexedMcap, on_chunk: Any, max_messages: int = 8192,
                      np.concatenate([c.channel for c in loaded])[flat], times[merged], which,
                      np.concatenate([c.start for c in loaded])[flat],
                      np.concatenate([c.size for c in loaded])[flat])
+        loaded = [c for c in loaded if c.taken < c.log_time.size]
+        pending = sum(c.log_time.size - c.taken for c in loaded)
+        held = sum(len(c.records) for c in loaded)
 
 
 def _pending_min(loaded: list[_Loaded]) -> int:
@@ -453,7 +463,7 @@ class _MessageIndex(rec.MessageIndex):
 class _Pending:
     """New message records not yet in a chunk."""
 
-    parts: list[bytes] = field(default_factory=list)
+    parts: list[bytes | memoryview] = field(default_factory=list)
     size: int = 0
     start: int = (1 << 63) - 1
     end: int = 0
@@ -555,18 +565,19 @@ class McapWriter:
         self.end = max(self.end, p.end)
         self._flush_if(CHUNK_BYTES)
 
-    def write_records(self, records: bytes, channel: NDArray[np.int64],
+    def write_records(self, records: bytes | NDArray[np.uint8], channel: NDArray[np.int64],
                       log_time: NDArray[np.int64], offset: NDArray[np.int64]) -> None:
         """Add message records built in bulk.
 
-        ``records``: their bytes; per record its ``channel``, ``log_time``
-        (ns) and ``offset`` in ``records``.
+        ``records``: their bytes (or a uint8 array of them, kept as it is
+        until the chunk is written); per record its ``channel``,
+        ``log_time`` (ns) and ``offset`` in ``records``.
         """
         if not channel.size:
             return
         p = self._pending
         base = p.size
-        p.parts.append(records)
+        p.parts.append(records if isinstance(records, bytes) else records.data)
         p.size += len(records)
         p.start = min(p.start, int(log_time.min()))
         p.end = max(p.end, int(log_time.max()))

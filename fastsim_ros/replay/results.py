@@ -19,7 +19,9 @@ class Profile:
     (decode, adapt, kinematics, solve) of patches, ``twist``: of twists,
     ``emit``: building and serializing the output messages of a patch,
     ``write``: writing them (the per-message path).  ``phases``: the
-    totals (s) of the chunked path's phases.  ``solves``: the solves as
+    totals (s) of the chunked path's phases, and parts of them:
+    ``decompress`` (of ``read``), ``scan`` (of ``decode``: the compiled
+    adapter loop), ``solver`` (of ``solve``: the compiled solves).  ``solves``: the solves as
     they were solved, to time the solver alone on the same inputs, in
     batches ``(pressure (k, ny, nx) Pa, grid (k, 4): x0, y0, dx, dy (m),
     creepages (k, 3): xi, eta, phi, solved (k,) bool)`` (kept as the

@@ -665,8 +665,9 @@ def _replay_indexed(task: Task, indexed: Any, reader: Any, staging: Path, pipeli
         if replay.batch is not None:
             t = replay.batch.timing
             prof.phases.update(decode=t.decode, kinematics=t.kinematics, solve=t.solve,
-                               state=t.state)
+                               state=t.state, scan=t.scan, solver=t.solver)
             prof.solves = t.inputs or []
+        prof.phases["decompress"] = indexed.decompress_s
     return first, last
 
 

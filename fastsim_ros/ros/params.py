@@ -207,7 +207,7 @@ PARAMETERS: tuple[ParameterSpec, ...] = (
                   "creep-slope reduction of a contaminated rail (modified FastSim, Spiryagin "
                   "et al. 2013, as CONTACT): k = k0 [alpha_inf + (1 - alpha_inf)/(1 + beta "
                   "eps)] divides the flexibilities; k0 is its value at vanishing creepage "
-                  "(1 with alpha_inf 1: the theory's full slope, today's numbers; any other: "
+                  "(1 with alpha_inf 1: the theory's full slope, a clean rail; any other: "
                   "a slip-dependent law is taken at the rigid slip velocity; "
                   "docs/guide_real_rails.md)",
                   low=1.0e-3, high=1.0, dynamic=True),
