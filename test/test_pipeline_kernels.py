@@ -195,20 +195,20 @@ def test_warm_up_compiles_every_words_type():
 def test_the_fast_builders_make_the_dataclasses_own_instances():
     import dataclasses
 
-    from fastsim_ros.pipeline import steady as pipeline
+    from fastsim_ros.pipeline import outcomes
     from fastsim_ros.contact.compiled import ContactForces
     from msg_adapters.kinematics import Creepage
     from msg_adapters.patch import ContactFrame, ContactPatch
 
     frame = ContactFrame((0.0, 0.75, -R), ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)))
     pressure = np.ones((2, 2))
-    cases = [(pipeline._new_frame, ContactFrame, (frame.origin, frame.axes)),
-             (pipeline._new_patch, ContactPatch,
+    cases = [(outcomes.new_frame, ContactFrame, (frame.origin, frame.axes)),
+             (outcomes.new_patch, ContactPatch,
               (T0, frame, pressure, -1e-3, -2e-3, 1e-3, 2e-3, 6e4, 4, 1, -1)),
-             (pipeline._new_creepage, Creepage, (1e-3, -2e-3, 0.1, 20.0)),
-             (pipeline._new_forces, ContactForces,
+             (outcomes.new_creepage, Creepage, (1e-3, -2e-3, 0.1, 20.0)),
+             (outcomes.new_forces, ContactForces,
               (-1e3, 2e2, 3.0, 6e4, 0.25, None, None, None, None)),
-             (pipeline._new_outcome, pipeline.Outcome,
+             (outcomes.new_outcome, outcomes.Outcome,
               ("left", T0, "solved", "", frame, True, None, None, None, None, False))]
     for build, cls, values in cases:
         built, reference = build(*values), cls(*values)
@@ -217,7 +217,7 @@ def test_the_fast_builders_make_the_dataclasses_own_instances():
             assert getattr(built, f.name) is getattr(reference, f.name), f.name
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(built, dataclasses.fields(cls)[0].name, None)
-    assert pipeline._new_frame(*cases[0][2]) == frame  # frozen dataclasses compare by value
+    assert outcomes.new_frame(*cases[0][2]) == frame  # frozen dataclasses compare by value
 
 
 @pytest.mark.parametrize("settings", [

@@ -3,25 +3,32 @@
 :class:`Pipeline` (:mod:`fastsim_ros.pipeline.steady`) turns patches into
 creep forces; :class:`ProfilePipeline` (:mod:`fastsim_ros.pipeline.profiles`)
 makes the patches from wheel and rail profiles and the wheelset's pose,
-then runs a :class:`Pipeline`.  The compiled per-patch path is
-:mod:`fastsim_ros.pipeline.kernels`.  No ROS import: the node and
+then runs a :class:`Pipeline`.  Their topics and the output table are
+:mod:`fastsim_ros.pipeline.topics`, what they give
+:mod:`fastsim_ros.pipeline.outcomes`; the compiled per-patch path is
+:mod:`fastsim_ros.pipeline.kernels`, its constants
+:mod:`fastsim_ros.pipeline.compiled_state`; the screen of a solved patch
+against the plausible values :mod:`fastsim_ros.pipeline.plausibility`; the
+friction estimator's cycle :mod:`fastsim_ros.estimation.cycle`.  No ROS import: the node and
 ``fastsim_replay`` are thin front ends of these.
 """
 
+from fastsim_ros.estimation.cycle import IMPLAUSIBLE_FORCE
+from fastsim_ros.pipeline.outcomes import (NO_CONTACT, SINCE_START, SINCE_START_KEY, SOLVED,
+                                           SOLVE_TIME_WINDOW, ContactReport, ContactStats,
+                                           FrictionEstimate, Outcome, Solved, WheelsetWrench)
 from fastsim_ros.pipeline.profiles import (LOAD_TOPIC, MIN_CONTACT_CELLS, POSE_TOPIC, SIDES,
                                            ProfileCycle, ProfilePipeline, TableContact,
                                            contact_name, make_pipeline, placement_of,
                                            table_grid_of, table_of, wheelset_of)
-from fastsim_ros.pipeline.steady import (CONTACT_OUTPUTS, DIAGNOSTICS_TOPIC, FRAME_TOLERANCE,
-                                         FRICTION_ESTIMATE_TOPIC, IMPLAUSIBLE_FORCE,
-                                         MARKERS_TOPIC, MEASURED_WRENCH_TOPIC, NO_CONTACT,
-                                         RAIL_TWIST_TOPIC, SINCE_START, SINCE_START_KEY,
-                                         SLOPE_ESTIMATE_TOPIC, SOLVE_TIME_WINDOW, SOLVED,
-                                         TWIST_HISTORY, WEAR_OUTPUTS, WHEEL_TWIST_TOPIC,
-                                         WHEELSET_WRENCH_TOPIC, ContactReport, ContactStats,
-                                         FrictionEstimate, InputHandler, InputTopic, Outcome,
-                                         Pipeline, PipelineConfig, Solved, WheelsetWrench,
-                                         implausible, output_topics, patch_extent, patch_topic)
+from fastsim_ros.pipeline.plausibility import implausible, patch_extent
+from fastsim_ros.pipeline.steady import FRAME_TOLERANCE, TWIST_HISTORY, Pipeline, PipelineConfig
+from fastsim_ros.pipeline.topics import (CONTACT_OUTPUTS, DIAGNOSTICS_TOPIC,
+                                         FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
+                                         MEASURED_WRENCH_TOPIC, RAIL_TWIST_TOPIC,
+                                         SLOPE_ESTIMATE_TOPIC, WEAR_OUTPUTS, WHEEL_TWIST_TOPIC,
+                                         WHEELSET_WRENCH_TOPIC, InputHandler, InputTopic,
+                                         output_topics, patch_topic)
 
 __all__ = [
     "CONTACT_OUTPUTS", "DIAGNOSTICS_TOPIC", "FRAME_TOLERANCE", "FRICTION_ESTIMATE_TOPIC",

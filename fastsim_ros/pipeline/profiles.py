@@ -58,8 +58,9 @@ from fastsim_ros.geometry.table import warm_up as table_warm_up
 from fastsim_ros.geometry.wheelset import (SIDES, Side, Vector, WheelPatch, Wheelset,
                                            WheelsetContact)
 from fastsim_ros.ros.params import PROFILE_CONTACTS, SPECS, ParameterError
-from fastsim_ros.pipeline.steady import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic,
-                                         Outcome, Pipeline, PipelineConfig, Solved,
+from fastsim_ros.pipeline.outcomes import Outcome, Solved
+from fastsim_ros.pipeline.steady import Pipeline, PipelineConfig
+from fastsim_ros.pipeline.topics import (RAIL_TWIST_TOPIC, WHEEL_TWIST_TOPIC, InputTopic,
                                          output_topics, patch_topic)
 from msg_adapters.cdr import Cloud, StampedTwist
 from msg_adapters.errors import MalformedMessageError, RejectedInput

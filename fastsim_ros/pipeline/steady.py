@@ -27,18 +27,27 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable, Collection, Container, Mapping, Sequence
-from dataclasses import MISSING, dataclass, field, fields
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from fastsim_ros.ros import params as parameters
-from fastsim_ros.ros import plausibility
 from fastsim_ros.ros.params import slope_reduction_of
 from fastsim_ros.pipeline import kernels as fast
-from fastsim_ros.contact import compiled
+from fastsim_ros.pipeline.plausibility import implausible
+from fastsim_ros.pipeline.compiled_state import CompiledState
+from fastsim_ros.pipeline.outcomes import (NO_CONTACT, SINCE_START, SINCE_START_KEY, SOLVED,
+                                           ContactReport, ContactStats, FrictionEstimate,
+                                           Outcome, Solved, WheelsetWrench, new_creepage,
+                                           new_estimate, new_forces, new_frame, new_outcome,
+                                           new_patch)
+from fastsim_ros.pipeline.topics import (FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
+                                         MEASURED_WRENCH_TOPIC, RAIL_TWIST_TOPIC,
+                                         SLOPE_ESTIMATE_TOPIC, WHEEL_TWIST_TOPIC,
+                                         WHEELSET_WRENCH_TOPIC, InputHandler, InputTopic,
+                                         output_topics, patch_topic)
 from fastsim_ros.contact.area import nearest_cells, regridded, turned_grid
-from fastsim_ros.contact.checks import check_bound
 from fastsim_ros.contact.compiled import (CalibratedMaeSolver, ContactForces,
                                           EquivalentEllipseSolver, MaeSolver)
 from fastsim_ros.contact.errors import ContactError, OutOfTableError
@@ -46,9 +55,9 @@ from fastsim_ros.contact.polach import PolachSolver
 from fastsim_ros.contact.friction import FrictionLaw, friction_law
 from fastsim_ros.errors import ParameterError
 from fastsim_ros.contact.slope_reduction import SlopeReduction
-from fastsim_ros.estimation import ContactSample, CreepModel, FrictionEkf
+from fastsim_ros.estimation import CreepModel, FrictionEkf
+from fastsim_ros.estimation.cycle import FrictionCycle
 from fastsim_ros.estimation.ekf import FrictionSlopeEkf
-from fastsim_ros.estimation.model import model_error
 from fastsim_ros.contact import kernels as contact_kernels
 from fastsim_ros.contact.transient import (RESET_REASONS, ContactMemory, TransientSolver,
                                            mae_state)
@@ -63,64 +72,9 @@ from msg_adapters.patch import ContactFrame, ContactPatch, patch_from_cloud, wor
 
 #: twists kept for matching patch stamps (at 1 kHz: 1 s of history)
 TWIST_HISTORY = 1024
-#: solve times kept per contact for the percentiles of the diagnostics
-SOLVE_TIME_WINDOW = 1000
 #: a frame "changes" (and is published again) when its origin moves by more
 #: than this (m) or an axis turns by more than this (rad, small angles)
 FRAME_TOLERANCE = 1e-6
-
-SOLVED, NO_CONTACT = "solved", "no_contact"
-
-
-def patch_topic(contact: str) -> str:
-    """Return the (relative) patch topic of a contact."""
-    return f"contact/{contact}/patch"
-
-
-WHEEL_TWIST_TOPIC, RAIL_TWIST_TOPIC = "wheelset/twist", "rail/twist"
-WHEELSET_WRENCH_TOPIC, MARKERS_TOPIC = "wheelset/wrench", "contact/markers"
-DIAGNOSTICS_TOPIC = "/diagnostics"
-#: a measured creep force (N) beyond this times the highest mu_s the estimator admits times the
-#: cycle's load is a fault of the measurement, not a rail: the update is skipped (implausible)
-IMPLAUSIBLE_FORCE = 1.0
-#: online friction estimation (parameter friction_estimation): the measured wrench in, the
-#: estimate out (Vector3Stamped: x = mu_s, y = its standard deviation, z = adhesion utilisation)
-MEASURED_WRENCH_TOPIC, FRICTION_ESTIMATE_TOPIC = "wheelset/measured_wrench", "friction/estimate"
-#: the creep-slope reduction's estimate (friction_estimate_slope_reduction): Vector3Stamped, x =
-#: k0, y = its standard deviation, z = the correlation of the mu_s and k0 estimates' errors
-SLOPE_ESTIMATE_TOPIC = "friction/slope_estimate"
-#: output topics of a contact: relative name -> message type
-CONTACT_OUTPUTS = {"wrench": "geometry_msgs/msg/WrenchStamped",
-                   "creepage": "geometry_msgs/msg/Vector3Stamped",
-                   "frame": "geometry_msgs/msg/PoseStamped",
-                   "traction": "sensor_msgs/msg/PointCloud2"}
-#: a contact's wear and fatigue topics (parameter wear_outputs; docs/guide_wear.md):
-#: energy = (T-gamma N, T-gamma/A Pa, frictional power W), damage = (wear rate kg/(m m^2),
-#: RCF damage per passage, frictional power / (T-gamma ``|V|``))
-WEAR_OUTPUTS = {"energy": "geometry_msgs/msg/Vector3Stamped",
-                "damage": "geometry_msgs/msg/Vector3Stamped"}
-
-
-def output_topics(contacts: tuple[str, ...], *, patches: bool = False,
-                  wear: bool = False) -> dict[str, str]:
-    """Return every output topic (relative, but /diagnostics) with its message type.
-
-    ``patches``: the patches are outputs too (profiles mode computes them);
-    ``wear``: the wear and fatigue topics too (:data:`WEAR_OUTPUTS`).
-    """
-    kinds = {**CONTACT_OUTPUTS, **WEAR_OUTPUTS} if wear else CONTACT_OUTPUTS
-    topics = {f"contact/{c}/{kind}": msgtype for c in contacts
-              for kind, msgtype in kinds.items()}
-    if patches:
-        topics.update({patch_topic(c): "sensor_msgs/msg/PointCloud2" for c in contacts})
-    topics[WHEELSET_WRENCH_TOPIC] = "geometry_msgs/msg/WrenchStamped"
-    topics[MARKERS_TOPIC] = "visualization_msgs/msg/MarkerArray"
-    topics[DIAGNOSTICS_TOPIC] = "diagnostic_msgs/msg/DiagnosticArray"
-    return topics
-
-
-#: a patch solved already: as converted, its creepages, forces and solve time (s)
-Solved = tuple[ContactPatch, Creepage, ContactForces, float]
 
 
 def _on_patch_cells(f: ContactForces, patch: ContactPatch) -> ContactForces:
@@ -169,174 +123,6 @@ class PipelineConfig:
     def contacts(self) -> tuple[str, ...]:
         """Return the configured contact names."""
         return tuple(self.values["contacts"])
-
-
-@dataclass(frozen=True, slots=True)
-class WheelsetWrench:
-    """Sum of the contacts' wrenches in the wheelset frame about its origin (N, N m)."""
-
-    stamp_ns: int
-    force: tuple[float, float, float]
-    torque: tuple[float, float, float]
-
-
-@dataclass(frozen=True, slots=True)
-class FrictionEstimate:
-    """The friction estimate after a rig cycle (``friction/estimate``).
-
-    ``mu``: the estimated static coefficient ``mu_s`` (what the next cycle's
-    wrenches use); ``sigma``: its standard deviation; ``utilisation``: the
-    cycle's creep forces over the friction available, ``sum |(Fx, Fy)| /
-    (mu sum N)`` at the mu they were solved with; ``status``: ``updated``,
-    ``unobservable`` (the linear range, or no contact: held, sigma grown),
-    ``implausible`` (the measured creep force beyond the friction any rail
-    gives the cycle's load: held, :data:`IMPLAUSIBLE_FORCE`) or
-    ``no_measurement`` (no fresh ``wheelset/measured_wrench``: held).
-    With the slope reduction estimated (``friction_estimate_slope_reduction``):
-    ``k0`` its estimate, ``sigma_k0`` its standard deviation, ``correlation``
-    that of the two estimates' errors (else NaN).
-    """
-
-    stamp_ns: int
-    mu: float
-    sigma: float
-    utilisation: float
-    status: str
-    k0: float = math.nan
-    sigma_k0: float = math.nan
-    correlation: float = math.nan
-
-
-@dataclass(frozen=True, slots=True, eq=False)
-class Outcome:
-    """What one patch gave.
-
-    ``status``: ``"solved"``, ``"no_contact"`` (zero wrench) or a rejection
-    reason of :data:`~msg_adapters.errors.REJECTION_REASONS` (no wrench);
-    ``detail``: words for the log.  When solved: the contact ``frame`` (and
-    whether it moved since it was last published), ``creepage``, ``forces``
-    (``fx, fy`` (N), ``mz`` (N m) about the contact origin, ``n`` (N)) and
-    the ``patch``.  ``wheelset``: the wheelset wrench when this patch
-    completed a rig cycle; ``markers``: whether markers are due;
-    ``friction``: the friction estimate after that cycle (estimation on).
-    """
-
-    contact: str
-    stamp_ns: int
-    status: str
-    detail: str = ""
-    frame: ContactFrame | None = None
-    frame_changed: bool = False
-    creepage: Creepage | None = None
-    forces: ContactForces | None = None
-    patch: ContactPatch | None = None
-    wheelset: WheelsetWrench | None = None
-    markers: bool = False
-    friction: FrictionEstimate | None = None
-
-    @property
-    def has_wrench(self) -> bool:
-        """Return whether a wrench is published for this patch (solved or no contact)."""
-        return self.status in (SOLVED, NO_CONTACT)
-
-
-#: the diagnostics key that names the keys counting since the start (a managed node: since
-#: its last configure), beside this_period/* and the status message (the last period)
-SINCE_START_KEY = "since_start"
-SINCE_START = "wrenches, solved, no_contact, rejected, rejected/*, twists/*, dropped/inactive"
-
-
-def patch_extent(pressure: np.ndarray, dx: float, dy: float) -> tuple[float, float]:
-    """Return a patch's span (m) along x and y: its grid's, or its cells in contact's if over.
-
-    The grid's span bounds the contact's, so the cells in contact are looked
-    at only where the grid spans more than a plausible patch.
-    """
-    ny, nx = pressure.shape
-    high = plausibility.PLAUSIBLE["patch_extent"].high
-    if nx * dx <= high and ny * dy <= high:
-        return nx * dx, ny * dy
-    rows, cols = np.nonzero(pressure > 0.0)
-    if cols.size == 0:
-        return 0.0, 0.0
-    return (float(np.ptp(cols)) + 1.0) * dx, (float(np.ptp(rows)) + 1.0) * dy
-
-
-def implausible(pressure: np.ndarray, dx: float, dy: float, load: float, cells: int,
-                creep: Creepage) -> str | None:
-    """Return why a solved patch is a likely unit mistake (one line), or None.
-
-    :func:`fastsim_ros.ros.plausibility.stream_problem` on the patch's extent,
-    its mean pressure (its largest where the mean is under the table's
-    bound) and its creepages: the replay's batch applies the same rule.
-    """
-    ex, ey = patch_extent(pressure, dx, dy)
-    p = load / (cells * dx * dy) if cells > 0 else 0.0
-    if not p >= plausibility.PLAUSIBLE["peak_pressure"].low:
-        p = float(pressure.max())
-    return plausibility.stream_problem(ex, ey, p, creep.xi, creep.eta, creep.phi)
-
-
-@dataclass
-class ContactStats:
-    """Counters and solve times of one contact (cumulative since start)."""
-
-    counts: dict[str, int] = field(default_factory=lambda: {
-        key: 0 for key in (SOLVED, NO_CONTACT) + REJECTION_REASONS})
-    solve_times: np.ndarray = field(default_factory=lambda: np.zeros(SOLVE_TIME_WINDOW))
-    solves: int = 0
-    window_inputs: int = 0
-    window_rejected: int = 0
-    window_first_ns: int | None = None
-    window_last_ns: int | None = None
-    last_detail: str = ""
-
-    def add_solve_time(self, seconds: float) -> None:
-        """Record one solve's wall time (s)."""
-        self.solve_times[self.solves % SOLVE_TIME_WINDOW] = seconds
-        self.solves += 1
-
-    def percentiles_us(self) -> tuple[float, float]:
-        """Return the p50 and p99 of the recent solve times (us); NaN before any."""
-        filled = self.solve_times[:min(self.solves, SOLVE_TIME_WINDOW)]
-        if filled.size == 0:
-            return math.nan, math.nan
-        p50, p99 = np.percentile(filled, (50.0, 99.0))
-        return float(p50) * 1e6, float(p99) * 1e6
-
-
-#: a handler of one input message (CDR bytes): the outcomes it gave (none for kinematics)
-InputHandler = Callable[[bytes | memoryview], tuple[Outcome, ...]]
-
-
-@dataclass(frozen=True)
-class InputTopic:
-    """One input topic of the pipeline and its handler (front ends dispatch on these).
-
-    ``topic``: relative name; ``msgtype``: its ROS type; ``kind``:
-    ``"patch"`` (of ``contact``), ``"wheel_twist"`` or ``"rail_twist"``;
-    ``take``: the pipeline's handler of one message (CDR bytes), returning
-    the outcomes it gave (none for kinematics); ``check``: for an input
-    without outcomes (the measured wrench), the same handler returning
-    ``"ok"`` or why the message was dropped (a front end logs it).
-    """
-
-    topic: str
-    msgtype: str
-    kind: str
-    contact: str | None
-    take: InputHandler
-    check: Callable[[bytes | memoryview], str] | None = None
-
-
-@dataclass(frozen=True)
-class ContactReport:
-    """One contact's diagnostics: level (0 OK, 1 WARN, 2 ERROR), message, key-values."""
-
-    name: str
-    level: int
-    message: str
-    values: tuple[tuple[str, str], ...]
 
 
 class _ContactState:
@@ -388,35 +174,6 @@ class _Every:
 _EVERY = _Every()
 
 
-def _builder(cls: type) -> Callable[..., Any]:
-    """Return a constructor of a frozen, slotted dataclass taking every field in order.
-
-    The dataclass's own ``__init__`` sets each field through
-    ``object.__setattr__`` (what ``frozen`` costs); this one calls each slot's
-    setter directly: half the time, for the five results built per patch on
-    the compiled path.  Plain defaults (no factories), no ``__post_init__``
-    (none of them has one); the instance equals the ``__init__``'s (test_pipeline_kernels.py).
-    """
-    names = [f.name for f in fields(cls)]
-    assert list(getattr(cls, "__slots__")) == names and not hasattr(cls, "__post_init__")
-    # a field with a plain default may be left out (Outcome.friction: only when estimating)
-    defaults = {f.name: f.default for f in fields(cls) if f.default is not MISSING}
-    args = ", ".join(f"{n}=default_{n}" if n in defaults else n for n in names)
-    body = "".join(f"    set_{n}(o, {n})\n" for n in names)
-    scope: dict[str, Any] = {"new": object.__new__, "cls": cls}
-    scope.update({f"default_{n}": v for n, v in defaults.items()})
-    scope.update({f"set_{n}": getattr(cls, n).__set__ for n in names})
-    exec(f"def build({args}):\n    o = new(cls)\n{body}    return o\n", scope)
-    build: Callable[..., Any] = scope["build"]
-    return build
-
-
-_new_frame = _builder(ContactFrame)
-_new_patch = _builder(ContactPatch)
-_new_creepage = _builder(Creepage)
-_new_forces = _builder(ContactForces)
-_new_outcome = _builder(Outcome)
-_new_estimate = _builder(FrictionEstimate)
 #: pipeline_kernels.solve_cloud's memory in steady rolling
 _STEADY_MEMORY = np.zeros(fast.MEMORY_SIZE)
 
@@ -474,15 +231,10 @@ class Pipeline:
                                   "old_stamp": 0, "malformed": 0}
         # online friction estimation (None: off); the measured wrenches (stamp, force)
         self._ekf: FrictionEkf | FrictionSlopeEkf | None = None
-        self._measured: deque[tuple[int, tuple[float, float, float]]] = deque(
-            maxlen=TWIST_HISTORY)
-        self._measured_used_ns: int | None = None
-        self._last_cycle_ns: int | None = None
+        self._friction = FrictionCycle(TWIST_HISTORY)
         # measured wrenches dropped, by reason (the twists' reasons)
         self.wrench_counts = {"nonfinite": 0, "wrong_frame": 0, "old_stamp": 0, "malformed": 0}
-        self.estimation_counts = {"measured": 0, "dropped": 0, "updated": 0,
-                                  "unobservable": 0, "implausible": 0, "no_measurement": 0,
-                                  "steps": 0}
+        self.estimation_counts = self._friction.counts
         self._apply(config)
 
     def _apply(self, config: PipelineConfig, changed: Collection[str] = ()) -> None:
@@ -514,6 +266,12 @@ class Pipeline:
         self._apply_estimation(config, changed)
         self._model_error_share = float(config["friction_model_error"])
         # the estimator's measurement model: the configured solver, law shape and bound
+        # and the model of the (mu_s, k0) estimate's: its reduction's alpha_inf and beta too
+        self._reduced_model = (self._solver, str(config["friction_law"]),
+                               float(config["friction_limit_ratio"]),
+                               float(config["friction_decay"]), str(self._bound),
+                               float(config["slope_reduction_alpha_inf"]),
+                               float(config["slope_reduction_beta"]))
         self._creep_model = CreepModel(self._solver,  # type: ignore[arg-type]
                                        str(config["friction_law"]),
                                        float(config["friction_limit_ratio"]),
@@ -534,7 +292,7 @@ class Pipeline:
                                          else None)
         # the compiled path (pipeline_kernels.solve_cloud): the MAE methods without
         # tractions; the solver's arguments as its solve_arrays passes them
-        self._compiled: tuple[Any, ...] | None = None
+        self._compiled: CompiledState | None = None
         solver = self._solver
         self._transient = config["rolling"] == "transient" and self._override is None
         # a new method or rolling: the contacts' memories start afresh; a new gap rule
@@ -547,11 +305,7 @@ class Pipeline:
             memory.max_gap = float(config["transient_max_gap"])
         # the compiled path knows no slope reduction: the solver's solve_arrays applies it
         if isinstance(solver, MaeSolver) and not self._tractions and not law.reduces_slope:
-            code, prm, mu_s, _ = compiled._law(self._mu, self._law, 1.0)
-            self._compiled = (solver._rule, check_bound(self._bound), solver.shear_modulus,
-                              solver._knots, solver._polys, code, prm, mu_s,
-                              self._law is not None, solver._calibrated, solver._pair_knots,
-                              solver._pair_values, solver._knee_for(self._bound))
+            self._compiled = CompiledState.of(solver, self._bound, self._mu, self._law)
 
     def _reduction(self, config: PipelineConfig) -> SlopeReduction | None:
         """Return the creep-slope reduction in force: the parameters', ``k0`` the estimate's.
@@ -714,199 +468,48 @@ class Pipeline:
         ``estimation_counts["dropped"]``) as a twist is: malformed, another
         frame, non-finite, older than the last.
         """
-        taken = self._screened(wrench, self._measured[-1][0] if self._measured else None)
+        measured = self._friction.measured
+        taken = self._screened(wrench, measured[-1][0] if measured else None)
         if isinstance(taken, str):
             self.estimation_counts["dropped"] += 1
             self.wrench_counts[taken] += 1
             return taken
         f = taken.linear
-        self._measured.append((taken.stamp_ns, (f[0], f[1], f[2])))
-        self.estimation_counts["measured"] += 1
+        self._friction.add(taken.stamp_ns, (f[0], f[1], f[2]))
         return "ok"
-
-    def _measurement(self, stamp_ns: int) -> tuple[float, float, float] | None:
-        """Return the measured force of the cycle stamped ``stamp_ns``, by the kinematics' rules.
-
-        The newest measured wrench not after the cycle and at most
-        ``max_kinematics_age`` before it, and not used by an earlier cycle.
-        """
-        for stamp, force in reversed(self._measured):
-            if stamp <= stamp_ns:
-                if stamp_ns - stamp > self._max_age_ns or (
-                        self._measured_used_ns is not None and stamp <= self._measured_used_ns):
-                    return None
-                self._measured_used_ns = stamp
-                return force
-        return None
 
     def _estimate(self, cycle: WheelsetWrench) -> FrictionEstimate:
         """Update the friction estimate with the cycle's measured force.x; use it from now on.
 
-        Measurement model (:mod:`fastsim_ros.estimation`): the wheelset
-        frame's ``x`` component of the contacts' wrenches, ``sum_c e_x,c[0]
-        Fx_c + e_y,c[0] Fy_c + e_z,c[0] N_c``, the creep forces solved at
-        ``mu_s`` (the published ones are those at the prior; the slope is the
-        march's derivative, from the published solve's own march on the
-        compiled path, else one march more per contact; with the equivalent
-        ellipse a forward difference, one more solve per contact).
+        The measurement and the filter's update are the estimator's cycle
+        (:meth:`fastsim_ros.estimation.cycle.FrictionCycle.update`, given each
+        contact's published solve and its march's slope); the estimate's
+        ``mu_s`` (and ``k0``) is what the next patches are solved with.
         """
         ekf = self._ekf
         assert ekf is not None
-        if self._last_cycle_ns is not None and cycle.stamp_ns > self._last_cycle_ns:
-            ekf.predict((cycle.stamp_ns - self._last_cycle_ns) * 1e-9)
-        self._last_cycle_ns = cycle.stamp_ns
         mu = self._mu
-        solved: list[tuple[ContactPatch, Creepage, ContactForces]] = []
-        normal_x = predicted = load = used = adhesion = slope = 0.0
-        marched = True  # every contact's slope came with its solve
-        slopes: list[tuple[float, float]] = []
-        for state in self._contacts.values():
-            taken = state.solved
-            if taken is None:
-                continue
-            patch, _, f = taken
-            ex, ey, ez = patch.frame.axes
-            if state.slope is None:
-                marched = False
-            else:
-                slope += ex[0] * state.slope[0] + ey[0] * state.slope[1]
-                slopes.append(state.slope)
-            solved.append(taken)
-            normal_x += ez[0] * f.n
-            predicted += ex[0] * f.fx + ey[0] * f.fy
-            load += f.n
-            used += math.hypot(f.fx, f.fy)
-            adhesion += (1.0 - f.slip_fraction) * f.n * math.hypot(ex[0], ey[0])
-        utilisation = used / (mu * load) if load > 0.0 else 0.0
-        measured = self._measurement(cycle.stamp_ns)
-        status = "no_measurement"
-        if measured is None:
-            pass
-        elif not (solved and load > 0.0):
-            status = "unobservable"  # no contact (a lifted wheelset): no force depends on mu
-        elif abs(measured[0] - normal_x) > (
-                IMPLAUSIBLE_FORCE * ekf.mu_bounds[1] * load + 10.0 * ekf.measurement_noise):
-            # more creep force than the highest friction the filter admits gives the load
-            # (plus ten of the load cell's sigmas): a fault of the measurement, which as a
-            # step of mu would drive the estimate to its bound and every wrench with it
-            status = "implausible"
-        elif isinstance(ekf, FrictionSlopeEkf):
-            status = self._estimate_with_slope(ekf, solved, measured[0] - normal_x, load)
-        else:
-            model, share = self._creep_model, self._model_error_share
-            # the model's samples only where a solve beyond the published one is asked
-            # for (a step of mu seen, a slope the march did not give): most cycles none
-            built: list[list[ContactSample]] = []
-
-            def samples() -> list[ContactSample]:
-                if not built:
-                    built.append([ContactSample(
-                        p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi, c.eta, c.phi, c.speed,
-                        ((p.frame.axes[0][0], p.frame.axes[1][0]),)) for p, c, _ in solved])
-                return built[0]
-            try:
-                if marched and model.has_slope and ekf.mu == mu:
-                    # the node's cycle: the model and its slope at the prior are the
-                    # published solve's (update, to the bit, without its sequences), times
-                    # the knee factor where the model carries it (CreepModel.knee_factor)
-                    if model.knee_corrected:
-                        predicted, slope = self._knee_corrected(model, solved, slopes, mu)
-                    step = ekf.update_scalar(
-                        measured[0] - normal_x, predicted, slope, load,
-                        model_error(mu, adhesion, share),
-                        lambda m: model.predict_with_error(samples(), m, share)[1])
-                else:  # a slope the march did not give, or an estimate off the published mu
-                    if model.knee_corrected:  # the published forces times their factors
-                        predicted = self._knee_corrected(model, solved, None, mu)[0]
-                    step = ekf.update((measured[0] - normal_x,),
-                                      lambda m: model.predict(samples(), m), load, (predicted,),
-                                      model_error(mu, adhesion, share),
-                                      lambda m: model.predict_with_error(samples(), m, share)[1],
-                                      (lambda m: model.slope(samples(), m)) if model.has_slope
-                                      else None)
-                status = step.status
-                self.estimation_counts["steps"] += int(step.step_seen)
-            except ContactError:  # the solver refused the perturbed mu: hold
-                status = "unobservable"
-        self.estimation_counts[status] += 1
+        status, utilisation = self._friction.update(
+            ekf, cycle.stamp_ns, mu,
+            [(state.solved, state.slope) for state in self._contacts.values()],
+            self._max_age_ns, self._creep_model, self._model_error_share,
+            self._reduced_model)
         if isinstance(ekf, FrictionSlopeEkf):
             reduction = self._law.reduction if self._law is not None else None
             if ekf.mu != mu or (reduction.k0 if reduction is not None else 1.0) != ekf.k0:
                 self._use_mu(ekf.mu, self.config)  # the law and the compiled path anew
-            return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status,
-                                 ekf.k0, ekf.sigma_k0, ekf.correlation)
-        if ekf.mu != mu:  # as _use_mu, which gives the same law and tuple, for less
+            return new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status,
+                                ekf.k0, ekf.sigma_k0, ekf.correlation)
+        if ekf.mu != mu:  # as _use_mu, which gives the same law and state, for less
             self._mu = ekf.mu
             if self._law is not None:
                 self._law = friction_law(str(self.config["friction_law"]), self._mu,
                                          limit_ratio=float(self.config["friction_limit_ratio"]),
                                          decay=float(self.config["friction_decay"]),
                                          reduction=self._reduction(self.config))
-            c = self._compiled
-            if c is not None:  # only mu_s (slot 7) depends on mu
-                self._compiled = c[:7] + (self._mu,) + c[8:]
-        return _new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
-
-    def _estimate_with_slope(self, ekf: FrictionSlopeEkf,
-                             solved: list[tuple[ContactPatch, Creepage, ContactForces]],
-                             measured: float, load: float) -> str:
-        """Update ``(mu_s, k0)`` with the cycle's measured creep force ``measured`` (N, x).
-
-        The model: the configured solver under the law at ``mu_s`` with the
-        reduction ``SlopeReduction(k0, alpha_inf, beta)`` (the modified
-        FastSim, no knee factor), the contacts' forces projected on the
-        wheelset's ``x`` (:meth:`CreepModel.predict`).  The model at the prior
-        is the published forces (solved under that very law and reduction);
-        the forward difference in each state is one solve per contact more.
-        Returns the cycle's status.
-        """
-        config = self.config
-        samples = [ContactSample(p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi, c.eta, c.phi,
-                                 c.speed, ((p.frame.axes[0][0], p.frame.axes[1][0]),))
-                   for p, c, _ in solved]
-        alpha_inf, beta = (float(config["slope_reduction_alpha_inf"]),
-                           float(config["slope_reduction_beta"]))
-        law = (str(config["friction_law"]), float(config["friction_limit_ratio"]),
-               float(config["friction_decay"]), str(self._bound))
-
-        def model(mu_s: float, k0: float) -> float:
-            reduction = SlopeReduction(k0, alpha_inf, beta)
-            creep = CreepModel(self._solver, *law, knee=False,  # type: ignore[arg-type]
-                               reduction=None if reduction.identity else reduction)
-            return float(creep.predict(samples, mu_s)[0])
-        predicted = math.fsum(p.frame.axes[0][0] * f.fx + p.frame.axes[1][0] * f.fy
-                              for p, _, f in solved)
-        try:
-            step = ekf.update(measured, model, load, predicted)
-        except ContactError:  # the solver refused a perturbed state: hold
-            return "unobservable"
-        self.estimation_counts["steps"] += int(step.step_seen)
-        return step.status
-
-    @staticmethod
-    def _knee_corrected(model: CreepModel,
-                        solved: list[tuple[ContactPatch, Creepage, ContactForces]],
-                        slopes: list[tuple[float, float]] | None,
-                        mu: float) -> tuple[float, float]:
-        """Return the model's value and slope at ``mu`` from the published solves and marches.
-
-        Per contact ``kappa F`` and ``kappa dF/dmu_s + F dkappa/dmu_s``
-        (:meth:`CreepModel.knee_factor`), projected on the wheelset's ``x``:
-        :meth:`CreepModel.predict` and :meth:`CreepModel.slope` without a
-        solve (the published forces and the march's slope are theirs);
-        ``slopes`` None: the value alone (slope 0).
-        """
-        predicted = slope = 0.0
-        for k, (p, c, f) in enumerate(solved):
-            kappa, dkappa = model.knee_factor_of(p.pressure, p.x0, p.y0, p.dx, p.dy, c.xi,
-                                                 c.eta, c.phi, c.speed, mu)
-            ex, ey, _ = p.frame.axes
-            force = ex[0] * f.fx + ey[0] * f.fy
-            predicted += kappa * force
-            if slopes is not None:
-                dfx, dfy = slopes[k]
-                slope += kappa * (ex[0] * dfx + ey[0] * dfy) + dkappa * force
-        return predicted, slope
+            if self._compiled is not None:  # only its mu_s depends on mu
+                self._compiled = self._compiled.with_mu(self._mu)
+        return new_estimate(cycle.stamp_ns, ekf.mu, ekf.sigma, utilisation, status)
 
     def kinematics(self, stamp_ns: int) -> tuple[StampedTwist, StampedTwist]:
         """Return the wheel and rail twists a patch stamped ``stamp_ns`` is solved with.
@@ -1016,8 +619,8 @@ class Pipeline:
         wheelset = self._add_wrench(state, stamp, f_ws, torque)
         friction = (self._estimate(wheelset) if wheelset is not None and self._ekf is not None
                     else None)
-        return _new_outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces,
-                            patch, wheelset, self._markers_due(state, stamp), friction)
+        return new_outcome(contact, stamp, SOLVED, "", patch.frame, changed, creep, forces,
+                           patch, wheelset, self._markers_due(state, stamp), friction)
 
     def _twist_array(self, what: str, twist: StampedTwist) -> np.ndarray:
         """Return a twist's ``(v, w)`` as an array (built once per twist)."""
@@ -1102,11 +705,11 @@ class Pipeline:
             patch_kernels.ORIGIN:patch_kernels.E_Z + 3].tolist()
         (x0, y0, dx, dy, load, cells, row_order, column_order, xi, eta, phi, speed, fx, fy,
          mz, n, slip_fraction, f0, f1, f2, t0, t1, t2) = result[:fast.DFX_DMU].tolist()
-        frame = _new_frame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
-        patch = _new_patch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, int(cells),
-                           int(row_order), int(column_order))
-        return (patch, _new_creepage(xi, eta, phi, speed),
-                _new_forces(fx, fy, mz, n, slip_fraction, None, None, None, None), (f0, f1, f2),
+        frame = new_frame((o0, o1, o2), ((ex0, ex1, ex2), (ey0, ey1, ey2), (ez0, ez1, ez2)))
+        patch = new_patch(cloud.stamp_ns, frame, pressure, x0, y0, dx, dy, load, int(cells),
+                          int(row_order), int(column_order))
+        return (patch, new_creepage(xi, eta, phi, speed),
+                new_forces(fx, fy, mz, n, slip_fraction, None, None, None, None), (f0, f1, f2),
                 (t0, t1, t2))
 
     def solve_patch(self, patch: ContactPatch, wheel: StampedTwist,

@@ -49,20 +49,16 @@ from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.subscription import Subscription
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PoseStamped, Vector3Stamped, WrenchStamped
 from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescriptor,
                                 ParameterType, SetParametersResult)
-from sensor_msgs.msg import PointCloud2
-from visualization_msgs.msg import MarkerArray
 
 from fastsim_ros.ros import params as parameters
 from fastsim_ros.pipeline import kernels as pipeline_kernels
 from fastsim_ros.contact import compiled
 from fastsim_ros.errors import ParameterError, StartupError
 from msg_adapters import patch as patch_adapter
-from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, FRICTION_ESTIMATE_TOPIC, MARKERS_TOPIC,
-                                  WHEELSET_WRENCH_TOPIC, InputTopic, Outcome, PipelineConfig,
-                                  patch_topic)
+from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, InputTopic, Outcome,
+                                  PipelineConfig)
 from fastsim_ros.pipeline.profiles import AnyPipeline, ProfilePipeline, make_pipeline
 
 NODE_NAME = "fastsim"
@@ -72,8 +68,6 @@ _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
           "string": ParameterType.PARAMETER_STRING,
           "string_array": ParameterType.PARAMETER_STRING_ARRAY,
           "double_array": ParameterType.PARAMETER_DOUBLE_ARRAY}
-_MESSAGE_TYPES = {"wrench": WrenchStamped, "creepage": Vector3Stamped, "frame": PoseStamped,
-                  "traction": PointCloud2}
 #: libyaml's loader where built (a params file in 0.5 ms, not 7: the check is on the start)
 _YAML_LOADER = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
 #: least time (s) between two looks at the ROS graph for patch topics no contact takes
@@ -328,24 +322,13 @@ class _FrontEnd:
         # one throttle per contact: a contact that keeps failing must not hide another's
         # rejections behind its own "(and N more)"
         self._rejections = {c: ThrottledLog(node.get_logger()) for c in config.contacts}
-        outputs = {f"contact/{c}/{kind}": msgtype for c in config.contacts
-                   for kind, msgtype in _MESSAGE_TYPES.items()}
-        outputs[WHEELSET_WRENCH_TOPIC] = WrenchStamped
-        outputs[MARKERS_TOPIC] = MarkerArray
-        declared = self.pipeline.outputs()
-        if FRICTION_ESTIMATE_TOPIC in declared:  # friction_estimation on
-            outputs[FRICTION_ESTIMATE_TOPIC] = Vector3Stamped
-        for topic, name in declared.items():  # the wear topics (wear_outputs on)
-            if topic not in outputs and name == "geometry_msgs/msg/Vector3Stamped":
-                outputs[topic] = Vector3Stamped
-        if isinstance(self.pipeline, ProfilePipeline):
-            # profiles mode computes the patches and publishes them, so that a recording
-            # replays in either mode
-            outputs.update({patch_topic(c): PointCloud2 for c in config.contacts})
-        for topic, msgtype in outputs.items():
-            self._pubs[topic] = node.create_publisher(
-                msgtype, topic, qos_out,
-                event_callbacks=PublisherEventCallbacks(matched=self._matched(topic)))
+        # the pipeline's one table of outputs (profiles mode's has the patches too, so
+        # that a recording replays in either mode); /diagnostics has its own publisher
+        for topic, msgtype in self.pipeline.outputs().items():
+            if topic != DIAGNOSTICS_TOPIC:
+                self._pubs[topic] = node.create_publisher(
+                    message_type(msgtype), topic, qos_out,
+                    event_callbacks=PublisherEventCallbacks(matched=self._matched(topic)))
         self._diagnostics = node.create_publisher(DiagnosticArray, DIAGNOSTICS_TOPIC, qos_out)
         # the pipeline's one table of inputs: each topic raw to its handler
         for entry in self.pipeline.inputs():
