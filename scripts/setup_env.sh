@@ -23,6 +23,25 @@ if [[ "$want" != "$have" ]]; then
     echo "$want" > "$stamp"
 fi
 
+# colcon copies the package into install/ and never removes what the sources no
+# longer have: a module moved or renamed would stay there beside its new place, and
+# an older version's egg-info would keep its entry points (a console script could
+# then start the old module).  So the installed tree keeps only files the sources
+# have (numba's caches in __pycache__ stay), and only the egg-info colcon writes now;
+# setuptools' staging copy in build/ is made afresh (it would copy the old files back).
+rm -rf build/fastsim_ros/build/lib
+for tree in install/fastsim_ros/lib/python3.*/site-packages; do
+    [[ -d "$tree" ]] || continue
+    for pkg in fastsim_ros msg_adapters; do
+        [[ -d "$tree/$pkg" ]] || continue
+        while IFS= read -r -d '' file; do
+            rel="${file#"$tree"/}"
+            [[ -e "$root/$rel" ]] || rm -f "$file"
+        done < <(find "$tree/$pkg" -type f -not -path '*/__pycache__/*' -print0)
+    done
+    rm -rf "$tree"/fastsim_ros-*.egg-info
+done
+
 # colcon and the interpreter it runs setup.py with must be the venv's.
 export PATH="$venv/bin:$PATH"
 colcon build \

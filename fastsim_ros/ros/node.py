@@ -322,6 +322,13 @@ class _FrontEnd:
         # one throttle per contact: a contact that keeps failing must not hide another's
         # rejections behind its own "(and N more)"
         self._rejections = {c: ThrottledLog(node.get_logger()) for c in config.contacts}
+        # what exists now (modules, kernels, the pipeline) lives as long as the node: out
+        # of the cyclic collector's sight, so that its passes stay short at kHz rates.  The
+        # full pass (30-50 ms) runs here, before any topic exists: a client may start
+        # sending as soon as the topics match, and at 1 kHz a patch topic's queue
+        # (qos_depth) holds 10 ms
+        gc.collect()
+        gc.freeze()
         # the pipeline's one table of outputs (profiles mode's has the patches too, so
         # that a recording replays in either mode); /diagnostics has its own publisher
         for topic, msgtype in self.pipeline.outputs().items():
@@ -786,8 +793,8 @@ def _run_node(make: Callable[..., Node], program: str, args: Sequence[str] | Non
         kind = node.get_parameter("executor").value  # checked at configure, else events
         executor = make_executor(kind if kind in ("events", "single_threaded") else "events")
         executor.add_node(node)
-        # everything built so far lives as long as the node: out of the cyclic
-        # collector's sight, so that its full passes stay short at kHz rates
+        # the executor too out of the collector's sight (the rest was frozen before the
+        # topics opened, so this pass is short)
         gc.collect()
         gc.freeze()
         # spin_once in a loop, not spin(): the events executor's spin() neither
