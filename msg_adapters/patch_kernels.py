@@ -27,7 +27,7 @@ OUT_SIZE = 22
 
 
 @njit(cache=True)
-def adapt(words, ny, nx, row, step, cols, pressure, out):
+def adapt(words, ny, nx, row, step, cols, pressure, out, checked=True):
     """Copy the pressure (Pa) out of the cloud, derive the contact frame, fit the grid.
 
     Fills ``pressure[j, i]`` (float64) and ``out`` (float64, OUT_SIZE), by
@@ -43,7 +43,9 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
     origin) . e_y`` (m): each step the mean over the other index of (last -
     first)/(n - 1), each offset the mean residual, ``WORST_*`` the largest
     distance (m) of a point from its grid line.  ``patch.py`` decides what
-    the numbers mean.
+    the numbers mean.  ``checked=False``: every word is known finite (the
+    replay tests a whole patch's words at once), and the per-point test is
+    skipped; the numbers are the same.  Returns the largest pressure (Pa).
     """
     cells = 0
     p_sum = 0.0
@@ -64,9 +66,9 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
             n0 = float(words[base + c3])
             n1 = float(words[base + c4])
             n2 = float(words[base + c5])
-            if not (math.isfinite(p) and math.isfinite(x) and math.isfinite(y)
-                    and math.isfinite(z) and math.isfinite(n0) and math.isfinite(n1)
-                    and math.isfinite(n2)):
+            if checked and not (math.isfinite(p) and math.isfinite(x) and math.isfinite(y)
+                                and math.isfinite(z) and math.isfinite(n0)
+                                and math.isfinite(n1) and math.isfinite(n2)):
                 status = NONFINITE
             pressure[j, i] = p
             if p < p_min:
@@ -91,27 +93,27 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
     out[P_SUM] = p_sum
     out[P_MIN] = p_min
     if status != OK or cells == 0:
-        return
+        return p_max
     o0, o1, o2 = s0 / p_sum, s1 / p_sum, s2 / p_sum
     out[ORIGIN], out[ORIGIN + 1], out[ORIGIN + 2] = o0, o1, o2
     # the contact frame (patch.contact_axes, the same operations)
     norm = math.sqrt(s3 * s3 + s4 * s4 + s5 * s5)
     if not norm > 0.0:
         out[STATUS] = ZERO_NORMAL
-        return
+        return p_max
     z0, z1, z2 = s3 / norm, s4 / norm, s5 / norm
     exx, exy, exz = 1.0 - z0 * z0, -z0 * z1, -z0 * z2
     ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
     if not ex_norm > 1e-6:
         out[STATUS] = NORMAL_ALONG_X
-        return
+        return p_max
     x0_, x1_, x2_ = exx / ex_norm, exy / ex_norm, exz / ex_norm
     y0_, y1_, y2_ = z1 * x2_ - z2 * x1_, z2 * x0_ - z0 * x2_, z0 * x1_ - z1 * x0_
     out[E_X], out[E_X + 1], out[E_X + 2] = x0_, x1_, x2_
     out[E_Y], out[E_Y + 1], out[E_Y + 2] = y0_, y1_, y2_
     out[E_Z], out[E_Z + 1], out[E_Z + 2] = z0, z1, z2
     if ny < 2 or nx < 2:
-        return
+        return p_max
     # the grid's steps from the spans between the first and last points of each
     # strip (x) and of each column (y), summed in index order
     span_x = 0.0
@@ -156,6 +158,7 @@ def adapt(words, ny, nx, row, step, cols, pressure, out):
     gy0 = sy / n - dy * 0.5 * (ny - 1)
     out[X0], out[DX], out[WORST_X] = gx0, dx, max(rx_high - gx0, gx0 - rx_low)
     out[Y0], out[DY], out[WORST_Y] = gy0, dy, max(ry_high - gy0, gy0 - ry_low)
+    return p_max
 
 
 @njit(cache=True, inline="always")

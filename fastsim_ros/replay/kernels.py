@@ -3,9 +3,9 @@
 The decisions stay in Python (:mod:`~fastsim_ros.replay.batch`); these
 loops only walk bytes and sum.  The patch scan runs the node's adapter
 loop (:func:`msg_adapters.patch_kernels.adapt`) on each patch of a chunk,
-or, where every word of the patch is finite, the same operations without
-its per-point finiteness test (:func:`adapt_finite`), so a patch gives the
-same numbers here as in the node.
+without its per-point finiteness test where every word of the patch is
+finite (:func:`all_finite`), so a patch gives the same numbers here as in
+the node.
 """
 
 from __future__ import annotations
@@ -131,32 +131,30 @@ def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pr
     the patch fields at word offsets ``cols``.  Fills ``pressure[i]`` (Pa)
     and ``out[i]`` as :func:`msg_adapters.patch_kernels.adapt` does (its
     status, cells, sums, contact frame and grid fit, by its indices): a
-    patch whose words are all finite goes through :func:`adapt_finite`
-    (the node's loop without its per-point finiteness test, the same
-    operations in the same order), any other through the node's own loop,
-    so a patch gives the node's numbers.  ``peak[i]``: the largest of
+    patch whose words are all finite goes through the node's loop without
+    its per-point finiteness test (``checked=False``), any other through the
+    node's loop with it, so a patch gives the node's numbers.  ``peak[i]``: the largest of
     ``pressure[i]`` (Pa) where the points are finite (the plausibility
     bound's peak pressure; NaN in, anything out).
     """
     words = (ny - 1) * row + nx * step
     nbytes = words * width
-    offsets = np.empty(nx)    # i dx of the grid fit, per column (adapt_finite's scratch)
     for i in range(start.size):
         buf = bufs[which[i]]
         s = start[i] + data_at
         if width == 4:
             w4 = buf[s:s + nbytes].view(np.float32)
             if all_finite(w4, words):
-                peak[i] = adapt_finite(w4, ny, nx, row, step, cols, pressure[i], out[i],
-                                       offsets)
+                peak[i] = patch_kernels.adapt(w4, ny, nx, row, step, cols, pressure[i],
+                                              out[i], False)
             else:
                 patch_kernels.adapt(w4, ny, nx, row, step, cols, pressure[i], out[i])
                 peak[i] = pressure[i].max()
         else:
             w8 = buf[s:s + nbytes].view(np.float64)
             if all_finite(w8, words):
-                peak[i] = adapt_finite(w8, ny, nx, row, step, cols, pressure[i], out[i],
-                                       offsets)
+                peak[i] = patch_kernels.adapt(w8, ny, nx, row, step, cols, pressure[i],
+                                              out[i], False)
             else:
                 patch_kernels.adapt(w8, ny, nx, row, step, cols, pressure[i], out[i])
                 peak[i] = pressure[i].max()
@@ -174,145 +172,6 @@ def all_finite(words, n):
     for k in range(n):
         ok &= abs(words[k]) < math.inf
     return ok
-
-
-@njit(cache=True)
-def adapt_finite(words, ny, nx, row, step, cols, pressure, out, offsets):
-    """:func:`msg_adapters.patch_kernels.adapt` on points whose words are all finite.
-
-    The node's loop, operation for operation and in its order (the words
-    keep their own float type, as ``float()`` of a float32 does in the
-    node's loop: float32 products, float64 sums), without its per-point
-    finiteness test, which :func:`all_finite` has passed for the whole
-    block; ``i dx`` of the fit's residuals taken once per column into
-    ``offsets`` (at least ``nx`` long), ``j dy`` once per row.  Writes what
-    ``adapt`` writes, bit for bit (the tests compare them on float32,
-    float64, padded, reordered, reversed and refused grids); returns the
-    largest pressure (Pa).
-    """
-    cells = 0
-    p_sum = 0.0
-    p_min = math.inf
-    p_max = -math.inf
-    status = patch_kernels.OK
-    s0 = s1 = s2 = s3 = s4 = s5 = 0.0
-    c0, c1, c2, c3, c4, c5, c6 = cols[0], cols[1], cols[2], cols[3], cols[4], cols[5], cols[6]
-    for j in range(ny):
-        for i in range(nx):
-            base = j * row + i * step
-            p = float(words[base + c6])
-            pressure[j, i] = p
-            if p < p_min:
-                p_min = p
-            if p > p_max:
-                p_max = p
-            if p > 0.0:
-                x = float(words[base + c0])
-                y = float(words[base + c1])
-                z = float(words[base + c2])
-                n0 = float(words[base + c3])
-                n1 = float(words[base + c4])
-                n2 = float(words[base + c5])
-                cells += 1
-                p_sum += p
-                s0 += p * x
-                s1 += p * y
-                s2 += p * z
-                s3 += p * n0
-                s4 += p * n1
-                s5 += p * n2
-    if status == patch_kernels.OK and p_min < 0.0:
-        status = patch_kernels.NEGATIVE
-    if status == patch_kernels.OK and p_max > patch_kernels.MAX_PRESSURE:
-        status = patch_kernels.TOO_HIGH
-    out[patch_kernels.STATUS] = status
-    out[patch_kernels.CELLS] = cells
-    out[patch_kernels.P_SUM] = p_sum
-    out[patch_kernels.P_MIN] = p_min
-    if status != patch_kernels.OK or cells == 0:
-        return p_max
-    o0, o1, o2 = s0 / p_sum, s1 / p_sum, s2 / p_sum
-    out[patch_kernels.ORIGIN] = o0
-    out[patch_kernels.ORIGIN + 1] = o1
-    out[patch_kernels.ORIGIN + 2] = o2
-    # the contact frame (patch.contact_axes, the same operations)
-    norm = math.sqrt(s3 * s3 + s4 * s4 + s5 * s5)
-    if not norm > 0.0:
-        out[patch_kernels.STATUS] = patch_kernels.ZERO_NORMAL
-        return p_max
-    z0, z1, z2 = s3 / norm, s4 / norm, s5 / norm
-    exx, exy, exz = 1.0 - z0 * z0, -z0 * z1, -z0 * z2
-    ex_norm = math.sqrt(exx * exx + exy * exy + exz * exz)
-    if not ex_norm > 1e-6:
-        out[patch_kernels.STATUS] = patch_kernels.NORMAL_ALONG_X
-        return p_max
-    x0_, x1_, x2_ = exx / ex_norm, exy / ex_norm, exz / ex_norm
-    y0_, y1_, y2_ = z1 * x2_ - z2 * x1_, z2 * x0_ - z0 * x2_, z0 * x1_ - z1 * x0_
-    out[patch_kernels.E_X] = x0_
-    out[patch_kernels.E_X + 1] = x1_
-    out[patch_kernels.E_X + 2] = x2_
-    out[patch_kernels.E_Y] = y0_
-    out[patch_kernels.E_Y + 1] = y1_
-    out[patch_kernels.E_Y + 2] = y2_
-    out[patch_kernels.E_Z] = z0
-    out[patch_kernels.E_Z + 1] = z1
-    out[patch_kernels.E_Z + 2] = z2
-    if ny < 2 or nx < 2:
-        return p_max
-    span_x = 0.0
-    for j in range(ny):
-        first = j * row
-        last = first + (nx - 1) * step
-        span_x += _along(words, last, c0, c1, c2, o0, o1, o2, x0_, x1_, x2_) - _along(
-            words, first, c0, c1, c2, o0, o1, o2, x0_, x1_, x2_)
-    span_y = 0.0
-    for i in range(nx):
-        first = i * step
-        last = first + (ny - 1) * row
-        span_y += _along(words, last, c0, c1, c2, o0, o1, o2, y0_, y1_, y2_) - _along(
-            words, first, c0, c1, c2, o0, o1, o2, y0_, y1_, y2_)
-    dx = span_x / (ny * (nx - 1))
-    dy = span_y / (nx * (ny - 1))
-    for i in range(nx):
-        offsets[i] = i * dx
-    sx = 0.0
-    sy = 0.0
-    rx_low = ry_low = math.inf
-    rx_high = ry_high = -math.inf
-    for j in range(ny):
-        row_dy = j * dy
-        for i in range(nx):
-            base = j * row + i * step
-            d0 = float(words[base + c0]) - o0
-            d1 = float(words[base + c1]) - o1
-            d2 = float(words[base + c2]) - o2
-            u = d0 * x0_ + d1 * x1_ + d2 * x2_
-            v = d0 * y0_ + d1 * y1_ + d2 * y2_
-            sx += u
-            sy += v
-            ru = u - offsets[i]
-            rv = v - row_dy
-            rx_low = min(rx_low, ru)
-            rx_high = max(rx_high, ru)
-            ry_low = min(ry_low, rv)
-            ry_high = max(ry_high, rv)
-    n = ny * nx
-    gx0 = sx / n - dx * 0.5 * (nx - 1)
-    gy0 = sy / n - dy * 0.5 * (ny - 1)
-    out[patch_kernels.X0] = gx0
-    out[patch_kernels.DX] = dx
-    out[patch_kernels.WORST_X] = max(rx_high - gx0, gx0 - rx_low)
-    out[patch_kernels.Y0] = gy0
-    out[patch_kernels.DY] = dy
-    out[patch_kernels.WORST_Y] = max(ry_high - gy0, gy0 - ry_low)
-    return p_max
-
-
-@njit(cache=True, inline="always")
-def _along(words, base, c0, c1, c2, o0, o1, o2, a0, a1, a2):
-    """Return ``(r - origin) . a`` of the point at word ``base`` (m): ``patch_kernels``' own."""
-    return ((float(words[base + c0]) - o0) * a0 + (float(words[base + c1]) - o1) * a1
-            + (float(words[base + c2]) - o2) * a2)
 
 
 @njit(cache=True)
