@@ -839,7 +839,7 @@ class Pipeline:
         than those of the last sum, i.e. stamped after the last sum's stamp
         (the newest of its wrenches).  After a rejected patch of the contact
         that arrives first, one sum pairs the other contact's wrench of the
-        cycle before, and the next cycle is whole again (a flag per contact
+        previous cycle and the next cycle is whole again (a flag per contact
         would pair them so for good).
         :func:`fastsim_ros.replay.kernels.advance` is the replay's copy of
         this rule.
