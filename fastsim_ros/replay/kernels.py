@@ -143,21 +143,25 @@ def scan_patches(bufs, which, start, data_at, width, ny, nx, row, step, cols, pr
         buf = bufs[which[i]]
         s = start[i] + data_at
         if width == 4:
-            w4 = buf[s:s + nbytes].view(np.float32)
-            if all_finite(w4, words):
-                peak[i] = patch_kernels.adapt(w4, ny, nx, row, step, cols, pressure[i],
-                                              out[i], False)
-            else:
-                patch_kernels.adapt(w4, ny, nx, row, step, cols, pressure[i], out[i])
-                peak[i] = pressure[i].max()
+            peak[i] = _adapt_patch(buf[s:s + nbytes].view(np.float32), words, ny, nx, row,
+                                   step, cols, pressure[i], out[i])
         else:
-            w8 = buf[s:s + nbytes].view(np.float64)
-            if all_finite(w8, words):
-                peak[i] = patch_kernels.adapt(w8, ny, nx, row, step, cols, pressure[i],
-                                              out[i], False)
-            else:
-                patch_kernels.adapt(w8, ny, nx, row, step, cols, pressure[i], out[i])
-                peak[i] = pressure[i].max()
+            peak[i] = _adapt_patch(buf[s:s + nbytes].view(np.float64), words, ny, nx, row,
+                                   step, cols, pressure[i], out[i])
+
+
+@njit(cache=True, inline="always")
+def _adapt_patch(words, n, ny, nx, row, step, cols, pressure, out):
+    """Run the node's adapter loop on one patch's ``n`` words; return its largest pressure (Pa).
+
+    Without the per-point finiteness test where every word is finite
+    (:func:`all_finite`); otherwise the node's loop with it (the status then
+    says why, and the largest pressure is NaN where one is).
+    """
+    if all_finite(words, n):
+        return patch_kernels.adapt(words, ny, nx, row, step, cols, pressure, out, False)
+    patch_kernels.adapt(words, ny, nx, row, step, cols, pressure, out)
+    return pressure.max()
 
 
 @njit(cache=True)
