@@ -20,11 +20,14 @@ status=0
 # pytest runs in the package root (pytest.ini: testpaths = test); its JUnit
 # XML goes to build/fastsim_ros/pytest.xml.  console_direct+ streams its
 # output.  --pytest-args must come last: it takes the rest of the line.
+# Two workers (pytest-xdist), each taking whole test files (a file's fixtures,
+# a contact table or a bag's replay, are built once): the suite is mostly one
+# process at a time waiting on one core, and the machines have two.
 colcon test \
     --build-base build --install-base install \
     --packages-select fastsim_ros \
     --event-handlers console_direct+ console_start_end- status- desktop_notification- \
-    --pytest-args -q || status=$?
+    --pytest-args -q -n 2 --dist loadfile || status=$?
 
 results_rc=0
 results="$(colcon test-result --test-result-base build --verbose 2>&1)" || results_rc=$?

@@ -1,7 +1,8 @@
 """The nodes' console scripts: a signal while start-up imports the node ends it quietly.
 
-The node's module imports rclpy, numpy and numba (about half a second, more
-on a cold disk) before :func:`fastsim_ros.ros.node.main` can put its own signal
+The node's module imports rclpy (a third of a second, more on a cold
+disk; numpy, numba and the kernels load later, once the parameters are
+checked) before :func:`fastsim_ros.ros.node.main` can put its own signal
 handling in place, and a console script imports its target's module before
 calling it: a SIGINT there would print a ``KeyboardInterrupt`` traceback
 from inside an import and a SIGTERM would kill the process (exit -15),

@@ -29,11 +29,10 @@ import sys
 import time
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import yaml
 
-import fastsim_ros.numba_quietly  # noqa: F401  (first: numba without its coverage hook)
 import rclpy
 from rclpy.exceptions import (InvalidParameterTypeException, InvalidParameterValueException,
                               ParameterException, ParameterUninitializedException)
@@ -53,13 +52,11 @@ from rcl_interfaces.msg import (FloatingPointRange, IntegerRange, ParameterDescr
                                 ParameterType, SetParametersResult)
 
 from fastsim_ros.ros import params as parameters
-from fastsim_ros.pipeline import kernels as pipeline_kernels
-from fastsim_ros.contact import compiled
 from fastsim_ros.errors import ParameterError, StartupError
-from msg_adapters import patch as patch_adapter
-from fastsim_ros.pipeline import (DIAGNOSTICS_TOPIC, MARKERS_TOPIC, InputTopic, Outcome,
-                                  PipelineConfig)
-from fastsim_ros.pipeline.profiles import AnyPipeline, ProfilePipeline, make_pipeline
+
+if TYPE_CHECKING:
+    from fastsim_ros.pipeline import InputTopic, Outcome, PipelineConfig
+    from fastsim_ros.pipeline.profiles import AnyPipeline
 
 NODE_NAME = "fastsim"
 _TYPES = {"double": ParameterType.PARAMETER_DOUBLE,
@@ -291,9 +288,18 @@ class _FrontEnd:
             if not self._contacts_given:
                 # the mode's own contacts (profiles: fixed per wheel), not a declared default
                 del values["contacts"]
-            config = PipelineConfig.from_values(values)
+            checked = parameters.checked(values)
         except ParameterError as e:
             raise StartupError(str(e)) from None
+        # the solver's modules (numba and its kernels, about half a second) load once the
+        # parameters are known good: a start refused for them ends without
+        import fastsim_ros.numba_quietly  # noqa: F401  (first: numba without its coverage hook)
+        from fastsim_ros.contact import compiled
+        from fastsim_ros.pipeline import PipelineConfig
+        from fastsim_ros.pipeline import kernels as pipeline_kernels
+        from fastsim_ros.pipeline.profiles import make_pipeline
+        from msg_adapters import patch as patch_adapter
+        config = PipelineConfig(checked)
         warm = compiled.warm_up()
         start = time.perf_counter()
         patch_adapter.warm_up()
@@ -307,6 +313,7 @@ class _FrontEnd:
 
     def _open(self) -> None:
         """Create the publishers, the subscriptions and the diagnostics timer."""
+        from fastsim_ros.pipeline import DIAGNOSTICS_TOPIC, ProfilePipeline
         node: Node = self  # type: ignore[assignment]
         config = self.pipeline.config
         depth = int(config["qos_depth"])
@@ -380,6 +387,7 @@ class _FrontEnd:
         counts DDS matched on the node's side, which a client cannot see
         from its own (a message sent before both sides matched is lost).
         """
+        from fastsim_ros.pipeline import MARKERS_TOPIC
         shared = [(f"publishers/{t}", str(s.get_publisher_count()))
                   for t, s in self._subs.items() if not t.startswith("contact/")]
         shared += [(f"subscribers/{t}", str(p.get_subscription_count()))
@@ -491,6 +499,7 @@ class _FrontEnd:
         hot path); each such topic is logged once.  Topics mode only: in
         profiles mode the node publishes the patches itself.
         """
+        from fastsim_ros.pipeline import ProfilePipeline
         node: Node = self  # type: ignore[assignment]
         if isinstance(self.pipeline, ProfilePipeline):
             return []
@@ -765,21 +774,26 @@ def _run(make: Callable[..., Node], program: str, args: Sequence[str] | None) ->
     # is: inside a callback, rclpy's executor logs it as FATAL with a traceback.  While
     # spinning the shut-down context alone ends the loop, so Python's handler is quiet
     # there; before (a cold kernel compile, a table build) it still interrupts.
-    spinning = [False]
+    spinning, interrupted = [False], [False]
 
     def on_sigint(signum: int, frame: Any) -> None:
         if not spinning[0]:
+            interrupted[0] = True
             raise KeyboardInterrupt
     previous = signal.signal(signal.SIGINT, on_sigint)
     try:
-        return _run_node(make, program, args, spinning)
+        return _run_node(make, program, args, spinning, interrupted)
     finally:
         signal.signal(signal.SIGINT, previous)
 
 
 def _run_node(make: Callable[..., Node], program: str, args: Sequence[str] | None,
-              spinning: list[bool]) -> int:
-    """:func:`_run` with Python's SIGINT handler in place (``spinning``: set while spinning)."""
+              spinning: list[bool], interrupted: list[bool]) -> int:
+    """:func:`_run` with Python's SIGINT handler in place.
+
+    ``spinning``: set while spinning; ``interrupted``: set by a SIGINT
+    before (the handler raised KeyboardInterrupt).
+    """
     try:
         rclpy.init(args=list(args) if args is not None else None)
     except _rclpy.RCLError as e:  # malformed --ros-args: rcl says why
@@ -811,6 +825,11 @@ def _run_node(make: Callable[..., Node], program: str, args: Sequence[str] | Non
                 executor.spin_once(timeout_sec=max(0.0, end - time.monotonic()))
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
+    except ImportError:
+        # the KeyboardInterrupt of a SIGINT while a C extension loads (numba's, imported
+        # once the parameters are checked) surfaces as that extension's ImportError
+        if not interrupted[0]:
+            raise
     except _rclpy.RCLError:
         if rclpy.ok():  # not a signal arriving while the node was being built
             raise
