@@ -160,7 +160,7 @@ class _ContactTopics:
         self.energy, self.damage = base + "energy", base + "damage"
         # the contact's WrenchStamped, (Fx, Fy, N) and (0, 0, Mz): only numbers change
         self.wrench_cdr = stamped_doubles_template(out.contact_frame_id(contact), 6).encode
-        # its Vector3Stamped (the wear topics)
+        # its Vector3Stamped (the creepage and the wear topics)
         self.vector_cdr = stamped_doubles_template(out.contact_frame_id(contact), 3).encode
 
 
@@ -845,21 +845,27 @@ class Pipeline:
         this rule.
         """
         state.wrench = (stamp, force, torque)
-        newest = stamp
-        for s in self._contacts.values():
-            if s.wrench is None or (self._last_sum_ns is not None
-                                    and s.wrench[0] <= self._last_sum_ns):
+        newest, last = stamp, self._last_sum_ns
+        states = self._contacts.values()
+        for s in states:
+            w = s.wrench
+            if w is None or (last is not None and w[0] <= last):
                 return None  # some contact has no wrench newer than the last sum
-            newest = max(newest, s.wrench[0])
+            if w[0] > newest:
+                newest = w[0]
         self._last_sum_ns = newest
-        fs = [0.0, 0.0, 0.0]
-        ts = [0.0, 0.0, 0.0]
-        for s in self._contacts.values():
+        # summed contact by contact, in the contacts' order
+        fx = fy = fz = tx = ty = tz = 0.0
+        for s in states:
             assert s.wrench is not None
-            for k in range(3):
-                fs[k] += s.wrench[1][k]
-                ts[k] += s.wrench[2][k]
-        return WheelsetWrench(newest, (fs[0], fs[1], fs[2]), (ts[0], ts[1], ts[2]))
+            _, (f0, f1, f2), (t0, t1, t2) = s.wrench
+            fx += f0
+            fy += f1
+            fz += f2
+            tx += t0
+            ty += t1
+            tz += t2
+        return WheelsetWrench(newest, (fx, fy, fz), (tx, ty, tz))
 
     def _markers_due(self, state: _ContactState, stamp: int) -> bool:
         if not self._markers:
@@ -905,8 +911,9 @@ class Pipeline:
             if topic in wanted:  # (out.contact_wrench_cdr, from the contact's template)
                 msgs.append((topic, topics.wrench_cdr(stamp, f.fx, f.fy, f.n, 0.0, 0.0, f.mz)))
             topic = topics.creepage
-            if topic in wanted:
-                msgs.append((topic, out.creepage_cdr(stamp, c, outcome.creepage)))
+            if topic in wanted:  # (out.creepage_cdr: the contact's Vector3Stamped)
+                cr = outcome.creepage
+                msgs.append((topic, topics.vector_cdr(stamp, cr.xi, cr.eta, cr.phi)))
             topic = topics.frame
             if outcome.frame_changed and topic in wanted:
                 msgs.append((topic, out.pose_cdr(stamp, frame_id, outcome.frame)))

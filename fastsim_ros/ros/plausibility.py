@@ -198,6 +198,12 @@ def check_patch(extent_x: float, extent_y: float, peak_pressure: float | None, *
               override=override)
 
 
+#: :func:`stream_problem`'s bounds, read once
+_EXTENT_HIGH = PLAUSIBLE["patch_extent"].high
+_PRESSURE_LOW = PLAUSIBLE["peak_pressure"].low
+_CREEPAGE, _SPIN = PLAUSIBLE["creepage"], PLAUSIBLE["spin"]
+
+
 def stream_problem(extent_x: float, extent_y: float, pressure: float, xi: float, eta: float,
                    phi: float, *, override: str = OVERRIDE_PARAMETER) -> str | None:
     """Return why a solved patch of a stream is implausible (one line), or None.
@@ -211,7 +217,11 @@ def stream_problem(extent_x: float, extent_y: float, pressure: float, xi: float,
     lifting) is small and light, and right.  The node and the replay
     reject such a patch as ``implausible`` (no wrench published).
     """
-    high = PLAUSIBLE["patch_extent"].high
+    # a plausible patch (every patch of a sound stream, at kHz rates) cleared at once
+    high, creepage, spin = _EXTENT_HIGH, _CREEPAGE, _SPIN
+    if (extent_x <= high and extent_y <= high and pressure >= _PRESSURE_LOW
+            and creepage.contains(xi) and creepage.contains(eta) and spin.contains(phi)):
+        return None
     for axis, extent in (("x", extent_x), ("y", extent_y)):
         if extent > high:
             return message("patch_extent", extent, what=f"patch extent along {axis}",
