@@ -130,8 +130,13 @@ def rss_mib(pid: int) -> float:
     return float("nan")
 
 
-def profile(calls: int) -> None:
-    """Time the node's per-message path in this process, step by step."""
+def profile(calls: int, evict: int = 0) -> None:
+    """Time the node's per-message path in this process, step by step.
+
+    ``evict``: bytes of other memory read before each patch (what the DDS
+    threads, the driver and the rest of a machine do to the caches between
+    two of a node's callbacks); 0: every patch runs with warm caches.
+    """
     from fastsim_ros.pipeline import Pipeline, PipelineConfig
     from msg_adapters import cdr
     from fastsim_ros.contact import compiled
@@ -143,8 +148,11 @@ def profile(calls: int) -> None:
     pipe.on_wheel_twist(set_stamp(twist, 1))
     steps: dict[str, list[float]] = {"decode (CDR view)": [], "adapt (frame, grid)": [],
                                      "whole on_patch": [], "messages (encode)": []}
+    other = np.ones(max(1, evict // 8))
     for i in range(calls):
         raw = set_stamp(patch, 1 + i)
+        if evict:
+            other.sum()
         t0 = time.perf_counter()
         c = cdr.read_cloud(raw)
         t1 = time.perf_counter()
@@ -157,7 +165,8 @@ def profile(calls: int) -> None:
         for key, dt in zip(steps, (t1 - t0, t2 - t1, t3 - t2, t4 - t3)):
             steps[key].append(dt * 1e6)
     p50, p99 = pipe.solve_time_percentiles("left")
-    print(f"per-message path, {calls} calls (us): median / p99")
+    print(f"per-message path, {calls} calls (us), {evict} bytes read between patches: "
+          "median / p99")
     for key, v in steps.items():
         print(f"  {key:22s} {statistics.median(v):7.1f} / {np.percentile(v, 99):7.1f}")
     # the pipeline's solve times: on its compiled path, the one call (adapter loop + solve)
@@ -253,7 +262,7 @@ def target_command(target: str, names: list[str], executor: str,
     if target == "fair floor":
         return [sys.executable, str(FLOOR), "--fair", "--contacts", *names]
     if target == "floor+solve":
-        return [sys.executable, str(FLOOR), "--solve", "--contacts", *names]
+        return [sys.executable, str(FLOOR), "--fair", "--solve", "--contacts", *names]
     if target == "baseline":  # the node of another checkout's sources (BASELINE)
         # its node module where that checkout has it (fastsim_ros/ros/, or the package's top
         # level in a checkout from before the front ends had their package)
@@ -579,9 +588,11 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
     The targets (4 x 1 kHz): received share within 0.2 points of the
     one-message floor's, p99 at most 2x its and under 1 ms, CPU at most
     1.5x the fair floor's (``dds_floor.py --fair``: the node's messages,
-    pre-serialised).  ``bound``: the floor that also solves a fixed patch
-    per patch (``dds_floor.py --solve``) runs in the rotation too: what the
-    solve alone adds.  ``trace``: the node's runs attribute their tail.
+    pre-serialised).  ``bound``: the fair floor that also solves a fixed
+    patch per patch with the default method (``dds_floor.py --fair
+    --solve``) runs in the rotation too: what the solve alone adds, the
+    least a node that solves each patch and publishes its messages costs.
+    ``trace``: the node's runs attribute their tail.
     """
     targets: tuple[str, ...] = ("node", "floor", "fair floor")
     if bound:
@@ -621,8 +632,9 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
               f"{b['cpu'] / fair['cpu']:.2f}x", flush=True)
     if bound:
         b = med["floor+solve"]
-        print(f"  floor+solve/floor: received {b['received'] - f['received']:+.2f} points, "
-              f"p99 {b['p99'] / f['p99']:.2f}x, CPU {b['cpu'] / f['cpu']:.2f}x", flush=True)
+        print(f"  floor+solve (the fair floor solving each patch)/floor: received "
+              f"{b['received'] - f['received']:+.2f} points, p99 {b['p99'] / f['p99']:.2f}x; "
+              f"/fair floor: CPU {b['cpu'] / fair['cpu']:.2f}x", flush=True)
 
 
 def main() -> None:
@@ -642,9 +654,12 @@ def main() -> None:
                         help="first time start-up to the first wrench, TRIALS times")
     parser.add_argument("--profile", type=int, default=0, metavar="CALLS",
                         help="first time the per-message path in-process")
+    parser.add_argument("--evict", type=int, default=0, metavar="BYTES",
+                        help="with --profile: read BYTES of other memory before each patch "
+                        "(caches as cold as a node's between callbacks)")
     parser.add_argument("--bound", action="store_true",
-                        help="with --floor: the floor that also solves a fixed patch "
-                        "(dds_floor.py --solve) in the rotation too")
+                        help="with --floor: the fair floor that also solves a fixed patch "
+                        "(dds_floor.py --fair --solve) in the rotation too")
     parser.add_argument("--baseline", default=None, metavar="CHECKOUT",
                         help="with --floor: the node of another checkout's sources (a "
                         "worktree of main, say) in the rotation too, as 'baseline'")
@@ -682,7 +697,7 @@ def main() -> None:
     if args.startup:
         startup(args.startup)
     if args.profile:
-        profile(args.profile)
+        profile(args.profile, args.evict)
     for n in args.contacts:
         for executor in args.executors:
             if args.floor:
