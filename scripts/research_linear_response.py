@@ -55,6 +55,7 @@ import argparse
 import math
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -519,27 +520,25 @@ def part_cost(proto: Prototype) -> None:
               f"{1e6 * t_fast:.0f} |", flush=True)
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--part", default="all",
-                        choices=("all", "wheelset", "wider", "ellipses", "curve", "a22", "cost"))
+def run_parts(description: str, parts: dict[str, Callable[[], None]]) -> int:
+    """Run the ``--part`` chosen (``all``: every part, in order); print the run's time."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--part", default="all", choices=("all", *parts))
     args = parser.parse_args()
-    proto = Prototype()
     start = time.perf_counter()
-    if args.part in ("all", "wheelset"):
-        part_wheelset(proto)
-    if args.part in ("all", "wider"):
-        part_wider(proto)
-    if args.part in ("all", "ellipses"):
-        part_ellipses(proto)
-    if args.part in ("all", "curve"):
-        part_curve(proto)
-    if args.part in ("all", "a22"):
-        part_a22()
-    if args.part in ("all", "cost"):
-        part_cost(proto)
+    for name, part in parts.items():
+        if args.part in ("all", name):
+            part()
     print(f"\nThe run took {time.perf_counter() - start:.0f} s.")
     return 0
+
+
+def main() -> int:
+    proto = Prototype()
+    return run_parts(__doc__.splitlines()[0], {
+        "wheelset": lambda: part_wheelset(proto), "wider": lambda: part_wider(proto),
+        "ellipses": lambda: part_ellipses(proto), "curve": lambda: part_curve(proto),
+        "a22": part_a22, "cost": lambda: part_cost(proto)})
 
 
 if __name__ == "__main__":

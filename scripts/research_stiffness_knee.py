@@ -106,10 +106,8 @@ core.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
-import time
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
@@ -429,25 +427,11 @@ def part_spin_knee(proto: rl.Prototype) -> None:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--part", default="all",
-                        choices=("all", "oracle", "wider", "predictor", "ellipse",
-                                 "spin_knee"))
-    args = parser.parse_args()
     proto = rl.Prototype()
-    start = time.perf_counter()
-    if args.part in ("all", "oracle"):
-        part_oracle(proto)
-    if args.part in ("all", "wider"):
-        part_wider(proto)
-    if args.part in ("all", "predictor"):
-        part_predictor(proto)
-    if args.part in ("all", "ellipse"):
-        part_ellipse(proto)
-    if args.part in ("all", "spin_knee"):
-        part_spin_knee(proto)
-    print(f"\nThe run took {time.perf_counter() - start:.0f} s.")
-    return 0
+    return rl.run_parts(__doc__.splitlines()[0], {
+        "oracle": lambda: part_oracle(proto), "wider": lambda: part_wider(proto),
+        "predictor": lambda: part_predictor(proto), "ellipse": lambda: part_ellipse(proto),
+        "spin_knee": lambda: part_spin_knee(proto)})
 
 
 if __name__ == "__main__":
