@@ -300,15 +300,19 @@ class _FrontEnd:
         from fastsim_ros.pipeline.profiles import make_pipeline
         from msg_adapters import patch as patch_adapter
         config = PipelineConfig(checked)
+        try:  # profiles mode reads and places its profiles here (and builds its table)
+            pipeline = make_pipeline(config, log=log)
+        except ParameterError as e:  # a profile file or placement: one line
+            raise StartupError(str(e)) from None
+        # the kernels loaded (compiled, on a cold cache: tens of seconds) after the profiles
+        # are read, so that a missing or unreadable profile is told at once; a table build
+        # loads what it uses as it goes
         warm = compiled.warm_up()
         start = time.perf_counter()
         patch_adapter.warm_up()
         pipeline_kernels.warm_up()
         self._warm = warm + time.perf_counter() - start
-        try:  # profiles mode reads and places its profiles here (and builds its table)
-            self.pipeline = make_pipeline(config, log=log)
-        except ParameterError as e:  # a profile file or placement: one line
-            raise StartupError(str(e)) from None
+        self.pipeline = pipeline
         return config
 
     def _open(self) -> None:
