@@ -263,6 +263,8 @@ def target_command(target: str, names: list[str], executor: str,
         return [sys.executable, str(FLOOR), "--fair", "--contacts", *names]
     if target == "floor+solve":
         return [sys.executable, str(FLOOR), "--fair", "--solve", "--contacts", *names]
+    if target == "floor+compiled":
+        return [sys.executable, str(FLOOR), "--fair", "--compiled", "--contacts", *names]
     if target == "baseline":  # the node of another checkout's sources (BASELINE)
         # its node module where that checkout has it (fastsim_ros/ros/, or the package's top
         # level in a checkout from before the front ends had their package)
@@ -591,12 +593,14 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
     pre-serialised).  ``bound``: the fair floor that also solves a fixed
     patch per patch with the default method (``dds_floor.py --fair
     --solve``) runs in the rotation too: what the solve alone adds, the
-    least a node that solves each patch and publishes its messages costs.
+    least a node that solves each patch and publishes its messages costs;
+    and the fair floor with the node's one compiled call on each received
+    patch (``--fair --compiled``: adapter loop and solve, nothing around it).
     ``trace``: the node's runs attribute their tail.
     """
     targets: tuple[str, ...] = ("node", "floor", "fair floor")
     if bound:
-        targets += ("floor+solve",)
+        targets += ("floor+solve", "floor+compiled")
     if BASELINE != ROOT:
         targets += ("baseline",)
     runs: dict[str, list[dict[str, float]]] = {t: [] for t in targets}
@@ -635,6 +639,11 @@ def against_floor(contacts: int, rate: float, seconds: float, rounds: int, execu
         print(f"  floor+solve (the fair floor solving each patch)/floor: received "
               f"{b['received'] - f['received']:+.2f} points, p99 {b['p99'] / f['p99']:.2f}x; "
               f"/fair floor: CPU {b['cpu'] / fair['cpu']:.2f}x", flush=True)
+        b = med["floor+compiled"]
+        print(f"  floor+compiled (the fair floor with the node's compiled call on each patch)"
+              f"/floor: received {b['received'] - f['received']:+.2f} points, p99 "
+              f"{b['p99'] / f['p99']:.2f}x; /fair floor: CPU {b['cpu'] / fair['cpu']:.2f}x",
+              flush=True)
 
 
 def main() -> None:
@@ -659,7 +668,8 @@ def main() -> None:
                         "(caches as cold as a node's between callbacks)")
     parser.add_argument("--bound", action="store_true",
                         help="with --floor: the fair floor that also solves a fixed patch "
-                        "(dds_floor.py --fair --solve) in the rotation too")
+                        "(dds_floor.py --fair --solve) and the one with the node's compiled "
+                        "call (--fair --compiled) in the rotation too")
     parser.add_argument("--baseline", default=None, metavar="CHECKOUT",
                         help="with --floor: the node of another checkout's sources (a "
                         "worktree of main, say) in the rotation too, as 'baseline'")
@@ -670,6 +680,7 @@ def main() -> None:
                         help="the driver takes the contacts' wrenches alone (not the creepages "
                         "and the wheelset wrench): the node then publishes the wrench alone")
     parser.add_argument("--target", choices=("node", "floor", "fair floor", "floor+solve",
+                                             "floor+compiled",
                                              "baseline"),
                         default="node",
                         help="what the single runs drive: the node or the DDS floor")

@@ -56,7 +56,7 @@ class Floor(Node):
     """Answer ``contact/<name>/patch`` with a fixed ``contact/<name>/wrench``, stamp copied."""
 
     def __init__(self, contacts: Sequence[str], depth: int = 10,
-                 solve: Callable[[], object] | None = None, fair: bool = False) -> None:
+                 solve: Callable[[bytes], object] | None = None, fair: bool = False) -> None:
         super().__init__("fastsim_floor")
         self._solve = solve
         qos_in = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
@@ -97,7 +97,7 @@ class Floor(Node):
 
     @staticmethod
     def _answer(pub, wrench: bytearray,
-                solve: Callable[[], object] | None) -> Callable[[bytes], None]:
+                solve: Callable[[bytes], object] | None) -> Callable[[bytes], None]:
         if solve is None:
             def callback(raw: bytes) -> None:
                 wrench[STAMP] = raw[STAMP]
@@ -105,7 +105,7 @@ class Floor(Node):
             return callback
 
         def solving(raw: bytes) -> None:
-            solve()
+            solve(raw)
             wrench[STAMP] = raw[STAMP]
             pub.publish(bytes(wrench))
         return solving
@@ -113,12 +113,12 @@ class Floor(Node):
     @staticmethod
     def _answer_fair(k: int, pub, wrench: bytearray, creepage_pub, creepage: bytearray,
                      cycle: "_Cycle",
-                     solve: Callable[[], object] | None) -> Callable[[bytes], None]:
+                     solve: Callable[[bytes], object] | None) -> Callable[[bytes], None]:
         newest, total = cycle.newest, cycle.total
 
         def callback(raw: bytes) -> None:
             if solve is not None:
-                solve()
+                solve(raw)
             stamp = raw[STAMP]
             wrench[STAMP] = stamp
             pub.publish(bytes(wrench))
@@ -145,7 +145,7 @@ class _Cycle:
         self.pub = pub
 
 
-def fixed_solve() -> Callable[[], object]:
+def fixed_solve() -> Callable[[bytes], object]:
     """Return a call of the default solve (mae_calibrated) on a fixed 30 x 30-cell patch."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
     from fastsim_ros.contact import compiled, samples
@@ -154,10 +154,64 @@ def fixed_solve() -> Callable[[], object]:
     solver = compiled.CalibratedMaeSolver(0.28, 8.0e10)  # the default method
     pressure = np.ascontiguousarray(area.pressure, dtype=np.float64)
 
-    def solve() -> object:
+    def solve(raw: bytes) -> object:
         return solver.solve_arrays(pressure, area.x0, area.y0, area.dx, area.dy, 1e-3, 0.0,
                                    0.0, 0.3, bound="given", tractions=False, friction=None,
                                    speed=20.0)
+    return solve
+
+
+def compiled_path() -> Callable[[bytes], object]:
+    """Return the node's one compiled call on each received patch, with nothing around it.
+
+    ``fastsim_ros.pipeline.kernels.solve_cloud`` (the adapter's loop over
+    the patch's own points, the creepages, the default method's solve, the
+    wheelset wrench) with the node's constant arguments, on a view of the
+    received CDR's points (the layout read from the first patch): what a
+    node whose whole per-patch path were one compiled call from the bytes
+    would cost, less the encoding (the fair floor's templates) and the
+    kinematics (a fixed rolling twist, creepage 1e-3 at 20 m/s).
+    """
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from fastsim_ros.contact import compiled
+    from fastsim_ros.pipeline import Pipeline, PipelineConfig
+    from fastsim_ros.pipeline import kernels as fast
+    from msg_adapters import cdr
+    from msg_adapters import patch as patch_adapter
+    from msg_adapters import patch_kernels
+    compiled.warm_up()
+    patch_adapter.warm_up()
+    fast.warm_up()
+    # the node's configuration of the compiled call (its defaults)
+    pipe = Pipeline(PipelineConfig.from_values({"contacts": ["c"], "publish_markers": False}))
+    state = pipe._compiled
+    assert state is not None
+    speed, xi, radius = 20.0, 1e-3, 0.46
+    wheel = np.array([speed, 0.0, 0.0, 0.0, speed * (1 - xi / 2) / (1 + xi / 2) / radius, 0.0])
+    rail = np.zeros(6)
+    frame = np.empty(patch_kernels.OUT_SIZE)
+    result = np.empty(fast.RESULT_SIZE)
+    memory = np.zeros(fast.MEMORY_SIZE)  # steady rolling
+    min_speed = float(pipe.config["min_rolling_speed"])
+    layout: list[tuple[int, np.dtype, int, int, int, int, int, np.ndarray, np.ndarray]] = []
+
+    def solve(raw: bytes) -> object:
+        if not layout:  # the topic's layout, read once
+            cloud = cdr.CloudReader().read(raw)
+            words, row, step, cols = patch_adapter._words(cloud)
+            # where the points start in the message (the view's address in the buffer's)
+            start = (np.frombuffer(cloud.data, dtype=np.uint8).ctypes.data
+                     - np.frombuffer(raw, dtype=np.uint8).ctypes.data)
+            layout.append((start, words.dtype, words.size, cloud.height, cloud.width, row,
+                           step, cols, np.empty((cloud.height, cloud.width))))
+        start, dtype, count, ny, nx, row, step, cols, pressure = layout[0]
+        words = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
+        return fast.solve_cloud(
+            words, ny, nx, row, step, cols, pressure, frame, wheel, rail, min_speed, state.rule,
+            state.parabolic, state.shear_modulus, state.knots, state.polys, state.law,
+            state.law_parameters, state.mu, state.slip_dependent, state.calibrated,
+            state.pair_knots, state.pair_values, False, result, memory, *fast.NO_STATE,
+            state.knee)
     return solve
 
 
@@ -171,12 +225,16 @@ def main(argv: Sequence[str] | None = None) -> int:
                         "wheelset wrench per rig cycle (the fair floor)")
     parser.add_argument("--solve", action="store_true",
                         help="also run the node's solve on a fixed patch for every patch")
+    parser.add_argument("--compiled", action="store_true",
+                        help="instead: the node's one compiled call (adapter loop and solve) "
+                        "on each received patch")
     args, ros_args = parser.parse_known_args(argv)
     rclpy.init(args=[sys.argv[0], *ros_args])  # its signal handlers end spin_once
     node = None
     try:
-        node = Floor(args.contacts, args.depth, fixed_solve() if args.solve else None,
-                     fair=args.fair)
+        solve = (compiled_path() if args.compiled else fixed_solve() if args.solve
+                 else None)
+        node = Floor(args.contacts, args.depth, solve, fair=args.fair)
         executor = EventsExecutor()
         executor.add_node(node)
         while rclpy.ok():  # as the node: spin_once, which returns on SIGTERM
