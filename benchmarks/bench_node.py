@@ -10,9 +10,15 @@ published -> wrench received, wall clock of this process) p50/p99/max, the
 node's CPU share (from /proc), and with ``--soak MINUTES`` the node's
 resident memory sampled every 10 s.  ``--profile`` first times the node's
 per-message path in this process (decode + adapt + solve + encode, and an
-rclpy publish) to show where the time goes.
+rclpy publish) to show where the time goes; with ``--evict BYTES`` each
+patch after that much other memory is read (caches as cold as a node's).
+``--floor N`` drives the node and the DDS floors (dds_floor.py) in turn;
+``--bound`` adds the fair floor that also solves a fixed patch and the one
+that runs the node's compiled call on each patch.
 
     .venv/bin/python benchmarks/bench_node.py --contacts 2 4 --seconds 20
+    .venv/bin/python benchmarks/bench_node.py --contacts 4 --seconds 10 --floor 3 --bound
+    .venv/bin/python benchmarks/bench_node.py --profile 3000 --evict 4000000
     .venv/bin/python benchmarks/bench_node.py --contacts 4 --soak 10
     .venv/bin/python benchmarks/bench_node.py --profiles 3 --seconds 10   # profiles mode
 """
