@@ -217,21 +217,23 @@ def stream_problem(extent_x: float, extent_y: float, pressure: float, xi: float,
     lifting) is small and light, and right.  The node and the replay
     reject such a patch as ``implausible`` (no wrench published).
     """
-    # a plausible patch (every patch of a sound stream, at kHz rates) cleared at once
-    high, creepage, spin = _EXTENT_HIGH, _CREEPAGE, _SPIN
-    if (extent_x <= high and extent_y <= high and pressure >= _PRESSURE_LOW
-            and creepage.contains(xi) and creepage.contains(eta) and spin.contains(phi)):
-        return None
-    for axis, extent in (("x", extent_x), ("y", extent_y)):
-        if extent > high:
-            return message("patch_extent", extent, what=f"patch extent along {axis}",
-                           override=override)
-    if pressure < PLAUSIBLE["peak_pressure"].low:
+    # each test once, its message built only where it fails (a sound stream at kHz rates
+    # passes them all)
+    high = _EXTENT_HIGH
+    if extent_x > high:
+        return message("patch_extent", extent_x, what="patch extent along x",
+                       override=override)
+    if extent_y > high:
+        return message("patch_extent", extent_y, what="patch extent along y",
+                       override=override)
+    if pressure < _PRESSURE_LOW:
         return message("peak_pressure", pressure, what="largest pressure", override=override)
-    for name, quantity, value in (("xi", "creepage", xi), ("eta", "creepage", eta),
-                                  ("phi", "spin", phi)):
-        if not PLAUSIBLE[quantity].contains(value):
-            return message(quantity, value, what=name, override=override)
+    if not _CREEPAGE.contains(xi):
+        return message("creepage", xi, what="xi", override=override)
+    if not _CREEPAGE.contains(eta):
+        return message("creepage", eta, what="eta", override=override)
+    if not _SPIN.contains(phi):
+        return message("spin", phi, what="phi", override=override)
     return None
 
 
