@@ -22,7 +22,6 @@ from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 
 from msg_adapters.cdr import Template, Writer, stamped_doubles
-from msg_adapters.kinematics import Creepage
 from msg_adapters.patch import ContactFrame
 
 #: traction cloud layout: x y z tau_x tau_y as float32, slip as uint8, the frictional power
@@ -57,12 +56,6 @@ def contact_wrench_cdr(stamp_ns: int, contact: str, fx: float, fy: float, n: flo
                        mz: float) -> bytes:
     """Return a contact's ``WrenchStamped``: ``force = (Fx, Fy, N)``, ``torque.z = Mz``."""
     return wrench_cdr(stamp_ns, contact_frame_id(contact), (fx, fy, n), (0.0, 0.0, mz))
-
-
-def creepage_cdr(stamp_ns: int, contact: str, creepage: Creepage) -> bytes:
-    """Return a serialized ``geometry_msgs/Vector3Stamped`` ``(xi, eta, phi)``."""
-    return stamped_doubles(stamp_ns, contact_frame_id(contact),
-                           (creepage.xi, creepage.eta, creepage.phi))
 
 
 def pose_cdr(stamp_ns: int, wheelset_frame: str, frame: ContactFrame) -> bytes:

@@ -911,7 +911,7 @@ class Pipeline:
             if topic in wanted:  # (out.contact_wrench_cdr, from the contact's template)
                 msgs.append((topic, topics.wrench_cdr(stamp, f.fx, f.fy, f.n, 0.0, 0.0, f.mz)))
             topic = topics.creepage
-            if topic in wanted:  # (out.creepage_cdr: the contact's Vector3Stamped)
+            if topic in wanted:  # (xi, eta, phi) in the contact's Vector3Stamped
                 cr = outcome.creepage
                 msgs.append((topic, topics.vector_cdr(stamp, cr.xi, cr.eta, cr.phi)))
             topic = topics.frame
