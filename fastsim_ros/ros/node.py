@@ -480,13 +480,13 @@ class _FrontEnd:
             self._raise_unless_shut_down()
 
     def _raise_unless_shut_down(self) -> None:
-        """Re-raise a publish's error, unless a signal shut the context down under it.
+        """Re-raise an rcl call's error, unless a signal shut the context down under it.
 
         SIGINT or SIGTERM shuts the context down from the signal handler, between
-        two statements of a callback: the callback's next publish then fails
-        ("publisher's context is invalid") and rclpy's executor would log the
-        error with its traceback as FATAL before ``main`` ends the spin.  That
-        publish is the shutdown's, not a fault: the message is dropped, as it
+        two statements of a callback: the callback's next publish or peer count
+        then fails ("publisher's context is invalid") and rclpy's executor would
+        log the error with its traceback as FATAL before ``main`` ends the spin.
+        That error is the shutdown's, not a fault: the message is dropped, as it
         would have been a moment later.
         """
         node: Node = self  # type: ignore[assignment]
@@ -541,11 +541,11 @@ class _FrontEnd:
         if not self._active or self._diagnostics is None:
             return
         node: Node = self  # type: ignore[assignment]
-        extra = self.connections()
-        unheard = self.unheard_values()
-        for c in self.pipeline.config.contacts:
-            extra[c] = extra.get(c, []) + unheard
-        try:
+        try:  # the peer counts and the graph are rcl calls too: a signal may end them
+            extra = self.connections()
+            unheard = self.unheard_values()
+            for c in self.pipeline.config.contacts:
+                extra[c] = extra.get(c, []) + unheard
             # CDR written directly: the message's ~80 Python objects cost more than the rest
             self._diagnostics.publish(self.pipeline.diagnostics_cdr(
                 node.get_clock().now().nanoseconds, extra))
