@@ -41,7 +41,7 @@ def _numba_cache_dir() -> str:
 #: is here).  A ``NUMBA_CACHE_DIR`` the user set is kept as it is: there numba's
 #: per-file time stamps are the only key, and a kernel changed in one file and
 #: compiled into another's can load stale (clear that directory after editing)
-_KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/knee.py",
+_KERNEL_SOURCES = ("contact/kernels.py", "contact/rules.py", "contact/knee.py", "contact/lobes.py",
                    "contact/slip_power.py",
                    "contact/transient.py",
                    "pipeline/kernels.py", "replay/kernels.py",

@@ -37,7 +37,7 @@ import math
 import numpy as np
 from numba import njit
 
-from fastsim_ros.contact import knee, rules
+from fastsim_ros.contact import knee, lobes, rules
 
 #: order of the coefficients in the ``polys`` array
 TABLE_NAMES = ("C11", "C22", "C23", "C33", "c11", "c12", "c13", "c21", "c22", "c23")
@@ -2005,11 +2005,81 @@ def mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic, shea
     return OK, 0.0, geo, env, flex, bound
 
 
+strip_loads = njit(cache=True, error_model="numpy")(lobes.strip_loads)
+gap_split = njit(cache=True, error_model="numpy")(lobes.gap_split)
+
+
+@njit(cache=True, error_model="numpy")
+def patch_gap(p, calibrated):
+    """Return ``(m, w)`` of :func:`fastsim_ros.contact.lobes.gap_split` on ``p`` (calibrated)."""
+    if not calibrated:
+        return 0, 1.0
+    q = np.empty(p.shape[0])
+    strip_loads(p, q)
+    return gap_split(q)
+
+
 @njit(cache=True, error_model="numpy")
 def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
               shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store,
               calibrated, pair_knots, pair_values, knee=NO_KNEE):
-    """Solve MAE + FastSim on one patch (:func:`fastsim_ros.contact.mae.mae_fastsim`).
+    """Solve MAE + FastSim on one patch: :func:`mae_solve_whole`, or its regions apart.
+
+    The calibrated method splits a patch of separate contact regions across
+    its widest gap of empty strips and blends the two parts' forces with the
+    whole patch's (:mod:`fastsim_ros.contact.lobes`; the tractions alike); a
+    patch without a gap, and the paper's MAE, are solved whole.  Where a
+    part cannot be solved (a region outside the tables) the whole patch is.
+    Arguments and return as :func:`mae_solve_whole`.
+    """
+    m, w = patch_gap(p, calibrated)
+    if w < 1.0:
+        ny, nx = p.shape
+        keep = store and w > 0.0
+        tx = np.empty((ny, nx) if keep else (0, 0))
+        ty = np.empty((ny, nx) if keep else (0, 0))
+        ts = np.empty((ny, nx) if keep else (0, 0), dtype=np.bool_)
+        a = mae_solve_whole(p[:m], x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                            shear_modulus, knots, polys, law, prm, speed, out_x[:m], out_y[:m],
+                            slip[:m], store, calibrated, pair_knots, pair_values, knee)
+        b = mae_solve_whole(p[m:], x0, y0 + m * dy, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                            parabolic, shear_modulus, knots, polys, law, prm, speed, out_x[m:],
+                            out_y[m:], slip[m:], store, calibrated, pair_knots, pair_values,
+                            knee)
+        if a[0] == OK and b[0] == OK:
+            fx, fy, mz = a[2] + b[2], a[3] + b[3], a[4] + b[4]
+            n, nslip = a[5] + b[5], a[6] + b[6]
+            if w > 0.0:
+                c = mae_solve_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                    parabolic, shear_modulus, knots, polys, law, prm, speed,
+                                    tx, ty, ts, keep, calibrated, pair_knots, pair_values,
+                                    knee)
+                if c[0] != OK:
+                    return c
+                fx = w * c[2] + (1.0 - w) * fx
+                fy = w * c[3] + (1.0 - w) * fy
+                mz = w * c[4] + (1.0 - w) * mz
+                n = c[5]
+                if w >= 0.5:
+                    nslip = c[6]
+                if keep:
+                    for j in range(ny):
+                        for i in range(nx):
+                            out_x[j, i] = w * tx[j, i] + (1.0 - w) * out_x[j, i]
+                            out_y[j, i] = w * ty[j, i] + (1.0 - w) * out_y[j, i]
+                            if w >= 0.5:
+                                slip[j, i] = ts[j, i]
+            return OK, 0.0, fx, fy, mz, n, nslip, a[7] + b[7]
+    return mae_solve_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                           shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
+                           store, calibrated, pair_knots, pair_values, knee)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_solve_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                    shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store,
+                    calibrated, pair_knots, pair_values, knee=NO_KNEE):
+    """Solve MAE + FastSim on one patch, whole (:func:`fastsim_ros.contact.mae.mae_fastsim`).
 
     ``p`` (Pa) on the grid ``x0, y0, dx, dy`` (m); creepages ``xi``, ``eta``
     (1), ``phi`` (1/m) about ``(xp, yp)`` (m); ``parabolic``: the
@@ -2037,6 +2107,47 @@ def mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabo
                        shear_modulus, knots, polys, law, prm, speed, calibrated, pair_knots,
                        pair_values, knee=NO_KNEE):
     """:func:`mae_solve` (no tractions) and the forces' derivatives in ``mu_s``, one march.
+
+    A patch of separate regions as :func:`mae_solve` splits it (the
+    derivatives blended alike); else :func:`mae_solve_mu_slope_whole`.
+    """
+    m, w = patch_gap(p, calibrated)
+    if w < 1.0:
+        a = mae_solve_mu_slope_whole(p[:m], x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                     parabolic, shear_modulus, knots, polys, law, prm, speed,
+                                     calibrated, pair_knots, pair_values, knee)
+        b = mae_solve_mu_slope_whole(p[m:], x0, y0 + m * dy, dx, dy, xi, eta, phi, mu, xp, yp,
+                                     rule, parabolic, shear_modulus, knots, polys, law, prm,
+                                     speed, calibrated, pair_knots, pair_values, knee)
+        if a[0] == OK and b[0] == OK:
+            fx, fy, mz = a[2] + b[2], a[3] + b[3], a[4] + b[4]
+            n, nslip = a[5] + b[5], a[6] + b[6]
+            dfx, dfy = a[8] + b[8], a[9] + b[9]
+            if w > 0.0:
+                c = mae_solve_mu_slope_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                             parabolic, shear_modulus, knots, polys, law, prm,
+                                             speed, calibrated, pair_knots, pair_values, knee)
+                if c[0] != OK:
+                    return c
+                fx = w * c[2] + (1.0 - w) * fx
+                fy = w * c[3] + (1.0 - w) * fy
+                mz = w * c[4] + (1.0 - w) * mz
+                dfx = w * c[8] + (1.0 - w) * dfx
+                dfy = w * c[9] + (1.0 - w) * dfy
+                n = c[5]
+                if w >= 0.5:
+                    nslip = c[6]
+            return OK, 0.0, fx, fy, mz, n, nslip, a[7] + b[7], dfx, dfy
+    return mae_solve_mu_slope_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                    parabolic, shear_modulus, knots, polys, law, prm, speed,
+                                    calibrated, pair_knots, pair_values, knee)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_solve_mu_slope_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                             shear_modulus, knots, polys, law, prm, speed, calibrated,
+                             pair_knots, pair_values, knee=NO_KNEE):
+    """:func:`mae_solve_whole` (no tractions) and the forces' derivatives in ``mu_s``, one march.
 
     Return ``(status, info, Fx, Fy, Mz, N, slipping cells, cells in
     contact, dFx/dmu_s, dFy/dmu_s)``: the first eight :func:`mae_solve`'s
@@ -2135,6 +2246,7 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
     empty_f = np.empty((0, 0))
     empty_b = np.empty((0, 0), dtype=np.bool_)
     prev_pb = -1
+    whole = 1.0
     for b in range(nb):
         pb = b if ps.shape[0] > 1 else 0
         xi, eta, phi = creep[b, 0], creep[b, 1], creep[b, 2]
@@ -2143,6 +2255,19 @@ def mae_batch(ps, x0, y0, dx, dy, creep, mu, xp, yp, rule, parabolic, shear_modu
             return status, b, 0.0
         p = ps[pb]
         same = _same_patch(b, pb, prev_pb, x0, y0, dx, dy)
+        if not same:
+            _, whole = patch_gap(p, calibrated)
+        if whole < 1.0:  # separate regions: mae_solve splits the patch (no setup to reuse)
+            r = mae_solve(p, x0[b], y0[b], dx[b], dy[b], xi, eta, phi, mu[b], xp, yp, rule,
+                          parabolic, shear_modulus, knots, polys, law, prm, speed[b], empty_f,
+                          empty_f, empty_b, False, calibrated, pair_knots, pair_values, knee)
+            if r[0] != OK:
+                return r[0], b, r[1]
+            out[b, 0] = r[2]
+            out[b, 1] = r[3]
+            out[b, 2] = r[4]
+            prev_pb = -1  # the next item sets its patch up afresh
+            continue
         if not same:
             status, info = mae_flexibility(p, x0[b], y0[b], dx[b], dy[b], rule, shear_modulus,
                                            knots, polys, geo, env, strips, calibrated,

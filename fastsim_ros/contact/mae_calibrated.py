@@ -55,7 +55,7 @@ couplings ``c12``, ``c21`` are left out, as in the paper.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -67,12 +67,14 @@ from fastsim_ros.contact.equivalent import equivalent_ellipse, reduce_slope
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.knee import KneeFactors, interpolate
+from fastsim_ros.contact.lobes import gap_split, strip_loads
 from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone,
                                      ZoneFlexibility, ZonePair, blended_flexibility,
                                      row_extents, split_geometries,
                                      strip_flexibility, sweep_point, zone_flexibility)
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
 from fastsim_ros.contact.rules import chord_bend_offset
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.tables import CoefficientTable
 from fastsim_ros.contact.traction import Tractions, resultants
 
@@ -275,6 +277,63 @@ def mae_calibrated_fastsim(area: GridArea, xi: float, eta: float, phi: float, *,
                            shear_modulus=shear_modulus)
         xi, eta, phi, friction, speed = red.xi, red.eta, red.phi, red.friction, None
         bound = bound * red.mu_ratio
+    q = np.empty(area.ny)
+    strip_loads(area.pressure, q)
+    m, w = gap_split(q)
+    if w < 1.0:  # separate contact regions (fastsim_ros.contact.lobes)
+        try:
+            parts = [_whole(GridArea(area.x0, area.y0 + lo * area.dy, area.dx, area.dy,
+                                     area.pressure[lo:hi]), xi, eta, phi,
+                            bound=bound[lo:hi], table=table, pairs=pairs,
+                            shear_modulus=shear_modulus, reference=reference, rule=rule,
+                            friction=friction, speed=speed, share=share, without=without,
+                            knee=knee)
+                     for lo, hi in ((0, m), (m, area.ny))]
+        except InvalidInputError:  # a region the tables do not hold: the patch whole
+            parts = []
+        if parts:
+            return _blend(area, parts, w, xi, eta, phi, bound=bound, table=table, pairs=pairs,
+                          shear_modulus=shear_modulus, reference=reference, rule=rule,
+                          friction=friction, speed=speed, share=share, without=without,
+                          knee=knee)
+    return _whole(area, xi, eta, phi, bound=bound, table=table, pairs=pairs,
+                  shear_modulus=shear_modulus, reference=reference, rule=rule,
+                  friction=friction, speed=speed, share=share, without=without, knee=knee)
+
+
+def _blend(area: GridArea, parts: list[MaeResult], w: float, xi: float, eta: float,
+           phi: float, **options: Any) -> MaeResult:
+    """Return the regions' solves ``parts`` (stacked along ``y``) blended with the whole's.
+
+    ``w``: the whole patch's weight (:func:`fastsim_ros.contact.lobes.gap_split`).
+    """
+    tau_x = np.concatenate([r.traction.tau_x for r in parts])
+    tau_y = np.concatenate([r.traction.tau_y for r in parts])
+    slip = np.concatenate([r.traction.slip for r in parts])
+    fx, fy, mz = (sum(r.fx for r in parts), sum(r.fy for r in parts),
+                  sum(r.mz for r in parts))
+    first = parts[0]
+    if w > 0.0:
+        whole = _whole(area, xi, eta, phi, **options)
+        t = whole.traction
+        fx = w * whole.fx + (1.0 - w) * fx
+        fy = w * whole.fy + (1.0 - w) * fy
+        mz = w * whole.mz + (1.0 - w) * mz
+        tau_x = w * t.tau_x + (1.0 - w) * tau_x
+        tau_y = w * t.tau_y + (1.0 - w) * tau_y
+        if w >= 0.5:
+            slip = t.slip
+            first = whole
+    return MaeResult(fx, fy, mz, Tractions(tau_x, tau_y, slip, fx, fy, mz), first.geometry,
+                     first.flexibility)
+
+
+def _whole(area: GridArea, xi: float, eta: float, phi: float, *,
+           bound: FloatArray, table: CoefficientTable, pairs: PairFactors,
+           shear_modulus: float, reference: tuple[float, float], rule: SplitRule,
+           friction: FrictionLaw | None, speed: float | None, share: PairShare,
+           without: tuple[str, ...], knee: KneeFactors | None) -> MaeResult:
+    """:func:`mae_calibrated_fastsim` on the patch whole (its slope reduction applied)."""
     geometries = split_geometries(area, rule)
     zone_pairs = [calibrated_flexibilities(area, g, table, pairs, shear_modulus, share=share,
                                            without=without) for g, _ in geometries]

@@ -96,6 +96,31 @@ def two_lobes(*, cells: int, scale: float = 1.0, load: float | None = None) -> G
     return _finish(x, y, dx, dy, p, scale, load)
 
 
+def two_regions(gap: float, *, cell: float = 2.5e-4, load: float = 2.0e4) -> GridArea:
+    """Make two Hertzian ellipses side by side across ``y``, their edges ``gap`` (m) apart.
+
+    A tread region (``a = 3 mm``, ``b = 2.5 mm``) and a smaller flange-root
+    region (``a = 2 mm``, ``b = 1.25 mm``), as a wheel's two-point contact
+    gives on one grid of square cells ``cell`` (m); ``gap`` >= 0 (0: the
+    regions touch), the first region's centre on a strip, the second's
+    wherever the gap puts it (its edge strips carry what the ellipse gives
+    them: a gap closing in small steps fills a strip gradually); Hertz-like
+    pressure per region in proportion to its size, ``load`` (N) in all.
+    """
+    if not gap >= 0.0:
+        raise InvalidInputError(f"gap must be at least 0 m, got {gap}")
+    (a1, b1), (a2, b2) = (3e-3, 2.5e-3), (2e-3, 1.25e-3)
+    nx = 2 * math.ceil(a1 / cell) + 2
+    centre2 = b1 + gap + b2
+    below = math.ceil(b1 / cell) + 1
+    ny = below + math.ceil((centre2 + b2) / cell) + 2
+    x = cell * (np.arange(nx) - (nx - 1) / 2.0)
+    y = cell * (np.arange(ny) - below)
+    xx, yy = x[None, :], y[:, None]
+    p = np.maximum(a1 * _hertz_like(xx, yy, a1, b1), a2 * _hertz_like(xx, yy - centre2, a2, b2))
+    return GridArea(float(x[0]), float(y[0]), cell, cell, p).with_load(load)
+
+
 def asymmetric_lobes(*, cells: int, scale: float = 1.0, load: float | None = None,
                      size: float = 0.6, lead: float = 0.3, overlap: float = 0.2,
                      a_over_b: tuple[float, float] = (1.0, 1.0)) -> GridArea:

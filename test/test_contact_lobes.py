@@ -1,0 +1,159 @@
+"""Separate contact regions on one grid: the split, its blend, the forces against exact."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from fastsim_ros.contact import exact, kernels, lobes, samples
+from fastsim_ros.contact.area import GridArea
+from fastsim_ros.contact.compiled import CalibratedMaeSolver, warm_up
+from fastsim_ros.contact.errors import InvalidInputError
+from fastsim_ros.contact.fastsim import traction_bound
+from fastsim_ros.contact.knee import knee_factors
+from fastsim_ros.contact.mae_calibrated import mae_calibrated_fastsim
+from fastsim_ros.contact.pairs import pair_factors
+from fastsim_ros.contact.tables import coefficient_table
+
+NU, G, MU, LOAD = 0.28, 8e10, 0.3, 2.0e4
+
+
+@pytest.fixture(scope="module")
+def solver():
+    warm_up()
+    return CalibratedMaeSolver(NU, G)
+
+
+def split(area: GridArea) -> tuple[int, float]:
+    q = np.empty(area.ny)
+    lobes.strip_loads(np.ascontiguousarray(area.pressure), q)
+    return lobes.gap_split(q)
+
+
+def parts(area: GridArea, m: int) -> list[GridArea]:
+    return [GridArea(area.x0, area.y0 + lo * area.dy, area.dx, area.dy,
+                     np.ascontiguousarray(area.pressure[lo:hi]))
+            for lo, hi in ((0, m), (m, area.ny))]
+
+
+def whole_patch(solver: CalibratedMaeSolver, area: GridArea,
+                creep: tuple[float, float, float]) -> tuple[float, float]:
+    """Return the calibrated MAE's ``(Fx, Fy)`` (N) on the patch whole, not split."""
+    r = kernels.mae_solve_whole(
+        np.ascontiguousarray(area.pressure), area.x0, area.y0, area.dx, area.dy, *creep, MU,
+        0.0, 0.0, solver._rule, False, G, solver._knots, solver._polys, kernels.LAW_CONSTANT,
+        np.zeros(2), 0.0, np.empty((0, 0)), np.empty((0, 0)), np.empty((0, 0), dtype=np.bool_),
+        False, True, solver._pair_knots, solver._pair_values, solver._knee)
+    assert r[0] == kernels.OK
+    return r[2], r[3]
+
+
+def error(f, e) -> float:
+    """Return the larger of the Fx and Fy errors, % of mu N."""
+    return 100.0 * max(abs(f.fx - e.fx), abs(f.fy - e.fy)) / (MU * LOAD)
+
+
+# ---------------------------------------------------------------- the rule
+
+
+@pytest.mark.parametrize("q, expected", [
+    ([0.0, 1.0, 2.0, 1.0, 0.0], (0, 1.0)),          # one region
+    ([1.0, 0.2, 3.0, 0.1, 2.0], (0, 1.0)),          # necks, no gap: whole
+    ([0.0, 0.0, 1.0, 0.0], (0, 1.0)),               # one strip
+])
+def test_a_patch_without_a_gap_is_whole(q, expected):
+    assert lobes.gap_split(np.array(q)) == expected
+
+
+def test_regions_a_narrower_width_apart_are_half_whole():
+    # two equal regions of 3 strips (loads 1, 2, 1) with an empty gap between: each side's
+    # half-width sqrt(5 (1/2 + 1/12)) strips, its centre mid-side
+    b = math.sqrt(5.0 * (0.5 + 1.0 / 12.0))
+    for gap in (1, 4, 9):
+        q = np.array([0.0, 1.0, 2.0, 1.0] + [0.0] * gap + [1.0, 2.0, 1.0, 0.0])
+        m, w = lobes.gap_split(q)
+        t = min(max(((gap + 3) - 2.0 * b) / (2.0 * b) / lobes.GAP_APART, 0.0), 1.0)
+        assert m == 4
+        assert w == pytest.approx(1.0 - t * t * (3.0 - 2.0 * t), rel=1e-12)
+
+
+def test_the_whole_weight_falls_as_the_gap_opens():
+    weights = [split(samples.two_regions(gap))[1] for gap in np.arange(0.0, 6e-3, 1e-4)]
+    assert weights[0] > 0.999 and weights[-1] == 0.0  # touching: one empty strip, no gap
+    # from whole to apart without a step of more than a tenth as the gap opens by 0.1 mm
+    # (0.4 cell; the sides' moments move with their edge strips, not monotonically)
+    assert max(abs(a - b) for a, b in zip(weights, weights[1:])) < 0.1
+
+
+def test_two_regions_needs_a_gap():
+    with pytest.raises(InvalidInputError, match="gap must be at least 0"):
+        samples.two_regions(-1e-4)
+
+
+# ---------------------------------------------------------------- the paths agree
+
+
+@pytest.mark.parametrize("gap", [1e-3, 3e-3])
+@pytest.mark.parametrize("creep", [(2e-4, 1e-4, 0.0), (-1e-3, 5e-4, 2.0)])
+def test_compiled_equals_reference_on_two_regions(solver, gap, creep):
+    area = samples.two_regions(gap)
+    ref = mae_calibrated_fastsim(area, *creep, bound=traction_bound(area, MU),
+                                 table=coefficient_table(NU), pairs=pair_factors(NU),
+                                 shear_modulus=G, knee=knee_factors(NU))
+    mine = solver.solve(area, *creep, mu=MU, tractions=True)
+    scale = MU * LOAD
+    assert mine.fx == pytest.approx(ref.fx, abs=1e-9 * scale)
+    assert mine.fy == pytest.approx(ref.fy, abs=1e-9 * scale)
+    top = abs(ref.traction.tau_x).max() + abs(ref.traction.tau_y).max()
+    np.testing.assert_allclose(mine.tau_x, ref.traction.tau_x, atol=1e-9 * top)
+    np.testing.assert_allclose(mine.tau_y, ref.traction.tau_y, atol=1e-9 * top)
+    # the tractions sum to the forces, the estimator's slope and a batch give the same forces
+    assert mine.tau_x.sum() * area.dx * area.dy == pytest.approx(mine.fx, rel=1e-12)
+    batch = solver.solve_batch(area.pressure, area.x0, area.y0, area.dx, area.dy,
+                               np.array([creep, (0.0, 0.0, 0.0), creep]), mu=MU)
+    assert tuple(batch[2]) == (mine.fx, mine.fy, mine.mz)
+
+
+def test_regions_far_apart_are_solved_as_two_patches(solver):
+    area = samples.two_regions(5e-3)
+    m, w = split(area)
+    assert w == 0.0
+    creep = (1e-3, -5e-4, 0.3)
+    both = solver.solve(area, *creep, mu=MU)
+    apart = [solver.solve(p, *creep, mu=MU) for p in parts(area, m)]
+    assert both.fx == sum(f.fx for f in apart)
+    assert both.fy == sum(f.fy for f in apart)
+    assert both.n == pytest.approx(LOAD, rel=1e-12)
+
+
+# ---------------------------------------------------------------- physics
+
+
+@pytest.mark.parametrize("creep", [(2e-4, 0.0, 0.0), (1e-3, 0.0, 0.0), (0.0, 1e-3, 0.0)])
+def test_regions_apart_meet_the_exact_theory(solver, creep):
+    """Two regions 5 mm apart: the regions' forces within 1% of mu N, 1.5-7% closer than whole."""
+    area = samples.two_regions(5e-3)
+    e = exact.coulomb(area, *creep, mu=MU, nu=NU, shear_modulus=G)
+    assert error(solver.solve(area, *creep, mu=MU), e) < 1.0
+    # the same method on the patch whole (the semi-ellipses across both regions) is far off
+    fx, fy = whole_patch(solver, area, creep)
+    whole = 100.0 * max(abs(fx - e.fx), abs(fy - e.fy)) / (MU * LOAD)
+    assert whole > error(solver.solve(area, *creep, mu=MU), e) + 1.4
+
+
+@pytest.mark.xfail(strict=True, reason="across the blend the forces step up to 0.9% of mu N "
+                   "beyond the exact ones (the whole patch's MAE alone: 0.6%) on this grid")
+def test_a_closing_gap_moves_the_forces_no_more_than_the_exact_ones(solver):
+    """The gap closed in steps of 0.1 mm: each step within the exact step + 0.5% of mu N."""
+    creep = (5e-4, 2e-4, 0.5)
+    rows = []
+    for gap in np.arange(5e-3, -5e-5, -1e-4):
+        area = samples.two_regions(gap)
+        f = solver.solve(area, *creep, mu=MU)
+        e = exact.coulomb(area, *creep, mu=MU, nu=NU, shear_modulus=G)
+        rows.append((np.array([f.fx, f.fy]), np.array([e.fx, e.fy])))
+    for (f0, e0), (f1, e1) in zip(rows, rows[1:]):
+        beyond = np.abs((f1 - f0) - (e1 - e0)).max()
+        assert 100.0 * beyond / (MU * LOAD) < 0.5
