@@ -101,14 +101,15 @@ def two_regions(gap: float, *, cell: float = 2.5e-4, load: float = 2.0e4) -> Gri
 
     A tread region (``a = 3 mm``, ``b = 2.5 mm``) and a smaller flange-root
     region (``a = 2 mm``, ``b = 1.25 mm``), as a wheel's two-point contact
-    gives on one grid of square cells ``cell`` (m); ``gap`` >= 0 (0: the
-    regions touch), the first region's centre on a strip, the second's
+    gives on one grid of square cells ``cell`` (m); ``gap`` (m; 0: the
+    regions touch, down to -1 mm: they overlap and merge into one patch
+    with a waist), the first region's centre on a strip, the second's
     wherever the gap puts it (its edge strips carry what the ellipse gives
     them: a gap closing in small steps fills a strip gradually); Hertz-like
     pressure per region in proportion to its size, ``load`` (N) in all.
     """
-    if not gap >= 0.0:
-        raise InvalidInputError(f"gap must be at least 0 m, got {gap}")
+    if not gap >= -1e-3:
+        raise InvalidInputError(f"gap must be at least -1 mm, got {gap}")
     (a1, b1), (a2, b2) = (3e-3, 2.5e-3), (2e-3, 1.25e-3)
     nx = 2 * math.ceil(a1 / cell) + 2
     centre2 = b1 + gap + b2
