@@ -165,3 +165,22 @@ def test_a_closing_gap_moves_the_forces_no_more_than_the_exact_ones(solver, wind
     for (f0, e0), (f1, e1) in zip(rows, rows[1:]):
         beyond = np.abs((f1 - f0) - (e1 - e0)).max()
         assert 100.0 * beyond / (MU * LOAD) < 0.5
+
+
+@pytest.mark.parametrize("gap", [1e-3, 5e-3])
+def test_the_dissipation_follows_the_split(solver, gap):
+    """Regions apart dissipate what they dissipate as patches of their own; blended, in between."""
+    area = samples.two_regions(gap)
+    m, w = split(area)
+    creep = (1e-3, -5e-4, 1.0)
+    both = solver.solve(area, *creep, mu=MU, tractions=True)
+    assert both.dissipation == pytest.approx(
+        both.dissipation_density.sum() * area.dx * area.dy, rel=1e-12)
+    apart = sum(solver.solve(p, *creep, mu=MU, tractions=True).dissipation
+                for p in parts(area, m))
+    if w == 0.0:
+        assert both.dissipation == pytest.approx(apart, rel=1e-12)
+    else:
+        assert 0.0 < w < 1.0 and both.dissipation != pytest.approx(apart, rel=1e-6)
+    # the frictional power is positive and at most mu N times the largest rigid slip
+    assert 0.0 < both.dissipation < MU * LOAD * (abs(creep[0]) + abs(creep[1]) + 5e-3)

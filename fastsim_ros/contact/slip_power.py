@@ -113,8 +113,46 @@ def mae_dissipation(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic
     """:func:`march_dissipation` of a solve of :func:`fastsim_ros.contact.kernels.mae_solve`.
 
     The arguments as that solve's (its tractions ``tau_x``, ``tau_y``,
-    ``slip``); returns ``(status, dissipation per metre rolled (N))``.
+    ``slip``); returns ``(status, dissipation per metre rolled (N))``.  A
+    patch the solve splits into its regions (:mod:`fastsim_ros.contact.lobes`)
+    is marched region by region with each region's flexibilities, blended
+    with the whole patch's march by the solve's weight.
     """
+    m, w = k.patch_gap(p, calibrated)
+    if w < 1.0:
+        ny, nx = p.shape
+        a = mae_dissipation_whole(p[:m], x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                  parabolic, shear_modulus, knots, polys, calibrated,
+                                  pair_knots, pair_values, tau_x[:m], tau_y[:m], slip[:m],
+                                  density[:m])
+        b = mae_dissipation_whole(p[m:], x0, y0 + m * dy, dx, dy, xi, eta, phi, mu, xp, yp,
+                                  rule, parabolic, shear_modulus, knots, polys, calibrated,
+                                  pair_knots, pair_values, tau_x[m:], tau_y[m:], slip[m:],
+                                  density[m:])
+        if a[0] == k.OK and b[0] == k.OK:
+            total = a[1] + b[1]
+            if w > 0.0:
+                apart = density.copy()
+                c = mae_dissipation_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                          parabolic, shear_modulus, knots, polys, calibrated,
+                                          pair_knots, pair_values, tau_x, tau_y, slip, density)
+                if c[0] != k.OK:
+                    return c
+                for j in range(ny):
+                    for i in range(nx):
+                        density[j, i] = w * density[j, i] + (1.0 - w) * apart[j, i]
+                total = w * c[1] + (1.0 - w) * total
+            return k.OK, total
+    return mae_dissipation_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                                 shear_modulus, knots, polys, calibrated, pair_knots,
+                                 pair_values, tau_x, tau_y, slip, density)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_dissipation_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                          shear_modulus, knots, polys, calibrated, pair_knots, pair_values,
+                          tau_x, tau_y, slip, density):
+    """:func:`mae_dissipation` on the patch whole (:func:`~fastsim_ros.contact.kernels.mae_setup`)."""
     status, _, geo, _, flex, _ = k.mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp,
                                              rule, parabolic, shear_modulus, knots, polys,
                                              calibrated, pair_knots, pair_values)
