@@ -152,7 +152,7 @@ def mae_dissipation(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic
 def mae_dissipation_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                           shear_modulus, knots, polys, calibrated, pair_knots, pair_values,
                           tau_x, tau_y, slip, density):
-    """:func:`mae_dissipation` on the patch whole (:func:`~fastsim_ros.contact.kernels.mae_setup`)."""
+    """:func:`mae_dissipation` on the patch whole (:func:`~.kernels.mae_setup`)."""
     status, _, geo, _, flex, _ = k.mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp,
                                              rule, parabolic, shear_modulus, knots, polys,
                                              calibrated, pair_knots, pair_values)
