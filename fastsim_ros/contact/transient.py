@@ -472,7 +472,108 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
                       calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo, nu,
                       with_far_field, f_old_x, f_old_y, slope, knee=k.NO_KNEE,
                       kappa_out=k.NO_KNEE):
-    """One time step of MAE + FastSim, rolling ``rolled`` (m) from the state ``prev_x, prev_y``.
+    """One time step of MAE + FastSim: :func:`mae_rolling_solve_whole`, or its regions apart.
+
+    A patch of separate contact regions is split as the steady solve splits
+    it (:func:`fastsim_ros.contact.kernels.mae_solve`,
+    :mod:`fastsim_ros.contact.lobes`), each region rolled from its own rows of
+    the state, with its own far field from its own previous force (its rows
+    of the state summed; the far field's Jacobian is guessed afresh, and
+    ``slope`` is left NaN), and blended with the whole patch's step by the
+    same weight: the forces, the new state and the strips' factors alike
+    (in the blend the published tractions, the state times the factors, then
+    sum to the forces to a few parts in 1e5).  So the steady state of a
+    patch of separate regions is the steady solve's (in the blend, with the
+    far field, within 0.2% of ``mu N``: the far field acts on the blended
+    state, whose fixed point is not quite the blend of the two steady
+    ones).  ``geo`` holds the whole patch's measures (area, centroid,
+    equivalent ellipse) either way.  Where a region cannot be solved the
+    whole patch is.  Arguments and return as :func:`mae_rolling_solve_whole`.
+    """
+    m, w = k.patch_gap(p, calibrated)
+    if w < 1.0:
+        ny, nx = p.shape
+        da = dx * dy
+        keep = w > 0.0
+        tx = np.empty((ny, nx) if keep else (0, 0))
+        ty = np.empty((ny, nx) if keep else (0, 0))
+        ts = np.empty((ny, nx) if keep else (0, 0), dtype=np.bool_)
+        tk = np.ones(kappa_out.shape[0] if keep else 0)
+        parts = np.zeros((2, 8))
+        status = k.OK
+        for z in range(2):
+            lo = 0 if z == 0 else m
+            hi = m if z == 0 else ny
+            fo_x = 0.0
+            fo_y = 0.0
+            for j in range(lo, hi):
+                for i in range(nx):
+                    fo_x += prev_x[j, i]
+                    fo_y += prev_y[j, i]
+            band_slope = np.full(4, math.nan)
+            band_geo = np.empty(k.GEO_SIZE)
+            r = mae_rolling_solve_whole(
+                p[lo:hi], x0, y0 + lo * dy, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                shear_modulus, knots, polys, law, prm, speed, out_x[lo:hi], out_y[lo:hi],
+                slip[lo:hi], calibrated, pair_knots, pair_values, prev_x[lo:hi], prev_y[lo:hi],
+                rolled, band_geo, nu, with_far_field, fo_x * da, fo_y * da, band_slope, knee,
+                kappa_out[lo:hi])
+            if r[0] != k.OK:
+                status = r[0]
+                break
+            parts[z, 0], parts[z, 1], parts[z, 2], parts[z, 3] = r[2], r[3], r[4], r[5]
+            parts[z, 4], parts[z, 5], parts[z, 6], parts[z, 7] = r[6], r[7], r[8], r[9]
+        if status == k.OK:
+            fx, fy, mz = parts[0, 0] + parts[1, 0], parts[0, 1] + parts[1, 1], \
+                parts[0, 2] + parts[1, 2]
+            n = parts[0, 3] + parts[1, 3]
+            nslip = int(parts[0, 4] + parts[1, 4])
+            ncontact = int(parts[0, 5] + parts[1, 5])
+            own_x, own_y = parts[0, 6] + parts[1, 6], parts[0, 7] + parts[1, 7]
+            if keep:
+                c = mae_rolling_solve_whole(
+                    p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                    shear_modulus, knots, polys, law, prm, speed, tx, ty, ts, calibrated,
+                    pair_knots, pair_values, prev_x, prev_y, rolled, geo, nu, with_far_field,
+                    f_old_x, f_old_y, slope, knee, tk)
+                if c[0] != k.OK:
+                    return c
+                fx = w * c[2] + (1.0 - w) * fx
+                fy = w * c[3] + (1.0 - w) * fy
+                mz = w * c[4] + (1.0 - w) * mz
+                n = c[5]
+                own_x = w * c[8] + (1.0 - w) * own_x
+                own_y = w * c[9] + (1.0 - w) * own_y
+                if w >= 0.5:
+                    nslip = c[6]
+                for j in range(ny):
+                    for i in range(nx):
+                        out_x[j, i] = w * tx[j, i] + (1.0 - w) * out_x[j, i]
+                        out_y[j, i] = w * ty[j, i] + (1.0 - w) * out_y[j, i]
+                        if w >= 0.5:
+                            slip[j, i] = ts[j, i]
+                    if kappa_out.shape[0] == ny:
+                        kappa_out[j] = w * tk[j] + (1.0 - w) * kappa_out[j]
+            else:
+                env = np.empty((2, nx), dtype=np.int64)
+                strips = np.empty((3, ny), dtype=np.int64)
+                k.mae_scan(p, x0, y0, dx, dy, geo, env, strips)
+            slope[:] = math.nan
+            return k.OK, 0.0, fx, fy, mz, n, nslip, ncontact, own_x, own_y
+    return mae_rolling_solve_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule,
+                                   parabolic, shear_modulus, knots, polys, law, prm, speed,
+                                   out_x, out_y, slip, calibrated, pair_knots, pair_values,
+                                   prev_x, prev_y, rolled, geo, nu, with_far_field, f_old_x,
+                                   f_old_y, slope, knee, kappa_out)
+
+
+@njit(cache=True, error_model="numpy")
+def mae_rolling_solve_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
+                            shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
+                            calibrated, pair_knots, pair_values, prev_x, prev_y, rolled, geo,
+                            nu, with_far_field, f_old_x, f_old_y, slope, knee=k.NO_KNEE,
+                            kappa_out=k.NO_KNEE):
+    """One time step of MAE + FastSim on the patch whole, rolling ``rolled`` (m) from the state.
 
     As :func:`fastsim_ros.contact.kernels.mae_solve` (same arguments and
     return, then FastSim's own ``Fx``, ``Fy``: the state's force, which
