@@ -2019,6 +2019,28 @@ def patch_gap(p, calibrated):
     return gap_split(q)
 
 
+@njit(cache=True, error_model="numpy", inline="always")
+def blended_forces(w, whole, fx, fy, mz):
+    """Return ``(Fx, Fy, Mz)``: ``w`` of the whole patch's (``whole[2:5]``), ``1 - w`` of these."""
+    return (w * whole[2] + (1.0 - w) * fx, w * whole[3] + (1.0 - w) * fy,
+            w * whole[4] + (1.0 - w) * mz)
+
+
+@njit(cache=True, error_model="numpy")
+def blend_tractions(w, tx, ty, ts, out_x, out_y, slip):
+    """Set the regions' tractions ``out_x``, ``out_y`` (Pa) to ``w`` of the whole's ``tx``, ``ty``.
+
+    ``1 - w`` of their own; the slip flags ``slip`` are the whole's
+    ``ts`` where ``w >= 1/2`` (:func:`mae_solve`).
+    """
+    for j in range(out_x.shape[0]):
+        for i in range(out_x.shape[1]):
+            out_x[j, i] = w * tx[j, i] + (1.0 - w) * out_x[j, i]
+            out_y[j, i] = w * ty[j, i] + (1.0 - w) * out_y[j, i]
+            if w >= 0.5:
+                slip[j, i] = ts[j, i]
+
+
 @njit(cache=True, error_model="numpy")
 def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
               shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip, store,
@@ -2056,19 +2078,12 @@ def mae_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                                     knee)
                 if c[0] != OK:
                     return c
-                fx = w * c[2] + (1.0 - w) * fx
-                fy = w * c[3] + (1.0 - w) * fy
-                mz = w * c[4] + (1.0 - w) * mz
+                fx, fy, mz = blended_forces(w, c, fx, fy, mz)
                 n = c[5]
                 if w >= 0.5:
                     nslip = c[6]
                 if keep:
-                    for j in range(ny):
-                        for i in range(nx):
-                            out_x[j, i] = w * tx[j, i] + (1.0 - w) * out_x[j, i]
-                            out_y[j, i] = w * ty[j, i] + (1.0 - w) * out_y[j, i]
-                            if w >= 0.5:
-                                slip[j, i] = ts[j, i]
+                    blend_tractions(w, tx, ty, ts, out_x, out_y, slip)
             return OK, 0.0, fx, fy, mz, n, nslip, a[7] + b[7]
     return mae_solve_whole(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic,
                            shear_modulus, knots, polys, law, prm, speed, out_x, out_y, slip,
@@ -2129,9 +2144,7 @@ def mae_solve_mu_slope(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabo
                                              speed, calibrated, pair_knots, pair_values, knee)
                 if c[0] != OK:
                     return c
-                fx = w * c[2] + (1.0 - w) * fx
-                fy = w * c[3] + (1.0 - w) * fy
-                mz = w * c[4] + (1.0 - w) * mz
+                fx, fy, mz = blended_forces(w, c, fx, fy, mz)
                 dfx = w * c[8] + (1.0 - w) * dfx
                 dfy = w * c[9] + (1.0 - w) * dfy
                 n = c[5]

@@ -31,8 +31,9 @@ Assumptions stated: one split (a third region stays with its side); the
 regions do not load each other (the half-space's coupling across the gap is
 left out); ``GAP_APART`` is a choice, not a fit (the take-over's regions,
 tens of strips apart, are beyond it; closing the gap of ``samples.two_regions``
-in 2 um steps, the forces move within 0.3% of ``mu N`` of the exact ones).  Plain arithmetic on arrays: the
-kernels compile it as it is (one formula for both paths).
+in 2 um steps, the forces move within 0.3% of ``mu N`` of the exact ones).
+Plain arithmetic on arrays: the kernels compile it as it is (one formula for
+both paths).
 """
 
 from __future__ import annotations

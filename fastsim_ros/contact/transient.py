@@ -538,21 +538,15 @@ def mae_rolling_solve(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabol
                     f_old_x, f_old_y, slope, knee, tk)
                 if c[0] != k.OK:
                     return c
-                fx = w * c[2] + (1.0 - w) * fx
-                fy = w * c[3] + (1.0 - w) * fy
-                mz = w * c[4] + (1.0 - w) * mz
+                fx, fy, mz = k.blended_forces(w, c, fx, fy, mz)
                 n = c[5]
                 own_x = w * c[8] + (1.0 - w) * own_x
                 own_y = w * c[9] + (1.0 - w) * own_y
                 if w >= 0.5:
                     nslip = c[6]
-                for j in range(ny):
-                    for i in range(nx):
-                        out_x[j, i] = w * tx[j, i] + (1.0 - w) * out_x[j, i]
-                        out_y[j, i] = w * ty[j, i] + (1.0 - w) * out_y[j, i]
-                        if w >= 0.5:
-                            slip[j, i] = ts[j, i]
-                    if kappa_out.shape[0] == ny:
+                k.blend_tractions(w, tx, ty, ts, out_x, out_y, slip)
+                if kappa_out.shape[0] == ny:
+                    for j in range(ny):
                         kappa_out[j] = w * tk[j] + (1.0 - w) * kappa_out[j]
             else:
                 env = np.empty((2, nx), dtype=np.int64)
