@@ -389,3 +389,28 @@ def test_forces_method_polach(capsys):
     rc, _, err = run(capsys, *EUROSPRINTER_FORCES, "--xi", "1e-3", "--mu", "0.36",
                      "--method", "polach", "--slope-k0", "0.5")
     assert rc == 2 and "--polach-ka" in err
+
+
+def test_forces_say_where_separate_regions_were_solved_apart(tmp_path, capsys):
+    """A patch of two regions 5 mm apart: solved apart, and the JSON says across which line."""
+    from fastsim_ros.contact import samples
+    from fastsim_ros.contact.compiled import CalibratedMaeSolver
+    ar = samples.two_regions(5e-3)
+    path = write_patch(tmp_path / "two.csv", ar)
+    argv = ["forces", "--patch", str(path), "--xi", "1e-3", "--eta", "0", "--phi", "0",
+            "--mu", "0.3", "--json"]
+    rc, out, err = run(capsys, *argv)
+    assert rc == 0 and err == ""
+    got = json.loads(out)
+    regions = got["regions"]
+    assert regions["whole_weight"] == 0.0
+    # the line lies in the gap: above the tread region's last strip, below the flange root's
+    rows = np.nonzero(ar.pressure.sum(axis=1) > 0.0)[0]
+    gap = rows[np.nonzero(np.diff(rows) > 1)[0][0]]
+    assert ar.y[gap] < regions["apart_at_y"] < ar.y[gap + 1]
+    apart = CalibratedMaeSolver(0.28, 8e10).solve(ar, 1e-3, 0.0, 0.0, mu=0.3)
+    assert got["Fx"] == pytest.approx(apart.fx, rel=1e-9)
+    one = write_patch(tmp_path / "one.csv", areas.ellipse(6e-3, 4e-3, nx=20, load=2e4))
+    rc, out, _ = run(capsys, "forces", "--patch", str(one), "--xi", "1e-3", "--eta", "0",
+                     "--phi", "0", "--mu", "0.3", "--json")
+    assert rc == 0 and json.loads(out)["regions"] is None

@@ -311,6 +311,15 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
                       # an empty zone (a one-sided split) has no semi-ellipse: null axes
                       zones=[{"area": z.area, "a": _or_none(z.a_eq), "b": _or_none(z.b_eq)}
                              for z in (g.zone1, g.zone2)])
+        if args.method == "mae_calibrated":
+            # separate contact regions (fastsim_ros.contact.lobes): where the patch was split
+            # and the whole patch's weight; the split and zones above are the whole patch's
+            from fastsim_ros.contact import lobes
+            loads = np.empty(patch.ny)
+            lobes.strip_loads(np.ascontiguousarray(patch.pressure), loads)
+            m, w = lobes.gap_split(loads)
+            result.update(regions={"apart_at_y": float(patch.y0 + (m - 0.5) * patch.dy),
+                                   "whole_weight": float(w)} if w < 1.0 else None)
     elif args.method in ("dlm", "asm"):
         from fastsim_ros.contact.asm import asm_fastsim
         from fastsim_ros.contact.dlm import dlm_fastsim
@@ -468,6 +477,7 @@ def print_coefficients(result: dict[str, Any]) -> None:
 
 #: units of the ``forces`` result's numbers in the readable table (the rest: none)
 FORCE_UNITS = {"N": "N", "Fx": "N", "Fy": "N", "Mz": "N m", "split_y": "m", "speed": "m/s",
+               "apart_at_y": "m",
                "friction_decay": "s/m", "area": "m^2", "a": "m", "b": "m", "x_c": "m",
                "y_c": "m", "T_gamma": "N", "T_gamma_per_area": "Pa",
                "wear_rate": "kg/(m m^2)", "frictional_dissipation": "J/m",
