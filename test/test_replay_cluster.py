@@ -301,3 +301,15 @@ def test_an_overwrite_on_a_cluster_shows_the_estimate_and_survives_a_killed_work
     assert comparable(out / "adhesion_rig") == comparable(tmp_path / "local" / "adhesion_rig")
     assert _estimate_lines(stdout) == _estimate_lines(local.stdout) != []
     assert "retried: 2 attempts" in stdout
+
+
+def test_a_scheduler_file_is_read_only_once_it_holds_the_address(tmp_path):
+    """The scheduler writes its file in place: empty or half-written, it gives no address yet."""
+    from fastsim_ros.replay.cluster import _scheduler_address
+    file = tmp_path / "scheduler.json"
+    assert _scheduler_address(file) is None
+    for partial in ("", '{"type": "Scheduler", "add', '{"type": "Scheduler"}'):
+        file.write_text(partial)
+        assert _scheduler_address(file) is None
+    file.write_text('{"type": "Scheduler", "address": "tcp://127.0.0.1:40123"}')
+    assert _scheduler_address(file) == "tcp://127.0.0.1:40123"

@@ -195,6 +195,15 @@ class Cluster:
             pass
 
 
+def _scheduler_address(file: Path) -> str | None:
+    """Return the address a Dask scheduler file gives, or None while it is missing or partial."""
+    try:
+        address = json.loads(file.read_text())["address"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    return address if isinstance(address, str) and address else None
+
+
 class LocalProcesses:
     """A Dask scheduler and ``workers`` worker processes on this machine (tests, benchmarks).
 
@@ -219,11 +228,15 @@ class LocalProcesses:
                                           "127.0.0.1", "--port", "0", "--no-dashboard",
                                           "--scheduler-file", str(file)))
             deadline = time.monotonic() + timeout
-            while not file.exists():
+            # the scheduler writes its file in place, not atomically: it can be seen empty or
+            # half-written, so it is read until it holds the address
+            address = _scheduler_address(file)
+            while address is None:
                 if time.monotonic() > deadline or self.procs[0].poll() is not None:
                     raise ClusterError("the local Dask scheduler did not start")
                 time.sleep(0.05)
-            self.address: str = json.loads(file.read_text())["address"]
+                address = _scheduler_address(file)
+            self.address: str = address
             for k in range(workers):
                 self.workers.append(self._start(
                     "distributed.cli.dask_worker", self.address, "--nthreads", "1",
