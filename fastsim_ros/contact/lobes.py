@@ -9,10 +9,10 @@ takes each region for half an ellipse cut at that line, and its linear
 response is far off (measured on S1002/UIC60 at the take-over, -4.95 mm:
 ``dFx/dxi`` 20% low, the spin's ``dFx/dphi`` of the wrong sign, Fy 4.2% of
 ``mu N`` off the exact theory).  Each region is a patch of its own: solved
-apart, the regions' forces are the exact theory's within 0.4% of ``mu N``
-there, and the exact theory on the regions apart is within 0.2% of the
-exact theory on the whole grid (the half-space couples regions 8 mm apart
-only weakly).  Regions that touch are coupled strongly: solved apart, two
+apart, the regions' forces are the exact theory's within 0.8% of ``mu N``
+through the take-over, and the exact theory on the regions apart is within
+0.2% of the exact theory on the whole grid (the half-space couples regions
+8 mm apart only weakly).  Regions that touch are coupled strongly: solved apart, two
 lobes joined by a thin neck came out up to 0.9% of ``mu N`` further from the
 exact theory than whole, so a neck is not a gap.
 
