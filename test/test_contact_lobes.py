@@ -68,6 +68,23 @@ def test_a_patch_without_a_gap_is_whole(q, expected):
     assert lobes.gap_split(np.array(q)) == expected
 
 
+def test_the_quick_gap_test_agrees_with_the_split():
+    """has_inner_gap (the solves' first question) says split exactly where gap_split splits."""
+    rng = np.random.default_rng(3)
+    patches = [samples.two_regions(g).pressure for g in (-4e-4, 0.0, 1e-4, 3e-3)]
+    for _ in range(200):
+        p = np.where(rng.random((9, 5)) < 0.3, rng.random((9, 5)), 0.0)
+        p[rng.random(9) < 0.3] = 0.0  # whole empty strips, anywhere
+        patches.append(p)
+    for p in patches:
+        q = np.empty(p.shape[0])
+        lobes.strip_loads(p, q)
+        split_there = lobes.gap_split(q) != (0, 1.0)
+        assert lobes.has_inner_gap(p) == split_there
+        assert kernels.patch_gap(np.ascontiguousarray(p), True) == lobes.gap_split(q)
+    assert kernels.patch_gap(np.ascontiguousarray(patches[-1]), False) == (0, 1.0)
+
+
 def test_regions_a_narrower_width_apart_are_half_whole():
     # two equal regions of 3 strips (loads 1, 2, 1) with an empty gap between: each side's
     # half-width sqrt(5 (1/2 + 1/12)) strips, its centre mid-side

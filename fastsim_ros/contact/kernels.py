@@ -2007,12 +2007,17 @@ def mae_setup(p, x0, y0, dx, dy, xi, eta, phi, mu, xp, yp, rule, parabolic, shea
 
 strip_loads = njit(cache=True, error_model="numpy")(lobes.strip_loads)
 gap_split = njit(cache=True, error_model="numpy")(lobes.gap_split)
+has_inner_gap = njit(cache=True, error_model="numpy")(lobes.has_inner_gap)
 
 
 @njit(cache=True, error_model="numpy")
 def patch_gap(p, calibrated):
-    """Return ``(m, w)`` of :func:`fastsim_ros.contact.lobes.gap_split` on ``p`` (calibrated)."""
-    if not calibrated:
+    """Return ``(m, w)`` of :func:`fastsim_ros.contact.lobes.gap_split` on ``p`` (calibrated).
+
+    Every solve asks: a patch without a gap is answered ``(0, 1)`` before its
+    strips' loads are summed.
+    """
+    if not calibrated or not has_inner_gap(p):
         return 0, 1.0
     q = np.empty(p.shape[0])
     strip_loads(p, q)

@@ -59,6 +59,31 @@ def strip_loads(p: NDArray[np.float64], out: NDArray[np.float64]) -> None:
         out[j] = s
 
 
+def has_inner_gap(p: NDArray[np.float64]) -> bool:
+    """Return whether a strip without contact (no ``p > 0``, Pa) lies between strips with it.
+
+    :func:`gap_split`'s condition for a split, found from each strip's first
+    cell in contact without summing the patch: the common patch, one region,
+    is told apart at a fraction of :func:`strip_loads`' cost.
+    """
+    ny, nx = p.shape
+    seen = False
+    empty_since = False
+    for j in range(ny):
+        contact = False
+        for i in range(nx):
+            if p[j, i] > 0.0:
+                contact = True
+                break
+        if contact:
+            if empty_since:
+                return True
+            seen = True
+        elif seen:
+            empty_since = True
+    return False
+
+
 def gap_split(q: NDArray[np.float64]) -> tuple[int, float]:
     """Return ``(m, w)``: the first empty strip of the widest gap, the whole patch's weight.
 
