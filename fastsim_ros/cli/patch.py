@@ -312,12 +312,10 @@ def forces(args: argparse.Namespace) -> dict[str, Any]:
                       zones=[{"area": z.area, "a": _or_none(z.a_eq), "b": _or_none(z.b_eq)}
                              for z in (g.zone1, g.zone2)])
         if args.method == "mae_calibrated":
-            # separate contact regions (fastsim_ros.contact.lobes): where the patch was split
-            # and the whole patch's weight; the split and zones above are the whole patch's
-            from fastsim_ros.contact import lobes
-            loads = np.empty(patch.ny)
-            lobes.strip_loads(np.ascontiguousarray(patch.pressure), loads)
-            m, w = lobes.gap_split(loads)
+            # separate contact regions (fastsim_ros.contact.lobes): where the solve split the
+            # patch and the whole patch's weight; the split and zones above are the whole patch's
+            from fastsim_ros.contact.kernels import patch_gap
+            m, w = patch_gap(np.ascontiguousarray(patch.pressure, dtype=np.float64), True)
             result.update(regions={"apart_at_y": float(patch.y0 + (m - 0.5) * patch.dy),
                                    "whole_weight": float(w)} if w < 1.0 else None)
     elif args.method in ("dlm", "asm"):

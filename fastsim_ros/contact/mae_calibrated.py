@@ -64,6 +64,7 @@ from fastsim_ros.contact.area import GridArea
 from fastsim_ros.contact.checks import SplitRule
 from fastsim_ros.contact.coefficients import CreepCoefficients, coefficients_of_solver
 from fastsim_ros.contact.equivalent import equivalent_ellipse, reduce_slope
+from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.fastsim import StripFlexibility, fastsim, sweep_integrals
 from fastsim_ros.contact.friction import FrictionLaw
 from fastsim_ros.contact.knee import KneeFactors, interpolate
@@ -74,7 +75,6 @@ from fastsim_ros.contact.mae import (DEFAULT_SPLIT, MaeGeometry, MaeResult, Zone
                                      strip_flexibility, sweep_point, zone_flexibility)
 from fastsim_ros.contact.pairs import PAIR_NAMES, PairFactors
 from fastsim_ros.contact.rules import chord_bend_offset
-from fastsim_ros.contact.errors import InvalidInputError
 from fastsim_ros.contact.tables import CoefficientTable
 from fastsim_ros.contact.traction import Tractions, resultants
 
