@@ -64,10 +64,17 @@ left patch at ``xi`` 4e-4 FastSim's own error (without the knee factors)
 grows with the exact strips' stiffness from 5.0 to 6.2% of mu N, and the
 strip knee factors, tabulated on ellipses with FastSim's strips, take out
 about the same 3.6 points as before: the knee belongs to the strips'
-stiffness it was tabulated with.
+stiffness it was tabulated with.  The tread's worst case, ``xi`` 1e-3 with
+spin 0.5 on the right patch (4.6%, all in ``Fy``), is the spin's lateral
+force shared over the strips: with each strip's ``L3`` set so that it
+carries the exact strip's lateral force under spin in full adhesion (an
+oracle), it is 2.2%, and with ``pole`` too every spin case of the tread is
+within 2.5%; the exact strips' lateral force under spin is 0.58 to 1.87
+times the default's over the right patch's strips of 2.6-6.2 mm chord.
 
 Usage: ``python scripts/research_spin_pole.py
-[--part all|ratio|ellipses|wheelset|a22|coupling|strips]``.  About 2 minutes.
+[--part all|ratio|ellipses|wheelset|a22|coupling|strips|spin_strips]``.
+About 2 minutes.
 """
 
 from __future__ import annotations
@@ -417,11 +424,92 @@ def part_strips() -> None:
           + " |")
 
 
+@contextmanager
+def exact_spin_strips(area: GridArea, shear_modulus: float, *, pole: bool) -> Iterator[None]:
+    """Solve with each strip's ``L3`` from the exact strips' lateral force under spin.
+
+    In full adhesion FastSim's strip ``j`` carries, under unit spin about
+    the reference, ``Fy_j = -(x_c/L2_j) D_j - S3_j/L3_j`` (spin about ``S``
+    plus the lateral creepage ``phi x_c`` it adds there; ``D_j``, ``S3_j``
+    the strip's sweep integrals); ``L3_j`` is set so that this is the exact
+    strip's (where that gives a positive ``L3_j``; elsewhere the zone's).
+    ``pole``: also ``Ls = L1 / r_s``.  An oracle: it costs the exact
+    linear solve of the patch.
+    """
+    by_phi = exact.full_adhesion(area, 0.0, 0.0, 1e-5, nu=NU, shear_modulus=shear_modulus)
+    fy = by_phi.tau_y.sum(axis=1) * area.cell_area / 1e-5
+
+    def flexibility(part: GridArea, geometry: MaeGeometry, zones: ZonePair) -> StripFlexibility:
+        flex = _DEFAULT_FLEXIBILITY(part, geometry, zones)
+        if part.ny != area.ny:  # a region of a split patch: left as the default has it
+            return flex
+        d, s3 = sweep_integrals(part, geometry.x_c)
+        dj = (d * part.mask).sum(axis=1) * part.cell_area
+        s3j = (s3 * part.mask).sum(axis=1) * part.cell_area
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = (-fy - geometry.x_c * dj / flex.l2) / s3j
+            l3 = np.where(np.isfinite(inv) & (inv > 0) & part.mask.any(axis=1), 1.0 / inv,
+                          flex.l3)
+        spin = flex.spin
+        if pole:
+            lower = part.y < geometry.y_s
+            ratio = np.ones(part.ny)
+            for zone, rows in ((geometry.zone1, lower), (geometry.zone2, ~lower)):
+                if not zone.empty:
+                    ratio[rows] = r_s(zone.a_over_b)
+            spin = flex.l1 / ratio
+        return StripFlexibility(flex.l1, flex.l2, l3, spin)
+
+    mc.strip_flexibility = flexibility
+    try:
+        with np.errstate(divide="ignore"):  # strips out of contact: 1/L summed to 0
+            yield
+    finally:
+        mc.strip_flexibility = _DEFAULT_FLEXIBILITY
+
+
+def part_spin_strips() -> None:
+    """Print the tread's spin cases with the exact strips' lateral force under spin."""
+    print("\n## The exact strips' lateral force under spin (L3_j, an oracle): error, % of mu N"
+          " (Fx, Fy)\n")
+    names = ("default", "exact strips' L3", "and pole")
+    print("| case | " + " | ".join(names) + " |")
+    print("| --- | " + " | ".join("---" for _ in names) + " |")
+    shares = []
+    for wheel in ("right", "left"):
+        area, _, n = va.patches(-0.476e-3, va.axle_spin(None))[wheel]
+        for creep in ((0.0, 0.0, 0.5), (1e-3, 0.0, 0.5), (0.0, 1e-3, 0.5), (1e-3, 0.0, 2.0)):
+            ex = exact.coulomb(area, *creep, mu=MU, nu=NU, shear_modulus=G)
+            cells = []
+            for pole in (None, False, True):
+                if pole is None:
+                    fx, fy = solve(area, creep, G)
+                else:
+                    with exact_spin_strips(area, G, pole=pole):
+                        fx, fy = solve(area, creep, G)
+                cells.append(f"{100 * (fx - ex.fx) / (MU * n):+.2f}, "
+                             f"{100 * (fy - ex.fy) / (MU * n):+.2f}")
+            print(f"| {wheel}, {creep} | " + " | ".join(cells) + " |", flush=True)
+        by_phi = exact.full_adhesion(area, 0.0, 0.0, 1e-5, nu=NU, shear_modulus=G)
+        lin = mc.mae_calibrated_fastsim(area, 0.0, 0.0, 1e-5,
+                                        bound=np.where(area.mask, np.inf, 0.0), table=TABLE,
+                                        pairs=PAIRS, shear_modulus=G)
+        chord = area.mask.sum(axis=1) * area.dx
+        inner = chord > 2.5e-3  # strips away from the patch's thin ends
+        share = by_phi.tau_y.sum(axis=1)[inner] / lin.traction.tau_y.sum(axis=1)[inner]
+        shares.append(f"{wheel} patch: the exact strips' lateral force under unit spin over "
+                      f"the default's, strips of chord {1e3 * chord[inner].min():.1f}-"
+                      f"{1e3 * chord[inner].max():.1f} mm: {share.min():.2f} to "
+                      f"{share.max():.2f}")
+    print("\n" + "\n".join(shares))
+
+
 def main() -> int:
     """Run the ``--part`` chosen (``all``: every part, in order); print the run's time."""
     parts: dict[str, Callable[[], None]] = {
         "ratio": part_ratio, "ellipses": part_ellipses, "wheelset": part_wheelset,
-        "a22": part_a22, "coupling": part_coupling, "strips": part_strips}
+        "a22": part_a22, "coupling": part_coupling, "strips": part_strips,
+        "spin_strips": part_spin_strips}
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--part", default="all", choices=("all", *parts))
     args = parser.parse_args()
