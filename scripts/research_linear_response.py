@@ -402,7 +402,7 @@ def part_curve(proto: Prototype) -> None:
 
 def part_a22() -> None:
     """Solve the Manchester A-2.2 poses of CONTACT (the package's patches, exact on them)."""
-    from fastsim_ros import cli
+    import validate_profiles as vp  # A-2.2's poses as the wheelset command's
     from fastsim_ros.cli.wheelset import solve_pose
     from fastsim_ros.geometry import benchmark as bm
     proto = Prototype(bm.SHEAR_MODULUS)
@@ -413,12 +413,7 @@ def part_a22() -> None:
     worst = {v: 0.0 for v in VARIANTS}
     for side in ("right", "left"):
         for case in bm.a22(side):
-            args = cli.build_parser().parse_args([
-                "wheelset", "--dy", repr(case.dy), "--yaw", repr(case.yaw), "--roll",
-                repr(case.roll), "--load", repr(bm.LOAD), "--speed", repr(case.forward_speed),
-                "--axle-spin", repr(case.axle_spin), "--mu", repr(bm.MU), "--shear-modulus",
-                repr(bm.SHEAR_MODULUS), "--nu", repr(bm.POISSON), "--cell", repr(bm.CELL)])
-            cycle, _ = solve_pose(args, case.dy, case.yaw)
+            cycle, _ = solve_pose(vp.pose_args(case, vp.DEFAULT), case.dy, case.yaw)
             for o in cycle.outcomes:
                 if o.patch is None or o.creepage is None or o.forces is None:
                     continue

@@ -79,11 +79,10 @@ About 2 minutes.
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
-import time
 from collections.abc import Callable, Iterator
+import contextlib
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -93,7 +92,6 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
 
-from fastsim_ros import cli  # noqa: E402
 from fastsim_ros.cli.wheelset import solve_pose  # noqa: E402
 from fastsim_ros.contact import exact, samples  # noqa: E402
 from fastsim_ros.contact import mae_calibrated as mc  # noqa: E402
@@ -107,6 +105,8 @@ from fastsim_ros.contact.tables import coefficient_table  # noqa: E402
 from fastsim_ros.geometry import benchmark as bm  # noqa: E402
 
 import validate_accuracy as va  # noqa: E402  (the wheelset's patches and spin cases)
+import validate_profiles as vp  # noqa: E402  (A-2.2's poses as the wheelset command's)
+from research_linear_response import run_parts  # noqa: E402
 
 MU, NU, G = va.MU, va.NU, va.G
 assert (bm.MU, bm.POISSON) == (MU, NU), "A-2.2's friction and nu are the wheelset's"
@@ -182,14 +182,33 @@ def pole_flexibility(variant: str, area: GridArea, geometry: MaeGeometry,
 _DEFAULT_FLEXIBILITY = mc.strip_flexibility
 
 
+Flexibility = Callable[[GridArea, MaeGeometry, ZonePair], StripFlexibility]
+
+
 @contextmanager
-def variant_of(name: str) -> Iterator[None]:
-    """Solve with the default method's ``Ls`` replaced by ``name``'s (:func:`pole_flexibility`)."""
-    mc.strip_flexibility = lambda area, g, z: pole_flexibility(name, area, g, z)
+def flexibility_of(flexibility: Flexibility) -> Iterator[None]:
+    """Solve the default method with its strips' flexibilities from ``flexibility``."""
+    mc.strip_flexibility = flexibility
     try:
-        yield
+        with np.errstate(divide="ignore"):  # strips out of contact: 1/L summed to 0
+            yield
     finally:
         mc.strip_flexibility = _DEFAULT_FLEXIBILITY
+
+
+def variant_of(name: str) -> contextlib.AbstractContextManager[None]:
+    """Solve with the default method's ``Ls`` replaced by ``name``'s (:func:`pole_flexibility`)."""
+    return flexibility_of(lambda area, g, z: pole_flexibility(name, area, g, z))
+
+
+def zone_ratios(area: GridArea, geometry: MaeGeometry) -> np.ndarray:
+    """Return each strip's ``r_s``: its zone's (1 for a strip of an empty zone)."""
+    lower = area.y < geometry.y_s
+    ratio = np.ones(area.ny)
+    for zone, rows in ((geometry.zone1, lower), (geometry.zone2, ~lower)):
+        if not zone.empty:
+            ratio[rows] = r_s(zone.a_over_b)
+    return ratio
 
 
 def solve(area: GridArea, creep: tuple[float, float, float],
@@ -219,10 +238,10 @@ def row(label: str, errs: dict[str, list[float]]) -> str:
     return f"| {label} | " + " | ".join(f"{max(errs[v]):.2f}" for v in VARIANTS) + " |"
 
 
-def header(first: str) -> None:
-    """Print a table's header: ``first``, then the variants."""
-    print(f"| {first} | " + " | ".join(VARIANTS) + " |")
-    print("| --- | " + " | ".join("---" for _ in VARIANTS) + " |")
+def header(first: str, names: tuple[str, ...] = VARIANTS) -> None:
+    """Print a table's header: ``first``, then ``names`` (the variants)."""
+    print(f"| {first} | " + " | ".join(names) + " |")
+    print("| --- | " + " | ".join("---" for _ in names) + " |")
 
 
 def part_ratio() -> None:
@@ -275,12 +294,7 @@ def a22_patches() -> Iterator[tuple[str, GridArea, tuple[float, float, float], f
     """Yield CONTACT's A-2.2 wheel-poses: label, the package's patch, creepages, N."""
     for side in ("right", "left"):
         for case in bm.a22(side):
-            args = cli.build_parser().parse_args([
-                "wheelset", "--dy", repr(case.dy), "--yaw", repr(case.yaw), "--roll",
-                repr(case.roll), "--load", repr(bm.LOAD), "--speed", repr(case.forward_speed),
-                "--axle-spin", repr(case.axle_spin), "--mu", repr(bm.MU), "--shear-modulus",
-                repr(bm.SHEAR_MODULUS), "--nu", repr(bm.POISSON), "--cell", repr(bm.CELL)])
-            cycle, _ = solve_pose(args, case.dy, case.yaw)
+            cycle, _ = solve_pose(vp.pose_args(case, vp.DEFAULT), case.dy, case.yaw)
             for o in cycle.outcomes:
                 if (o.patch is None or o.creepage is None or o.forces is None
                         or not o.contact.startswith(side)):
@@ -364,28 +378,17 @@ def exact_strips(area: GridArea, shear_modulus: float, *, spin: str) -> Iterator
             l1, l2 = (np.where((kk > 0) & (dj > 0), dj / kk, math.inf) for kk in k)
         if spin == "L4":
             return StripFlexibility(l1, l2, flex.l3, flex.spin)
-        lower = part.y < geometry.y_s
-        ratio = np.ones(part.ny)
-        for zone, rows in ((geometry.zone1, lower), (geometry.zone2, ~lower)):
-            if not zone.empty:
-                ratio[rows] = r_s(zone.a_over_b)
-        return StripFlexibility(l1, l2, flex.l3, l1 / ratio)
+        return StripFlexibility(l1, l2, flex.l3, l1 / zone_ratios(part, geometry))
 
-    mc.strip_flexibility = flexibility
-    try:
-        with np.errstate(divide="ignore"):  # strips out of contact: 1/L summed to 0
-            yield
-    finally:
-        mc.strip_flexibility = _DEFAULT_FLEXIBILITY
+    with flexibility_of(flexibility):
+        yield
 
 
 def part_strips() -> None:
     """Print the default against FastSim with the exact strips' stiffness (an oracle)."""
     print("\n## FastSim with the exact strips' stiffness (L1_j, L2_j; the strip knee factors "
           "as the default's): worst error, % of mu N\n")
-    names = ("default", "exact strips, L4", "exact strips, pole")
-    print("| case | " + " | ".join(names) + " |")
-    print("| --- | " + " | ".join("---" for _ in names) + " |")
+    header("case", ("default", "exact strips, L4", "exact strips, pole"))
 
     def three(area: GridArea, creep: tuple[float, float, float], n: float,
               g: float) -> list[float]:
@@ -450,31 +453,18 @@ def exact_spin_strips(area: GridArea, shear_modulus: float, *, pole: bool) -> It
             inv = (-fy - geometry.x_c * dj / flex.l2) / s3j
             l3 = np.where(np.isfinite(inv) & (inv > 0) & part.mask.any(axis=1), 1.0 / inv,
                           flex.l3)
-        spin = flex.spin
-        if pole:
-            lower = part.y < geometry.y_s
-            ratio = np.ones(part.ny)
-            for zone, rows in ((geometry.zone1, lower), (geometry.zone2, ~lower)):
-                if not zone.empty:
-                    ratio[rows] = r_s(zone.a_over_b)
-            spin = flex.l1 / ratio
+        spin = flex.l1 / zone_ratios(part, geometry) if pole else flex.spin
         return StripFlexibility(flex.l1, flex.l2, l3, spin)
 
-    mc.strip_flexibility = flexibility
-    try:
-        with np.errstate(divide="ignore"):  # strips out of contact: 1/L summed to 0
-            yield
-    finally:
-        mc.strip_flexibility = _DEFAULT_FLEXIBILITY
+    with flexibility_of(flexibility):
+        yield
 
 
 def part_spin_strips() -> None:
     """Print the tread's spin cases with the exact strips' lateral force under spin."""
     print("\n## The exact strips' lateral force under spin (L3_j, an oracle): error, % of mu N"
           " (Fx, Fy)\n")
-    names = ("default", "exact strips' L3", "and pole")
-    print("| case | " + " | ".join(names) + " |")
-    print("| --- | " + " | ".join("---" for _ in names) + " |")
+    header("case", ("default", "exact strips' L3", "and pole"))
     shares = []
     for wheel in ("right", "left"):
         area, _, n = va.patches(-0.476e-3, va.axle_spin(None))[wheel]
@@ -506,19 +496,10 @@ def part_spin_strips() -> None:
 
 def main() -> int:
     """Run the ``--part`` chosen (``all``: every part, in order); print the run's time."""
-    parts: dict[str, Callable[[], None]] = {
+    return run_parts(__doc__.splitlines()[0], {
         "ratio": part_ratio, "ellipses": part_ellipses, "wheelset": part_wheelset,
         "a22": part_a22, "coupling": part_coupling, "strips": part_strips,
-        "spin_strips": part_spin_strips}
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--part", default="all", choices=("all", *parts))
-    args = parser.parse_args()
-    start = time.perf_counter()
-    for name, part in parts.items():
-        if args.part in ("all", name):
-            part()
-    print(f"\nThe run took {time.perf_counter() - start:.0f} s.")
-    return 0
+        "spin_strips": part_spin_strips})
 
 
 if __name__ == "__main__":

@@ -76,7 +76,8 @@ TARGET = {"position": 0.5e-3, "angle": 0.01, "n": 0.01, "creepage": 0.02, "creep
           "exact": 5.0, "default": 10.0}
 
 
-def _args(case: benchmark.CaseResult, method: str) -> argparse.Namespace:
+def pose_args(case: benchmark.CaseResult, method: str) -> argparse.Namespace:
+    """Return the ``fastsim_contact wheelset`` arguments of an A-2.2 wheel-pose."""
     return cli.build_parser().parse_args([
         "wheelset", "--dy", repr(case.dy), "--yaw", repr(case.yaw), "--roll", repr(case.roll),
         "--load", repr(benchmark.LOAD), "--speed", repr(case.forward_speed),
@@ -87,7 +88,7 @@ def _args(case: benchmark.CaseResult, method: str) -> argparse.Namespace:
 
 def solve_case(case: benchmark.CaseResult, method: str) -> dict[str, Any]:
     """One wheel of one pose: the package's numbers in the benchmark's terms."""
-    args = _args(case, method)
+    args = pose_args(case, method)
     start = time.perf_counter()
     cycle, pipeline = solve_pose(args, case.dy, case.yaw)
     seconds = time.perf_counter() - start
