@@ -115,6 +115,8 @@ VARIANTS = ("L4", "pole", "pole+C13")
 ASPECTS = (0.1, 0.2, 0.3, 0.5, 0.7, 1.0, 1.5, 2.0, 3.0, 5.0, 10.0)
 TABLE, PAIRS, KNEE = coefficient_table(NU), pair_factors(NU), knee_factors(NU)
 _RATIO: list[np.ndarray] = []
+#: the default method's strip flexibilities (every variant starts from them)
+_DEFAULT_FLEXIBILITY = mc.strip_flexibility
 
 
 def ellipse(aspect: float, cells: int = 40) -> GridArea:
@@ -177,9 +179,6 @@ def pole_flexibility(variant: str, area: GridArea, geometry: MaeGeometry,
         spin = l1 * y_rel / (ratio * y_rel - shift)
     spin = np.where(np.isfinite(flex.l1) & np.isfinite(spin), spin, flex.spin)
     return StripFlexibility(flex.l1, flex.l2, flex.l3, spin)
-
-
-_DEFAULT_FLEXIBILITY = mc.strip_flexibility
 
 
 Flexibility = Callable[[GridArea, MaeGeometry, ZonePair], StripFlexibility]

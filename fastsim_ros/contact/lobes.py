@@ -13,8 +13,8 @@ apart, the regions' forces are the exact theory's within 0.8% of ``mu N``
 through the take-over, and the exact theory on the regions apart is within
 0.2% of the exact theory on the whole grid (the half-space couples regions
 8 mm apart only weakly).  Regions that touch are coupled strongly: solved apart, two
-lobes joined by a thin neck came out up to 0.9% of ``mu N`` further from the
-exact theory than whole, so a neck is not a gap.
+lobes joined by a thin neck are up to 0.9% of ``mu N`` further from the exact
+theory than whole, so a neck is not a gap.
 
 The rule, continuous as a gap opens: the widest gap (empty strips between
 contact strips, measured between the two sides' edges relative to the
